@@ -1,0 +1,756 @@
+//! The genetic algorithm of the paper (§2.2): selection, crossover and mutation for one generation.
+//!
+//! A population is a `P x G` row-major array of genomes (see [`crate::genome`] for the gene
+//! order). [`next_generation`] turns the parents and their fitness into the children:
+//!
+//! 1. the first `elitism` children are exact copies of the best parents (off by default, as in the
+//!    paper);
+//! 2. every other child c draws only from its own stream,
+//!    `Stream::new(seed, generation, Purpose::Reproduce, c, 0)`. With probability
+//!    `crossover_rate` it selects two parents and a cut x uniform in `1..=N-1`, taking neurons
+//!    `0..x` from the first and the rest from the second; otherwise it selects one parent and
+//!    copies it. Then each gene is resampled over its range with probability `mutation_rate`.
+//!
+//! Because no child shares randomness with another, children are built in parallel and the result
+//! is the same bits for any number of threads.
+//!
+//! # Example
+//! ```
+//! use ctrnn::ga::{initial_population, next_generation, GaConfig};
+//! use ctrnn::genome::Layout;
+//! let layout = Layout { size: 2, n_inputs: 1 };
+//! let config = GaConfig { population: 10, ..GaConfig::default() };
+//! let parents = initial_population(layout, &config, 7)?;
+//! let fitness: Vec<f64> = (0..10).map(|i| i as f64).collect();
+//! let children = next_generation(&parents, &fitness, layout, &config, 7, 0)?;
+//! assert_eq!(children.len(), parents.len());
+//! # Ok::<(), ctrnn::Error>(())
+//! ```
+
+use std::fmt;
+use std::str::FromStr;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::genome::{self, Layout, Ranges};
+use crate::rng::{Purpose, Stream};
+
+/// How parents are chosen from the fitness values.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Selection {
+    /// Probability proportional to fitness, uniform when every fitness is 0 (the paper's).
+    /// Needs every fitness >= 0.
+    #[default]
+    Proportional,
+    /// Linear ranking: probability proportional to rank, worst = 1 and best = P. Any finite
+    /// fitness is allowed; equal fitness ranks the lower index higher.
+    Rank,
+}
+
+impl Selection {
+    /// The lowercase name used in configs: `"proportional"` or `"rank"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Selection::Proportional => "proportional",
+            Selection::Rank => "rank",
+        }
+    }
+}
+
+impl fmt::Display for Selection {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for Selection {
+    type Err = Error;
+
+    /// Parses `"proportional"` or `"rank"`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "proportional" => Ok(Selection::Proportional),
+            "rank" => Ok(Selection::Rank),
+            _ => Err(Error::Config(format!(
+                "selection is \"{s}\"; it must be \"proportional\" or \"rank\""
+            ))),
+        }
+    }
+}
+
+/// The settings of the genetic algorithm.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GaConfig {
+    /// Number of individuals P (at least 2). Default 100.
+    pub population: usize,
+    /// Probability that a child is made by crossover rather than by copying one parent, in [0, 1].
+    /// Default 0.5.
+    pub crossover_rate: f64,
+    /// Probability that each gene of a child is resampled over its range, in [0, 1].
+    /// Default 0.025.
+    pub mutation_rate: f64,
+    /// Number of best individuals copied unchanged into the next generation (below
+    /// `population`). Default 0, as in the paper.
+    pub elitism: usize,
+    /// How parents are selected. Default [`Selection::Proportional`], as in the paper.
+    pub selection: Selection,
+    /// Intervals for the initial draw and for mutation. Default [`Ranges::default`].
+    pub ranges: Ranges,
+}
+
+impl Default for GaConfig {
+    fn default() -> Self {
+        GaConfig {
+            population: 100,
+            crossover_rate: 0.5,
+            mutation_rate: 0.025,
+            elitism: 0,
+            selection: Selection::Proportional,
+            ranges: Ranges::default(),
+        }
+    }
+}
+
+impl GaConfig {
+    /// Checks every setting; the error names the setting, its value and what is allowed.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::ga::GaConfig;
+    /// let bad = GaConfig { crossover_rate: 1.5, ..GaConfig::default() };
+    /// assert_eq!(
+    ///     bad.validate().unwrap_err().to_string(),
+    ///     "invalid config: crossover_rate is 1.5; it must be in [0, 1]"
+    /// );
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        if self.population < 2 {
+            return Err(Error::Config(format!(
+                "population is {}; it must be at least 2",
+                self.population
+            )));
+        }
+        for (name, rate) in [
+            ("crossover_rate", self.crossover_rate),
+            ("mutation_rate", self.mutation_rate),
+        ] {
+            if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
+                return Err(Error::Config(format!(
+                    "{name} is {rate}; it must be in [0, 1]"
+                )));
+            }
+        }
+        if self.elitism >= self.population {
+            return Err(Error::Config(format!(
+                "elitism is {}; it must be below population = {}",
+                self.elitism, self.population
+            )));
+        }
+        self.ranges.validate()
+    }
+}
+
+/// Checks that `fitness` can be selected on: every value finite, and every value >= 0 for
+/// proportional selection. Errors name the individual.
+pub fn check_fitness(fitness: &[f64], selection: Selection) -> Result<()> {
+    if let Some(i) = fitness.iter().position(|f| !f.is_finite()) {
+        return Err(Error::Fitness(format!(
+            "fitness of individual {i} is {}; every fitness must be finite",
+            fitness[i]
+        )));
+    }
+    if selection == Selection::Proportional {
+        if let Some(i) = fitness.iter().position(|&f| f < 0.0) {
+            return Err(Error::Fitness(format!(
+                "fitness of individual {i} is {}; proportional selection needs every fitness \
+                 >= 0 (use selection = \"rank\" for negative fitness)",
+                fitness[i]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Draws parent indices with fixed probabilities, built once per generation.
+///
+/// Holds the prefix sums of the selection weights; each draw is one uniform and a binary search.
+#[derive(Clone, Debug)]
+pub struct Selector {
+    /// `cumulative[i]` = sum of the weights of individuals `0..=i`.
+    cumulative: Vec<f64>,
+    /// The last individual with a positive weight (guards against rounding at the top end).
+    last: usize,
+}
+
+impl Selector {
+    /// The selector for `fitness` under `selection`, after [`check_fitness`].
+    ///
+    /// Proportional: weight = fitness, or 1 for everyone when every fitness is 0.
+    /// Rank: weight = rank, worst = 1 and best = P, equal fitness ranking the lower index higher.
+    pub fn new(fitness: &[f64], selection: Selection) -> Result<Selector> {
+        if fitness.is_empty() {
+            return Err(Error::Fitness(
+                "there are no fitness values; selection needs at least 1 individual".into(),
+            ));
+        }
+        check_fitness(fitness, selection)?;
+        let weights: Vec<f64> = match selection {
+            Selection::Proportional => {
+                if fitness.iter().all(|&f| f == 0.0) {
+                    vec![1.0; fitness.len()]
+                } else {
+                    fitness.to_vec()
+                }
+            }
+            Selection::Rank => {
+                // Worst first; among equal fitness the higher index first, so it ranks lower.
+                let mut order: Vec<usize> = (0..fitness.len()).collect();
+                order.sort_by(|&a, &b| fitness[a].total_cmp(&fitness[b]).then(b.cmp(&a)));
+                let mut w = vec![0.0; fitness.len()];
+                for (rank0, &i) in order.iter().enumerate() {
+                    w[i] = (rank0 + 1) as f64;
+                }
+                w
+            }
+        };
+        let mut total = 0.0;
+        let cumulative: Vec<f64> = weights
+            .iter()
+            .map(|w| {
+                total += w;
+                total
+            })
+            .collect();
+        if !total.is_finite() {
+            return Err(Error::Fitness(format!(
+                "the fitness values sum to {total}; they are too large to select on"
+            )));
+        }
+        let last = weights.iter().rposition(|&w| w > 0.0).unwrap_or(0);
+        Ok(Selector { cumulative, last })
+    }
+
+    /// Draws one individual: a single uniform from `stream`, then a binary search.
+    pub fn pick(&self, stream: &mut Stream) -> usize {
+        let total = self.cumulative[self.cumulative.len() - 1];
+        let u = stream.uniform() * total;
+        // The first individual whose cumulative weight exceeds u; zero weights are never chosen.
+        let i = self.cumulative.partition_point(|&c| c <= u);
+        i.min(self.last)
+    }
+
+    /// The probability of picking each individual.
+    pub fn probabilities(&self) -> Vec<f64> {
+        let total = self.cumulative[self.cumulative.len() - 1];
+        let mut prev = 0.0;
+        self.cumulative
+            .iter()
+            .map(|&c| {
+                let p = (c - prev) / total;
+                prev = c;
+                p
+            })
+            .collect()
+    }
+}
+
+/// Indices of the `k` best individuals, best first; equal fitness puts the lower index first.
+fn best_indices(fitness: &[f64], k: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..fitness.len()).collect();
+    order.sort_by(|&a, &b| fitness[b].total_cmp(&fitness[a]).then(a.cmp(&b)));
+    order.truncate(k);
+    order
+}
+
+/// The initial population, `population x G` row-major: individual i is
+/// [`genome::random`] drawn from `Stream::new(seed, 0, Purpose::Init, i, 0)`.
+pub fn initial_population(layout: Layout, config: &GaConfig, seed: u64) -> Result<Vec<f64>> {
+    config.validate()?;
+    layout.validate()?;
+    let g = layout.len();
+    let mut genes = vec![0.0; config.population * g];
+    genes.par_chunks_mut(g).enumerate().for_each(|(i, row)| {
+        let mut stream = Stream::new(seed, 0, Purpose::Init, i as u64, 0);
+        row.copy_from_slice(&genome::random(layout, &config.ranges, &mut stream));
+    });
+    Ok(genes)
+}
+
+/// Builds generation `generation + 1` from `parents` (`P x G` row-major, P = `config.population`)
+/// and their `fitness`, returning the `P x G` children. See the module docs for the operators.
+///
+/// The result depends only on the arguments, not on the number of threads.
+pub fn next_generation(
+    parents: &[f64],
+    fitness: &[f64],
+    layout: Layout,
+    config: &GaConfig,
+    seed: u64,
+    generation: u64,
+) -> Result<Vec<f64>> {
+    config.validate()?;
+    layout.validate()?;
+    let (p, g) = (config.population, layout.len());
+    if fitness.len() != p {
+        return Err(Error::InvalidArgument(format!(
+            "fitness has {} values; expected population = {p}",
+            fitness.len()
+        )));
+    }
+    if parents.len() != p * g {
+        return Err(Error::InvalidArgument(format!(
+            "parents has {} values; expected population x genome length = {p} x {g} = {}",
+            parents.len(),
+            p * g
+        )));
+    }
+    let selector = Selector::new(fitness, config.selection)?;
+    let parent = |i: usize| &parents[i * g..(i + 1) * g];
+    let per = layout.genes_per_neuron();
+
+    let mut children = vec![0.0; p * g];
+    let (elites, rest) = children.split_at_mut(config.elitism * g);
+    for (row, best) in elites
+        .chunks_exact_mut(g)
+        .zip(best_indices(fitness, config.elitism))
+    {
+        row.copy_from_slice(parent(best));
+    }
+    rest.par_chunks_mut(g).enumerate().for_each(|(k, child)| {
+        let c = config.elitism + k;
+        let mut stream = Stream::new(seed, generation, Purpose::Reproduce, c as u64, 0);
+        if stream.bernoulli(config.crossover_rate) {
+            let a = selector.pick(&mut stream);
+            let b = selector.pick(&mut stream);
+            if layout.size == 1 {
+                child.copy_from_slice(parent(a));
+            } else {
+                let x = stream.range_inclusive_int(1, layout.size as u64 - 1) as usize;
+                let cut = x * per;
+                child[..cut].copy_from_slice(&parent(a)[..cut]);
+                child[cut..].copy_from_slice(&parent(b)[cut..]);
+            }
+        } else {
+            child.copy_from_slice(parent(selector.pick(&mut stream)));
+        }
+        genome::mutate(
+            layout,
+            &config.ranges,
+            child,
+            config.mutation_rate,
+            &mut stream,
+        );
+    });
+    Ok(children)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn layout(size: usize, n_inputs: usize) -> Layout {
+        Layout { size, n_inputs }
+    }
+
+    /// Parents whose neuron k of individual p holds the marker `1000 p + k` in every gene.
+    fn marked_parents(p: usize, l: Layout) -> Vec<f64> {
+        let per = l.genes_per_neuron();
+        (0..p * l.len())
+            .map(|x| {
+                let (i, g) = (x / l.len(), x % l.len());
+                (1000 * i + g / per) as f64
+            })
+            .collect()
+    }
+
+    #[test]
+    fn selection_parses_and_serializes() {
+        assert_eq!("rank".parse::<Selection>().unwrap(), Selection::Rank);
+        assert_eq!(
+            "proportional".parse::<Selection>().unwrap(),
+            Selection::Proportional
+        );
+        let e = "roulette".parse::<Selection>().unwrap_err().to_string();
+        assert!(e.contains("\"roulette\"") && e.contains("\"rank\""), "{e}");
+        assert_eq!(serde_json::to_string(&Selection::Rank).unwrap(), "\"rank\"");
+        let c: GaConfig = serde_json::from_str(r#"{"selection": "rank", "elitism": 2}"#).unwrap();
+        assert_eq!(c.selection, Selection::Rank);
+        assert_eq!(c.population, 100);
+        assert!(serde_json::from_str::<GaConfig>(r#"{"populaton": 5}"#).is_err());
+    }
+
+    #[test]
+    fn config_validation_messages() {
+        assert!(GaConfig::default().validate().is_ok());
+        let msg = |c: GaConfig| c.validate().unwrap_err().to_string();
+        let d = GaConfig::default;
+        assert!(msg(GaConfig {
+            population: 1,
+            ..d()
+        })
+        .contains("population is 1"));
+        assert!(msg(GaConfig {
+            mutation_rate: f64::NAN,
+            ..d()
+        })
+        .contains("mutation_rate is NaN; it must be in [0, 1]"));
+        assert!(msg(GaConfig {
+            crossover_rate: -0.1,
+            ..d()
+        })
+        .contains("crossover_rate is -0.1"));
+        assert!(msg(GaConfig {
+            elitism: 100,
+            ..d()
+        })
+        .contains("elitism is 100; it must be below population = 100"));
+        let e = GaConfig {
+            ranges: Ranges {
+                tau: (-1.0, 1.0),
+                ..Ranges::default()
+            },
+            ..d()
+        }
+        .validate()
+        .unwrap_err();
+        assert!(matches!(e, Error::Config(_)) && e.to_string().contains("ranges.tau"));
+    }
+
+    #[test]
+    fn bad_fitness_names_the_individual() {
+        let mut f = vec![1.0; 10];
+        f[7] = f64::NAN;
+        let e = check_fitness(&f, Selection::Rank).unwrap_err();
+        assert!(matches!(e, Error::Fitness(_)));
+        assert!(
+            e.to_string().contains("fitness of individual 7 is NaN"),
+            "{e}"
+        );
+        f[7] = f64::NEG_INFINITY;
+        assert!(check_fitness(&f, Selection::Rank)
+            .unwrap_err()
+            .to_string()
+            .contains("individual 7 is -inf"));
+        f[7] = -0.5;
+        assert!(check_fitness(&f, Selection::Rank).is_ok());
+        let e = check_fitness(&f, Selection::Proportional)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("individual 7 is -0.5") && e.contains("\"rank\""),
+            "{e}"
+        );
+        // next_generation reports it too.
+        let l = layout(2, 0);
+        let config = GaConfig {
+            population: 10,
+            ..GaConfig::default()
+        };
+        f[7] = f64::NAN;
+        let parents = vec![1.0; 10 * l.len()];
+        let e = next_generation(&parents, &f, l, &config, 0, 0).unwrap_err();
+        assert!(e.to_string().contains("individual 7 is NaN"), "{e}");
+    }
+
+    #[test]
+    fn shape_errors() {
+        let l = layout(2, 1);
+        let config = GaConfig {
+            population: 4,
+            ..GaConfig::default()
+        };
+        let e = next_generation(&[0.0; 40], &[1.0; 3], l, &config, 0, 0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fitness has 3 values; expected population = 4"),
+            "{e}"
+        );
+        let e = next_generation(&[0.0; 39], &[1.0; 4], l, &config, 0, 0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("4 x 10 = 40"), "{e}");
+    }
+
+    fn frequencies(sel: &Selector, draws: usize, seed: u64) -> Vec<usize> {
+        let mut counts = vec![0; sel.probabilities().len()];
+        let mut s = Stream::new(seed, 0, Purpose::Evaluate, 0, 0);
+        for _ in 0..draws {
+            counts[sel.pick(&mut s)] += 1;
+        }
+        counts
+    }
+
+    /// Chi-square statistic of `counts` against probabilities `probs` (cells with p = 0 must be 0).
+    fn chi2(counts: &[usize], probs: &[f64]) -> f64 {
+        let n: usize = counts.iter().sum();
+        counts
+            .iter()
+            .zip(probs)
+            .map(|(&c, &p)| {
+                if p == 0.0 {
+                    assert_eq!(c, 0, "picked an individual with probability 0");
+                    0.0
+                } else {
+                    let e = p * n as f64;
+                    (c as f64 - e).powi(2) / e
+                }
+            })
+            .sum()
+    }
+
+    #[test]
+    fn proportional_selection_follows_fitness() {
+        let fitness = [1.0, 2.0, 0.0, 3.0, 4.0, 0.5];
+        let sel = Selector::new(&fitness, Selection::Proportional).unwrap();
+        let probs = sel.probabilities();
+        let expected: Vec<f64> = fitness.iter().map(|f| f / 10.5).collect();
+        for (p, e) in probs.iter().zip(&expected) {
+            assert!((p - e).abs() < 1e-15);
+        }
+        let counts = frequencies(&sel, 200_000, 1);
+        // 4 degrees of freedom (5 non-zero cells): P(chi2 > 18.47) = 0.001.
+        let x = chi2(&counts, &probs);
+        assert!(x < 18.47, "chi2 = {x}, counts {counts:?}");
+        // A wrong table must fail the same test: compare with uniform over the non-zero cells.
+        let wrong = [0.2, 0.2, 0.0, 0.2, 0.2, 0.2];
+        assert!(chi2(&counts, &wrong) > 100.0);
+    }
+
+    #[test]
+    fn all_zero_fitness_selects_uniformly() {
+        let sel = Selector::new(&[0.0; 8], Selection::Proportional).unwrap();
+        assert_eq!(sel.probabilities(), vec![0.125; 8]);
+        let counts = frequencies(&sel, 80_000, 2);
+        // 7 degrees of freedom: P(chi2 > 24.32) = 0.001.
+        let x = chi2(&counts, &[0.125; 8]);
+        assert!(x < 24.32, "chi2 = {x}, counts {counts:?}");
+    }
+
+    #[test]
+    fn rank_selection_is_linear_in_rank() {
+        // Ranks: individual 1 (-1) = 1, 3 (0) = 2, 2 (5, higher index of a tie) = 3, 0 (5) = 4.
+        let sel = Selector::new(&[5.0, -1.0, 5.0, 0.0], Selection::Rank).unwrap();
+        let probs = sel.probabilities();
+        let expected = [0.4, 0.1, 0.3, 0.2];
+        for (p, e) in probs.iter().zip(expected) {
+            assert!((p - e).abs() < 1e-15, "{probs:?}");
+        }
+        let counts = frequencies(&sel, 100_000, 3);
+        // 3 degrees of freedom: P(chi2 > 16.27) = 0.001.
+        let x = chi2(&counts, &expected);
+        assert!(x < 16.27, "chi2 = {x}, counts {counts:?}");
+    }
+
+    #[test]
+    fn selection_edge_cases() {
+        // A single positive fitness is always picked, including at the top of the table.
+        let sel = Selector::new(&[0.0, 0.0, 3.0, 0.0], Selection::Proportional).unwrap();
+        let counts = frequencies(&sel, 1000, 4);
+        assert_eq!(counts, vec![0, 0, 1000, 0]);
+        assert!(Selector::new(&[], Selection::Rank).is_err());
+        let e = Selector::new(&[f64::MAX, f64::MAX], Selection::Proportional).unwrap_err();
+        assert!(matches!(e, Error::Fitness(_)));
+    }
+
+    #[test]
+    fn mutation_changes_each_gene_with_the_configured_frequency() {
+        let l = layout(3, 2); // 21 genes
+        let p = 2000;
+        let rate = 0.05;
+        let config = GaConfig {
+            population: p,
+            crossover_rate: 0.0,
+            mutation_rate: rate,
+            ..GaConfig::default()
+        };
+        // Every parent the same genome, so a child's gene differs exactly when it was mutated.
+        let mut s = Stream::new(0, 0, Purpose::Init, 0, 0);
+        let one = genome::random(l, &config.ranges, &mut s);
+        let parents: Vec<f64> = one.iter().copied().cycle().take(p * l.len()).collect();
+        let children = next_generation(&parents, &vec![1.0; p], l, &config, 5, 0).unwrap();
+        let mut per_gene = vec![0usize; l.len()];
+        for child in children.chunks_exact(l.len()) {
+            for (g, (a, b)) in child.iter().zip(&one).enumerate() {
+                if a != b {
+                    per_gene[g] += 1;
+                }
+            }
+        }
+        let total: usize = per_gene.iter().sum();
+        let n = (p * l.len()) as f64;
+        let sd = (n * rate * (1.0 - rate)).sqrt(); // ~ 45
+        assert!((total as f64 - n * rate).abs() < 5.0 * sd, "{total} of {n}");
+        let sd1 = (p as f64 * rate * (1.0 - rate)).sqrt(); // ~ 9.7 per gene
+        for (g, &c) in per_gene.iter().enumerate() {
+            assert!(
+                (c as f64 - p as f64 * rate).abs() < 5.0 * sd1,
+                "gene {g} mutated {c} times of {p}"
+            );
+        }
+    }
+
+    #[test]
+    fn crossover_cuts_only_at_neuron_boundaries() {
+        let l = layout(5, 2);
+        let per = l.genes_per_neuron();
+        let p = 40;
+        let config = GaConfig {
+            population: p,
+            crossover_rate: 1.0,
+            mutation_rate: 0.0,
+            ..GaConfig::default()
+        };
+        let parents = marked_parents(p, l);
+        let fitness: Vec<f64> = (0..p).map(|i| 1.0 + i as f64).collect();
+        let children = next_generation(&parents, &fitness, l, &config, 9, 3).unwrap();
+        let mut cuts_seen = [false; 5];
+        for child in children.chunks_exact(l.len()) {
+            // Each neuron block wholly from one parent, and that parent's own neuron k.
+            let source: Vec<usize> = child
+                .chunks_exact(per)
+                .enumerate()
+                .map(|(k, block)| {
+                    assert!(
+                        block.iter().all(|&v| v == block[0]),
+                        "split block {block:?}"
+                    );
+                    let m = block[0] as usize;
+                    assert_eq!(m % 1000, k, "neuron {k} came from another position");
+                    m / 1000
+                })
+                .collect();
+            // A prefix of parent A then a suffix of parent B, cut somewhere in 1..=N-1.
+            let a = source[0];
+            let b = source[l.size - 1];
+            let x = source.iter().position(|&s| s != a).unwrap_or(l.size);
+            assert!(source[x..].iter().all(|&s| s == b), "{source:?}");
+            if a != b {
+                assert!((1..l.size).contains(&x));
+                cuts_seen[x] = true;
+            }
+        }
+        assert_eq!(cuts_seen, [false, true, true, true, true]);
+
+        // Without crossover, every child is a copy of one parent.
+        let config0 = GaConfig {
+            crossover_rate: 0.0,
+            ..config.clone()
+        };
+        let children = next_generation(&parents, &fitness, l, &config0, 9, 3).unwrap();
+        for child in children.chunks_exact(l.len()) {
+            let i = child[0] as usize / 1000;
+            assert_eq!(child, &parents[i * l.len()..(i + 1) * l.len()]);
+        }
+
+        // One neuron: crossover copies the first parent.
+        let l1 = layout(1, 1);
+        let parents1 = marked_parents(p, l1);
+        let children = next_generation(&parents1, &fitness, l1, &config, 9, 3).unwrap();
+        for child in children.chunks_exact(l1.len()) {
+            assert!(child.iter().all(|&v| v == child[0]));
+        }
+    }
+
+    #[test]
+    fn resampled_genes_stay_in_range() {
+        let l = layout(3, 2);
+        let ranges = Ranges {
+            tau: (1.0, 1.5),
+            theta: (2.0, 3.0),
+            weights: (-5.0, -4.0),
+            sensor_weights: (7.0, 7.25),
+        };
+        let config = GaConfig {
+            population: 50,
+            mutation_rate: 1.0,
+            ranges,
+            ..GaConfig::default()
+        };
+        let parents = vec![100.0; 50 * l.len()]; // out of every range
+        let children = next_generation(&parents, &[1.0; 50], l, &config, 1, 1).unwrap();
+        for child in children.chunks_exact(l.len()) {
+            for (g, &v) in child.iter().enumerate() {
+                let (lo, hi) = genome::gene_range(l, &ranges, g);
+                assert!(lo <= v && v < hi, "gene {g} = {v} outside [{lo}, {hi})");
+            }
+            assert!(genome::decode(l, child).is_ok());
+        }
+        let init = initial_population(l, &config, 3).unwrap();
+        for child in init.chunks_exact(l.len()) {
+            for (g, &v) in child.iter().enumerate() {
+                let (lo, hi) = genome::gene_range(l, &ranges, g);
+                assert!(lo <= v && v < hi);
+            }
+        }
+    }
+
+    #[test]
+    fn elitism_copies_the_best_unchanged() {
+        let l = layout(2, 1);
+        let p = 10;
+        let config = GaConfig {
+            population: p,
+            elitism: 3,
+            crossover_rate: 1.0,
+            mutation_rate: 1.0,
+            ..GaConfig::default()
+        };
+        let parents = marked_parents(p, l);
+        let fitness = [1.0, 9.0, 2.0, 5.0, 9.0, 0.0, 7.0, 3.0, 4.0, 1.0];
+        let children = next_generation(&parents, &fitness, l, &config, 2, 0).unwrap();
+        let g = l.len();
+        // Best: 1 and 4 (tie at 9, lower index first), then 6.
+        for (c, best) in [1usize, 4, 6].into_iter().enumerate() {
+            assert_eq!(
+                &children[c * g..(c + 1) * g],
+                &parents[best * g..(best + 1) * g]
+            );
+        }
+        // Everything after the elites was fully mutated.
+        let parent_values: Vec<f64> = parents.clone();
+        assert!(children[3 * g..].iter().all(|v| !parent_values.contains(v)));
+    }
+
+    #[test]
+    fn result_is_independent_of_thread_count() {
+        let l = layout(4, 2);
+        let p = 64;
+        let config = GaConfig {
+            population: p,
+            elitism: 2,
+            mutation_rate: 0.1,
+            ..GaConfig::default()
+        };
+        let parents = initial_population(l, &config, 11).unwrap();
+        let fitness: Vec<f64> = (0..p).map(|i| ((i * 37) % 17) as f64).collect();
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| next_generation(&parents, &fitness, l, &config, 11, 4).unwrap())
+        };
+        let one = run(1);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&one), bits(&run(2)));
+        assert_eq!(bits(&one), bits(&run(4)));
+        // Same inputs, same children; another generation, other children.
+        assert_eq!(bits(&one), bits(&run(1)));
+        let other = next_generation(&parents, &fitness, l, &config, 11, 5).unwrap();
+        assert_ne!(bits(&one), bits(&other));
+        // The initial population does not depend on threads either.
+        let init = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| initial_population(l, &config, 11).unwrap())
+        };
+        assert_eq!(bits(&init(1)), bits(&init(3)));
+    }
+}

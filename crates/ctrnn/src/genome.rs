@@ -1,0 +1,478 @@
+//! The modular genome (paper §2.2): a network's parameters as one flat vector of model units.
+//!
+//! A network of N neurons and M sensors has `N * (2 + M + N)` genes, one indivisible block of
+//! `2 + M + N` genes per neuron. Neuron i's block is, in order:
+//!
+//! ```text
+//! tau_i, theta_i, sensor_weights[i][0..M], weights[i][0..N]
+//! ```
+//!
+//! where `weights[i][j]` is the weight from neuron j to neuron i, so a block holds the neuron's
+//! time constant, its threshold, and everything that flows into it. Gene g belongs to neuron
+//! `g / (2 + M + N)`. This is the layout of the genomes that ask/tell hands out and takes back, and
+//! crossover cuts only between blocks.
+//!
+//! Genes are stored in model units (no scaling to [0, 1]); [`Ranges`] only bounds the initial draw
+//! and mutation.
+//!
+//! # Example
+//! ```
+//! use ctrnn::genome::{decode, encode, random, Layout, Ranges};
+//! use ctrnn::rng::{Purpose, Stream};
+//! let layout = Layout { size: 3, n_inputs: 1 };
+//! let mut stream = Stream::new(1, 0, Purpose::Init, 0, 0);
+//! let genes = random(layout, &Ranges::default(), &mut stream);
+//! assert_eq!(genes.len(), layout.len()); // 3 x (2 + 1 + 3) = 18
+//! let net = decode(layout, &genes)?;
+//! assert_eq!(encode(&net), genes);
+//! # Ok::<(), ctrnn::Error>(())
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::network::Network;
+use crate::rng::Stream;
+
+/// The intervals that the initial population is drawn from and that mutation resamples over.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Ranges {
+    /// Time constants `(lo, hi)`, with `lo > 0`. Default `(0.5, 10.0)`.
+    pub tau: (f64, f64),
+    /// Thresholds `(lo, hi)`. Default `(-16.0, 16.0)`.
+    pub theta: (f64, f64),
+    /// Recurrent weights `(lo, hi)`. Default `(-16.0, 16.0)`.
+    pub weights: (f64, f64),
+    /// Sensor weights `(lo, hi)`. Default `(-16.0, 16.0)`.
+    pub sensor_weights: (f64, f64),
+}
+
+impl Default for Ranges {
+    fn default() -> Self {
+        Ranges {
+            tau: (0.5, 10.0),
+            theta: (-16.0, 16.0),
+            weights: (-16.0, 16.0),
+            sensor_weights: (-16.0, 16.0),
+        }
+    }
+}
+
+impl Ranges {
+    /// Checks every interval: finite bounds with `lo < hi`, and `tau`'s `lo > 0`.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::genome::Ranges;
+    /// let bad = Ranges { theta: (1.0, -1.0), ..Ranges::default() };
+    /// assert!(bad.validate().unwrap_err().to_string().contains("ranges.theta"));
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        for (name, (lo, hi)) in [
+            ("tau", self.tau),
+            ("theta", self.theta),
+            ("weights", self.weights),
+            ("sensor_weights", self.sensor_weights),
+        ] {
+            if !(lo.is_finite() && hi.is_finite()) {
+                return Err(Error::Config(format!(
+                    "ranges.{name} is ({lo}, {hi}); both bounds must be finite"
+                )));
+            }
+            if lo >= hi {
+                return Err(Error::Config(format!(
+                    "ranges.{name} is ({lo}, {hi}); the lower bound must be below the upper bound"
+                )));
+            }
+        }
+        if self.tau.0 <= 0.0 {
+            return Err(Error::Config(format!(
+                "ranges.tau is ({}, {}); time constants must be > 0, so the lower bound must be > 0",
+                self.tau.0, self.tau.1
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The shape of a genome: N neurons and M sensors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layout {
+    /// Number of neurons N (at least 1).
+    pub size: usize,
+    /// Number of sensors M (may be 0).
+    pub n_inputs: usize,
+}
+
+impl Layout {
+    /// The layout of an existing network.
+    pub fn of(net: &Network) -> Layout {
+        Layout {
+            size: net.size(),
+            n_inputs: net.n_inputs(),
+        }
+    }
+
+    /// Genes in one neuron's block: `2 + M + N`.
+    pub fn genes_per_neuron(&self) -> usize {
+        2 + self.n_inputs + self.size
+    }
+
+    /// Genes in the whole genome: `N * (2 + M + N)`.
+    #[allow(clippy::len_without_is_empty)]
+    pub fn len(&self) -> usize {
+        self.size * self.genes_per_neuron()
+    }
+
+    /// Checks that the layout has at least one neuron.
+    pub fn validate(&self) -> Result<()> {
+        if self.size == 0 {
+            return Err(Error::Config(
+                "layout.size is 0; a network needs at least 1 neuron".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A readable name for gene `g`, such as `"gene 9 (neuron 1, weights[1][2])"`.
+    pub fn gene_name(&self, g: usize) -> String {
+        let per = self.genes_per_neuron();
+        let (i, o) = (g / per, g % per);
+        let what = match Gene::of(*self, o) {
+            Gene::Tau => format!("tau[{i}]"),
+            Gene::Theta => format!("theta[{i}]"),
+            Gene::SensorWeight(k) => format!("sensor_weights[{i}][{k}]"),
+            Gene::Weight(j) => format!("weights[{i}][{j}]"),
+        };
+        format!("gene {g} (neuron {i}, {what})")
+    }
+}
+
+/// Which parameter a position inside a neuron's block holds.
+enum Gene {
+    Tau,
+    Theta,
+    SensorWeight(usize),
+    Weight(usize),
+}
+
+impl Gene {
+    /// The parameter at offset `o` (`0 <= o < 2 + M + N`) of a block.
+    fn of(layout: Layout, o: usize) -> Gene {
+        match o {
+            0 => Gene::Tau,
+            1 => Gene::Theta,
+            o if o < 2 + layout.n_inputs => Gene::SensorWeight(o - 2),
+            o => Gene::Weight(o - 2 - layout.n_inputs),
+        }
+    }
+}
+
+/// The genome of `net`, in the block order described in the module docs. The state is not encoded.
+pub fn encode(net: &Network) -> Vec<f64> {
+    let (n, m) = (net.size(), net.n_inputs());
+    let mut genes = Vec::with_capacity(Layout::of(net).len());
+    for i in 0..n {
+        genes.push(net.tau()[i]);
+        genes.push(net.theta()[i]);
+        genes.extend_from_slice(&net.sensor_weights()[i * m..(i + 1) * m]);
+        genes.extend_from_slice(&net.weights()[i * n..(i + 1) * n]);
+    }
+    genes
+}
+
+/// The network that `genes` encodes, with its state at zero; the exact inverse of [`encode`].
+///
+/// Errors name the offending gene and its neuron: a wrong length, a non-finite value, or a time
+/// constant that is not positive.
+pub fn decode(layout: Layout, genes: &[f64]) -> Result<Network> {
+    layout.validate()?;
+    let (n, m, per) = (layout.size, layout.n_inputs, layout.genes_per_neuron());
+    if genes.len() != layout.len() {
+        return Err(Error::InvalidArgument(format!(
+            "genome has {} genes; a network of N = {n} neurons and M = {m} sensors needs \
+             N x (2 + M + N) = {}",
+            genes.len(),
+            layout.len()
+        )));
+    }
+    if let Some(g) = genes.iter().position(|v| !v.is_finite()) {
+        return Err(Error::InvalidNetwork(format!(
+            "{} is {}; every gene must be finite",
+            layout.gene_name(g),
+            genes[g]
+        )));
+    }
+    if let Some(i) = (0..n).find(|&i| genes[i * per] <= 0.0) {
+        return Err(Error::InvalidNetwork(format!(
+            "{} is {}; every time constant must be > 0",
+            layout.gene_name(i * per),
+            genes[i * per]
+        )));
+    }
+    let mut tau = Vec::with_capacity(n);
+    let mut theta = Vec::with_capacity(n);
+    let mut sensor_weights = Vec::with_capacity(n * m);
+    let mut weights = Vec::with_capacity(n * n);
+    for block in genes.chunks_exact(per) {
+        tau.push(block[0]);
+        theta.push(block[1]);
+        sensor_weights.extend_from_slice(&block[2..2 + m]);
+        weights.extend_from_slice(&block[2 + m..]);
+    }
+    Network::new(tau, theta, weights, sensor_weights, None)
+}
+
+/// The interval `(lo, hi)` that gene `g` is drawn from and mutated over.
+///
+/// # Panics
+/// If `g >= layout.len()`.
+pub fn gene_range(layout: Layout, ranges: &Ranges, g: usize) -> (f64, f64) {
+    assert!(
+        g < layout.len(),
+        "gene {g} is out of a genome of {} genes",
+        layout.len()
+    );
+    match Gene::of(layout, g % layout.genes_per_neuron()) {
+        Gene::Tau => ranges.tau,
+        Gene::Theta => ranges.theta,
+        Gene::SensorWeight(_) => ranges.sensor_weights,
+        Gene::Weight(_) => ranges.weights,
+    }
+}
+
+/// A random genome: each gene uniform over its range, drawn in gene order from `stream`.
+pub fn random(layout: Layout, ranges: &Ranges, stream: &mut Stream) -> Vec<f64> {
+    (0..layout.len())
+        .map(|g| {
+            let (lo, hi) = gene_range(layout, ranges, g);
+            stream.range(lo, hi)
+        })
+        .collect()
+}
+
+/// Mutates `genes` in place: each gene, in order, is resampled uniformly over its range with
+/// probability `rate`. Returns how many genes were resampled.
+///
+/// Every gene costs one draw from `stream`, plus one more when it is resampled.
+///
+/// # Panics
+/// If `genes.len() != layout.len()`.
+pub fn mutate(
+    layout: Layout,
+    ranges: &Ranges,
+    genes: &mut [f64],
+    rate: f64,
+    stream: &mut Stream,
+) -> usize {
+    assert_eq!(
+        genes.len(),
+        layout.len(),
+        "genome length does not match its layout"
+    );
+    let mut changed = 0;
+    for (g, gene) in genes.iter_mut().enumerate() {
+        if stream.bernoulli(rate) {
+            let (lo, hi) = gene_range(layout, ranges, g);
+            *gene = stream.range(lo, hi);
+            changed += 1;
+        }
+    }
+    changed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Purpose;
+    use proptest::prelude::*;
+
+    fn stream(k: u64) -> Stream {
+        Stream::new(k, 0, Purpose::Init, 0, 0)
+    }
+
+    #[test]
+    fn layout_sizes_and_block_order() {
+        let l = Layout {
+            size: 2,
+            n_inputs: 3,
+        };
+        assert_eq!((l.genes_per_neuron(), l.len()), (7, 14));
+        let net = Network::new(
+            vec![1.0, 2.0],
+            vec![3.0, 4.0],
+            vec![11.0, 12.0, 21.0, 22.0],
+            vec![5.0, 6.0, 7.0, 8.0, 9.0, 10.0],
+            None,
+        )
+        .unwrap();
+        assert_eq!(
+            encode(&net),
+            vec![
+                1.0, 3.0, 5.0, 6.0, 7.0, 11.0, 12.0, // neuron 0
+                2.0, 4.0, 8.0, 9.0, 10.0, 21.0, 22.0, // neuron 1
+            ]
+        );
+        assert_eq!(l.gene_name(0), "gene 0 (neuron 0, tau[0])");
+        assert_eq!(l.gene_name(8), "gene 8 (neuron 1, theta[1])");
+        assert_eq!(l.gene_name(10), "gene 10 (neuron 1, sensor_weights[1][1])");
+        assert_eq!(l.gene_name(13), "gene 13 (neuron 1, weights[1][1])");
+    }
+
+    #[test]
+    fn decode_errors_name_the_gene() {
+        let l = Layout {
+            size: 2,
+            n_inputs: 1,
+        };
+        let e = decode(l, &[1.0; 9]).unwrap_err().to_string();
+        assert!(e.contains("9 genes") && e.contains("= 10"), "{e}");
+        let mut g = vec![1.0; 10];
+        g[5] = -1.0;
+        let e = decode(l, &g).unwrap_err().to_string();
+        assert!(
+            e.contains("gene 5 (neuron 1, tau[1])") && e.contains("> 0"),
+            "{e}"
+        );
+        g[5] = 1.0;
+        g[9] = f64::NAN;
+        let e = decode(l, &g).unwrap_err().to_string();
+        assert!(
+            e.contains("gene 9 (neuron 1, weights[1][1])") && e.contains("finite"),
+            "{e}"
+        );
+        let e = decode(
+            Layout {
+                size: 0,
+                n_inputs: 1,
+            },
+            &[],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("at least 1 neuron"), "{e}");
+    }
+
+    #[test]
+    fn ranges_validate_names_the_field() {
+        assert!(Ranges::default().validate().is_ok());
+        let cases = [
+            (
+                Ranges {
+                    tau: (0.0, 1.0),
+                    ..Ranges::default()
+                },
+                "ranges.tau",
+            ),
+            (
+                Ranges {
+                    weights: (2.0, 2.0),
+                    ..Ranges::default()
+                },
+                "ranges.weights",
+            ),
+            (
+                Ranges {
+                    sensor_weights: (0.0, f64::INFINITY),
+                    ..Ranges::default()
+                },
+                "ranges.sensor_weights",
+            ),
+            (
+                Ranges {
+                    theta: (f64::NAN, 1.0),
+                    ..Ranges::default()
+                },
+                "ranges.theta",
+            ),
+        ];
+        for (r, field) in cases {
+            let e = r.validate().unwrap_err();
+            assert!(matches!(e, Error::Config(_)));
+            assert!(e.to_string().contains(field), "{e}");
+        }
+    }
+
+    #[test]
+    fn random_and_mutated_genes_stay_in_range() {
+        let l = Layout {
+            size: 4,
+            n_inputs: 2,
+        };
+        let r = Ranges {
+            tau: (1.0, 2.0),
+            theta: (-3.0, -2.0),
+            weights: (5.0, 6.0),
+            sensor_weights: (-8.0, -7.0),
+        };
+        let in_range = |genes: &[f64]| {
+            genes.iter().enumerate().all(|(g, &v)| {
+                let (lo, hi) = gene_range(l, &r, g);
+                lo <= v && v < hi
+            })
+        };
+        let mut s = stream(5);
+        for _ in 0..50 {
+            let mut genes = random(l, &r, &mut s);
+            assert!(in_range(&genes));
+            assert!(decode(l, &genes).is_ok());
+            assert_eq!(mutate(l, &r, &mut genes, 1.0, &mut s), l.len());
+            assert!(in_range(&genes));
+        }
+        let mut genes = random(l, &r, &mut s);
+        let before = genes.clone();
+        assert_eq!(mutate(l, &r, &mut genes, 0.0, &mut s), 0);
+        assert_eq!(genes, before);
+    }
+
+    #[test]
+    fn mutation_resamples_with_the_configured_frequency() {
+        let l = Layout {
+            size: 10,
+            n_inputs: 3,
+        };
+        let r = Ranges::default();
+        let mut s = stream(8);
+        let rate = 0.05;
+        let rounds = 1000;
+        let mut genes = random(l, &r, &mut s);
+        let (mut reported, mut differing) = (0usize, 0usize);
+        for _ in 0..rounds {
+            let before = genes.clone();
+            reported += mutate(l, &r, &mut genes, rate, &mut s);
+            differing += genes.iter().zip(&before).filter(|(a, b)| a != b).count();
+        }
+        let n = (rounds * l.len()) as f64; // 150_000 genes
+        let sd = (n * rate * (1.0 - rate)).sqrt(); // ~ 84
+        assert_eq!(reported, differing);
+        assert!(
+            (reported as f64 - n * rate).abs() < 5.0 * sd,
+            "{reported} of {n}"
+        );
+    }
+
+    fn layout_and_genes() -> impl Strategy<Value = (Layout, Vec<f64>)> {
+        (1usize..6, 0usize..4).prop_flat_map(|(size, n_inputs)| {
+            let l = Layout { size, n_inputs };
+            let per = l.genes_per_neuron();
+            prop::collection::vec(-1e6..1e6f64, l.len()).prop_map(move |mut g| {
+                for i in 0..size {
+                    g[i * per] = g[i * per].abs() + 1e-3; // tau > 0
+                }
+                (l, g)
+            })
+        })
+    }
+
+    proptest! {
+        #[test]
+        fn round_trip_is_exact((l, genes) in layout_and_genes()) {
+            let net = decode(l, &genes).unwrap();
+            prop_assert_eq!(Layout::of(&net), l);
+            prop_assert_eq!(encode(&net), genes.clone());
+            prop_assert_eq!(decode(l, &encode(&net)).unwrap(), net);
+        }
+    }
+}

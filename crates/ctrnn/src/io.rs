@@ -1,0 +1,325 @@
+//! The network file format, `dnnevo-network` version 1 (JSON), and atomic file writes.
+//!
+//! ```json
+//! {"format": "dnnevo-network", "version": 1,
+//!  "tau": [1.0, 2.0], "theta": [0.0, 0.5],
+//!  "weights": [[0.0, 1.0], [-1.0, 0.0]], "sensor_weights": [[0.5], [0.0]],
+//!  "state": [0.0, 0.0],
+//!  "integrator": {"method": "euler", "dt": 0.1, "substeps": 10},
+//!  "meta": {"task": "sequence-1bit", "seed": 3}}
+//! ```
+//!
+//! `state`, `integrator` and `meta` are optional. Floats are written in their shortest form that
+//! reads back to the same bits, so a file round-trips exactly. Python reads and writes files
+//! through this module too, so both produce the same bytes. The schema is `docs/network.schema.json`.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+use crate::error::{Error, Result};
+use crate::integrate::Integrator;
+use crate::network::Network;
+
+/// The value of the `format` field.
+pub const FORMAT: &str = "dnnevo-network";
+/// The version this crate writes and reads.
+pub const VERSION: u64 = 1;
+
+/// A network together with the optional parts of its file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NetworkFile {
+    /// The network, including its state.
+    pub network: Network,
+    /// How the network is meant to be integrated, if recorded.
+    pub integrator: Option<Integrator>,
+    /// Free-form facts: task, seed, generation, fitness, dnnevo version, input/output labels.
+    pub meta: Map<String, Value>,
+}
+
+impl NetworkFile {
+    /// A file holding just `network`.
+    pub fn new(network: Network) -> Self {
+        NetworkFile {
+            network,
+            integrator: None,
+            meta: Map::new(),
+        }
+    }
+}
+
+/// The document as it is stored.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Document {
+    format: String,
+    version: u64,
+    tau: Vec<f64>,
+    theta: Vec<f64>,
+    weights: Vec<Vec<f64>>,
+    sensor_weights: Vec<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    state: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    integrator: Option<Integrator>,
+    #[serde(default, skip_serializing_if = "Map::is_empty")]
+    meta: Map<String, Value>,
+}
+
+/// Serialises `file` as pretty-printed JSON.
+///
+/// # Example
+/// ```
+/// use ctrnn::{io, Network};
+/// let net = Network::new(vec![1.5], vec![0.1], vec![0.3], vec![], None).unwrap();
+/// let text = io::to_json(&io::NetworkFile::new(net.clone()));
+/// assert_eq!(io::from_json(&text).unwrap().network, net);
+/// ```
+pub fn to_json(file: &NetworkFile) -> String {
+    let net = &file.network;
+    let (n, m) = (net.size(), net.n_inputs());
+    let rows = |flat: &[f64], cols: usize| -> Vec<Vec<f64>> {
+        (0..n)
+            .map(|i| flat[i * cols..(i + 1) * cols].to_vec())
+            .collect()
+    };
+    let doc = Document {
+        format: FORMAT.into(),
+        version: VERSION,
+        tau: net.tau().to_vec(),
+        theta: net.theta().to_vec(),
+        weights: rows(net.weights(), n),
+        sensor_weights: rows(net.sensor_weights(), m),
+        state: Some(net.state().to_vec()),
+        integrator: file.integrator,
+        meta: file.meta.clone(),
+    };
+    serde_json::to_string_pretty(&doc).expect("a document of finite floats always serialises")
+}
+
+/// Parses and validates a network document. Every failure is [`Error::Format`], naming the field.
+pub fn from_json(text: &str) -> Result<NetworkFile> {
+    let value: Value =
+        serde_json::from_str(text).map_err(|e| Error::Format(format!("not valid JSON: {e}")))?;
+    let obj = value
+        .as_object()
+        .ok_or_else(|| Error::Format("the document is not a JSON object".into()))?;
+    match obj.get("format") {
+        Some(Value::String(s)) if s == FORMAT => {}
+        Some(other) => {
+            return Err(Error::Format(format!(
+                "format is {other}; expected \"{FORMAT}\""
+            )))
+        }
+        None => {
+            return Err(Error::Format(format!(
+                "missing field `format`; expected \"{FORMAT}\""
+            )))
+        }
+    }
+    match obj.get("version") {
+        Some(v) if v.as_u64() == Some(VERSION) => {}
+        Some(v) => {
+            return Err(Error::Format(format!(
+                "version is {v}; this dnnevo reads version {VERSION}"
+            )))
+        }
+        None => {
+            return Err(Error::Format(format!(
+                "missing field `version`; expected {VERSION}"
+            )))
+        }
+    }
+    let doc: Document = serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        if path == "." {
+            Error::Format(inner.to_string())
+        } else {
+            Error::Format(format!("{path}: {inner}"))
+        }
+    })?;
+    let n = doc.tau.len();
+    let flatten = |field: &str, rows: Vec<Vec<f64>>, cols: Option<usize>| -> Result<Vec<f64>> {
+        if rows.len() != n {
+            return Err(Error::Format(format!(
+                "{field} has {} rows; expected N = {n} (the length of tau)",
+                rows.len()
+            )));
+        }
+        let cols = cols.unwrap_or_else(|| rows.first().map_or(0, Vec::len));
+        if let Some(i) = rows.iter().position(|r| r.len() != cols) {
+            return Err(Error::Format(format!(
+                "{field}[{i}] has {} values; expected {cols}",
+                rows[i].len()
+            )));
+        }
+        Ok(rows.concat())
+    };
+    let weights = flatten("weights", doc.weights, Some(n))?;
+    let sensor_weights = flatten("sensor_weights", doc.sensor_weights, None)?;
+    if let Some(integ) = &doc.integrator {
+        integ
+            .validate()
+            .map_err(|e| Error::Format(format!("integrator: {}", strip(e))))?;
+    }
+    let network = Network::new(doc.tau, doc.theta, weights, sensor_weights, doc.state)
+        .map_err(|e| Error::Format(strip(e)))?;
+    Ok(NetworkFile {
+        network,
+        integrator: doc.integrator,
+        meta: doc.meta,
+    })
+}
+
+/// The message of an error without its category prefix.
+fn strip(e: Error) -> String {
+    match e {
+        Error::InvalidNetwork(m) | Error::InvalidArgument(m) => m,
+        other => other.to_string(),
+    }
+}
+
+/// Writes `file` to `path` atomically.
+pub fn save(path: &Path, file: &NetworkFile) -> Result<()> {
+    let mut text = to_json(file);
+    text.push('\n');
+    write_atomic(path, text.as_bytes())
+}
+
+/// Reads and validates the network file at `path`.
+pub fn load(path: &Path) -> Result<NetworkFile> {
+    let text = fs::read_to_string(path).map_err(|source| Error::Io {
+        context: format!("cannot read {}", path.display()),
+        source,
+    })?;
+    from_json(&text).map_err(|e| match e {
+        Error::Format(m) => Error::Format(format!("{}: {m}", path.display())),
+        other => other,
+    })
+}
+
+/// Writes `bytes` to a temporary file beside `path`, flushes it to disk, then renames it over
+/// `path`, so a reader sees the old file or the new one, never a torn one.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let io_err = |what: &str, source| Error::Io {
+        context: format!("cannot {what} {}", path.display()),
+        source,
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| Error::InvalidArgument(format!("{} is not a file path", path.display())))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".tmp{}", std::process::id()));
+    let tmp: PathBuf = path.with_file_name(tmp_name);
+    let result = (|| {
+        let mut f = fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = fs::remove_file(&tmp);
+        return Err(io_err("write", e));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::Method;
+
+    fn sample() -> NetworkFile {
+        let net = Network::new(
+            vec![0.1 + 0.2, 7.0 / 3.0],
+            vec![-1e-300, 16.0],
+            vec![1.0 / 3.0, -2.5, 5e-324, std::f64::consts::PI],
+            vec![0.1, 0.7],
+            Some(vec![1.0 / 7.0, -0.0]),
+        )
+        .unwrap();
+        let mut meta = Map::new();
+        meta.insert("task".into(), "sequence-1bit".into());
+        meta.insert("seed".into(), 3.into());
+        NetworkFile {
+            network: net,
+            integrator: Some(Integrator {
+                method: Method::Rk4,
+                dt: 0.05,
+                substeps: 10,
+            }),
+            meta,
+        }
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let f = sample();
+        let back = from_json(&to_json(&f)).unwrap();
+        assert_eq!(back, f);
+        for (a, b) in back.network.weights().iter().zip(f.network.weights()) {
+            assert_eq!(a.to_bits(), b.to_bits());
+        }
+        assert_eq!(to_json(&back), to_json(&f));
+    }
+
+    #[test]
+    fn file_round_trip_and_atomic_write() {
+        let dir = std::env::temp_dir().join(format!("ctrnn-io-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("net.json");
+        save(&path, &sample()).unwrap();
+        assert_eq!(load(&path).unwrap(), sample());
+        let leftovers = fs::read_dir(&dir).unwrap().count();
+        assert_eq!(leftovers, 1, "no temporary file is left behind");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn err(text: &str) -> String {
+        match from_json(text) {
+            Err(Error::Format(m)) => m,
+            other => panic!("expected a format error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn bad_documents_name_the_problem() {
+        let good = to_json(&sample());
+        let edit = |from: &str, to: &str| good.replacen(from, to, 1);
+        assert!(err(&edit("dnnevo-network", "other")).contains("expected \"dnnevo-network\""));
+        assert!(err(&edit("\"version\": 1", "\"version\": 2")).contains("version is 2"));
+        assert!(err(&good[..good.len() / 2]).contains("not valid JSON"));
+        assert!(err("[1, 2]").contains("not a JSON object"));
+        let no_tau = good.replacen("\"tau\"", "\"tua\"", 1);
+        let e = err(&no_tau);
+        assert!(e.contains("tua") || e.contains("tau"), "{e}");
+        let e = err(&edit("\"theta\": [", "\"theta\": [\"x\", "));
+        assert!(e.contains("theta[0]"), "{e}");
+        let e = err(&edit("\"theta\": [", "\"theta\": [1e999, "));
+        assert!(
+            e.contains("theta") || e.contains("number out of range"),
+            "{e}"
+        );
+        let e = err(&edit("\"tau\": [", "\"tau\": [-1.0, "));
+        assert!(e.contains("weights has 2 rows; expected N = 3"), "{e}");
+        let e = err(&edit("0.30000000000000004", "-0.5"));
+        assert!(e.contains("tau[0]") && e.contains("> 0"), "{e}");
+        let e = err(&edit("\"dt\": 0.05", "\"dt\": -1.0"));
+        assert!(e.contains("integrator") && e.contains("dt"), "{e}");
+        let minimal = r#"{"format": "dnnevo-network", "version": 1, "tau": [1],
+            "theta": [0], "weights": [[0]], "sensor_weights": [[]]}"#;
+        let f = from_json(minimal).unwrap();
+        assert_eq!((f.network.size(), f.network.n_inputs()), (1, 0));
+        assert_eq!(f.network.state(), &[0.0]);
+        let missing = r#"{"format": "dnnevo-network", "version": 1, "tau": [1],
+            "weights": [[0]], "sensor_weights": [[]]}"#;
+        assert!(err(missing).contains("missing field `theta`"));
+        let ragged = minimal.replace("[[0]]", "[[0, 1]]");
+        assert!(err(&ragged).contains("weights[0] has 2 values; expected 1"));
+    }
+}

@@ -1,0 +1,33 @@
+//! Continuous-time recurrent neural networks ("dynamical neural networks") after Yamauchi & Beer:
+//! the model, its integrators for one network or a whole population, and the network file format.
+//!
+//! This crate knows no task and no Python.
+//!
+//! # Example
+//! ```
+//! use ctrnn::{Integrator, Network, Population, Inputs};
+//! let net = Network::new(vec![1.0, 2.0], vec![0.0, 0.0], vec![0.0, 1.0, 1.0, 0.0], vec![1.0, 1.0], None)?;
+//! let mut pop = Population::new(&[net.clone(), net])?;
+//! let states = pop.run(Inputs::Shared(&[1.0; 3]), 3, &Integrator::default(), true, None)?;
+//! assert_eq!(states.len(), 2 * 3 * 2); // P x T x N
+//! # Ok::<(), ctrnn::Error>(())
+//! ```
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod ga;
+pub mod genome;
+pub mod integrate;
+pub mod io;
+pub mod math;
+pub mod network;
+pub mod population;
+pub mod rng;
+
+pub use error::{Error, Result};
+pub use ga::{GaConfig, Selection};
+pub use genome::{Layout, Ranges};
+pub use integrate::{Integrator, Lanes, Method, LANES};
+pub use network::{compose, Network};
+pub use population::{Block, Inputs, Population};
+pub use rng::{Purpose, Stream};

@@ -1,0 +1,325 @@
+//! A continuous-time recurrent neural network: its parameters, its state, and their validation.
+//!
+//! The model (paper §2.1, with the sigmoid misprint corrected as in READING.md) is
+//!
+//! ```text
+//! tau_i dv_i/dt = -v_i + sum_j weights[i][j] f(v_j - theta_j) + sum_k sensor_weights[i][k] I_k
+//! f(x) = 1 / (1 + e^-x)
+//! ```
+//!
+//! Matrices are stored row-major: `weights[i * size + j]` is the weight from neuron j to neuron i,
+//! and `sensor_weights[i * n_inputs + k]` the weight from sensor k to neuron i.
+
+use crate::error::{check_finite, Error, Result};
+use crate::math::sigmoid;
+
+/// A network of `size` neurons and `n_inputs` sensors, always valid once constructed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Network {
+    size: usize,
+    n_inputs: usize,
+    tau: Vec<f64>,
+    theta: Vec<f64>,
+    weights: Vec<f64>,
+    sensor_weights: Vec<f64>,
+    state: Vec<f64>,
+}
+
+impl Network {
+    /// Builds a network from flat row-major parameters, validating every field.
+    ///
+    /// `state` defaults to zeros. Errors name the field and the index of the first bad value.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::Network;
+    /// // Two neurons, one sensor.
+    /// let net = Network::new(
+    ///     vec![1.0, 2.0],             // tau
+    ///     vec![0.0, -1.0],            // theta
+    ///     vec![0.0, 1.0, -1.0, 0.0],  // weights, row i = inputs of neuron i
+    ///     vec![0.5, 0.0],             // sensor_weights, 2 x 1
+    ///     None,
+    /// ).unwrap();
+    /// assert_eq!((net.size(), net.n_inputs()), (2, 1));
+    /// assert!(Network::new(vec![-1.0], vec![0.0], vec![0.0], vec![], None).is_err());
+    /// ```
+    pub fn new(
+        tau: Vec<f64>,
+        theta: Vec<f64>,
+        weights: Vec<f64>,
+        sensor_weights: Vec<f64>,
+        state: Option<Vec<f64>>,
+    ) -> Result<Self> {
+        let size = tau.len();
+        if size == 0 {
+            return Err(Error::InvalidNetwork(
+                "tau is empty; a network needs at least 1 neuron".into(),
+            ));
+        }
+        let n_inputs = sensor_weights.len() / size;
+        let state = state.unwrap_or_else(|| vec![0.0; size]);
+        expect_len("theta", theta.len(), size, "N")?;
+        expect_len("weights", weights.len(), size * size, "N x N")?;
+        if sensor_weights.len() != size * n_inputs {
+            return Err(Error::InvalidNetwork(format!(
+                "sensor_weights has {} values, which is not a multiple of N = {size}; expected N x M",
+                sensor_weights.len()
+            )));
+        }
+        expect_len("state", state.len(), size, "N")?;
+        let net = Network {
+            size,
+            n_inputs,
+            tau,
+            theta,
+            weights,
+            sensor_weights,
+            state,
+        };
+        net.validate()?;
+        Ok(net)
+    }
+
+    /// Checks the values: every one finite and every `tau > 0`.
+    pub fn validate(&self) -> Result<()> {
+        check_finite("tau", &self.tau, 0)?;
+        if let Some(i) = self.tau.iter().position(|&t| t <= 0.0) {
+            return Err(Error::InvalidNetwork(format!(
+                "tau[{i}] is {}; every time constant must be > 0",
+                self.tau[i]
+            )));
+        }
+        check_finite("theta", &self.theta, 0)?;
+        check_finite("weights", &self.weights, self.size)?;
+        check_finite("sensor_weights", &self.sensor_weights, self.n_inputs)?;
+        check_finite("state", &self.state, 0)
+    }
+
+    /// Number of neurons N.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+    /// Number of sensors M.
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs
+    }
+    /// Time constants, length N.
+    pub fn tau(&self) -> &[f64] {
+        &self.tau
+    }
+    /// Thresholds, length N.
+    pub fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+    /// Recurrent weights, N x N row-major; `[i * N + j]` is from neuron j to neuron i.
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+    /// Sensor weights, N x M row-major; `[i * M + k]` is from sensor k to neuron i.
+    pub fn sensor_weights(&self) -> &[f64] {
+        &self.sensor_weights
+    }
+    /// The state v, length N.
+    pub fn state(&self) -> &[f64] {
+        &self.state
+    }
+
+    /// Replaces the state; `None` resets it to zeros.
+    pub fn set_state(&mut self, state: Option<&[f64]>) -> Result<()> {
+        match state {
+            None => self.state.fill(0.0),
+            Some(s) => {
+                expect_len("state", s.len(), self.size, "N")?;
+                check_finite("state", s, 0)?;
+                self.state.copy_from_slice(s);
+            }
+        }
+        Ok(())
+    }
+
+    /// Firing rates `f(v_i - theta_i)` of the current state.
+    pub fn outputs(&self) -> Vec<f64> {
+        self.state
+            .iter()
+            .zip(&self.theta)
+            .map(|(v, t)| sigmoid(v - t))
+            .collect()
+    }
+
+    /// Mutable access for the integrator, which keeps values finite only if the inputs are.
+    pub(crate) fn state_mut(&mut self) -> &mut [f64] {
+        &mut self.state
+    }
+}
+
+fn expect_len(field: &str, got: usize, want: usize, shape: &str) -> Result<()> {
+    if got == want {
+        Ok(())
+    } else {
+        Err(Error::InvalidNetwork(format!(
+            "{field} has {got} values; expected {shape} = {want}"
+        )))
+    }
+}
+
+/// Builds the fully interconnected network of `a` and `b` (paper §5.3).
+///
+/// `a`'s neurons come first, so `a`'s neuron 0 stays neuron 0 (the output); `b`'s neuron j becomes
+/// neuron `a.size() + j`. Every sensor feeds both parts as before. The cross weights between the
+/// parts start at 0, so the composite first behaves exactly like its two parts side by side.
+///
+/// # Example
+/// ```
+/// use ctrnn::{compose, Network};
+/// let a = Network::new(vec![1.0], vec![0.0], vec![2.0], vec![1.0], None).unwrap();
+/// let b = Network::new(vec![3.0], vec![1.0], vec![-2.0], vec![0.5], None).unwrap();
+/// let ab = compose(&a, &b).unwrap();
+/// assert_eq!(ab.weights(), &[2.0, 0.0, 0.0, -2.0]);
+/// ```
+pub fn compose(a: &Network, b: &Network) -> Result<Network> {
+    if a.n_inputs != b.n_inputs {
+        return Err(Error::InvalidNetwork(format!(
+            "cannot compose networks with {} and {} inputs; both must have the same M",
+            a.n_inputs, b.n_inputs
+        )));
+    }
+    let n = a.size + b.size;
+    let mut weights = vec![0.0; n * n];
+    for (part, offset) in [(a, 0), (b, a.size)] {
+        for i in 0..part.size {
+            let row = &part.weights[i * part.size..(i + 1) * part.size];
+            let start = (offset + i) * n + offset;
+            weights[start..start + part.size].copy_from_slice(row);
+        }
+    }
+    let cat = |x: &[f64], y: &[f64]| [x, y].concat();
+    Network::new(
+        cat(&a.tau, &b.tau),
+        cat(&a.theta, &b.theta),
+        weights,
+        cat(&a.sensor_weights, &b.sensor_weights),
+        Some(cat(&a.state, &b.state)),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn net2() -> Network {
+        Network::new(
+            vec![1.0, 2.0],
+            vec![0.0, 0.5],
+            vec![1.0, 2.0, 3.0, 4.0],
+            vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6],
+            None,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn shapes_are_inferred() {
+        let n = net2();
+        assert_eq!((n.size(), n.n_inputs()), (2, 3));
+        assert_eq!(n.state(), &[0.0, 0.0]);
+    }
+
+    #[test]
+    fn validation_names_field_and_index() {
+        let err = |r: Result<Network>| r.unwrap_err().to_string();
+        let e = err(Network::new(
+            vec![1.0, -2.0],
+            vec![0.0; 2],
+            vec![0.0; 4],
+            vec![],
+            None,
+        ));
+        assert!(e.contains("tau[1]") && e.contains("> 0"), "{e}");
+        let e = err(Network::new(
+            vec![1.0, 0.0],
+            vec![0.0; 2],
+            vec![0.0; 4],
+            vec![],
+            None,
+        ));
+        assert!(e.contains("tau[1]"), "{e}");
+        let e = err(Network::new(
+            vec![1.0; 2],
+            vec![0.0; 2],
+            vec![0.0, 0.0, f64::NAN, 0.0],
+            vec![],
+            None,
+        ));
+        assert!(e.contains("weights[1][0]") && e.contains("finite"), "{e}");
+        let e = err(Network::new(
+            vec![1.0; 2],
+            vec![0.0; 3],
+            vec![0.0; 4],
+            vec![],
+            None,
+        ));
+        assert!(e.contains("theta has 3 values; expected N = 2"), "{e}");
+        let e = err(Network::new(
+            vec![1.0; 2],
+            vec![0.0; 2],
+            vec![0.0; 3],
+            vec![],
+            None,
+        ));
+        assert!(e.contains("weights") && e.contains("N x N = 4"), "{e}");
+        let e = err(Network::new(
+            vec![1.0; 2],
+            vec![0.0; 2],
+            vec![0.0; 4],
+            vec![0.0; 3],
+            None,
+        ));
+        assert!(
+            e.contains("sensor_weights") && e.contains("multiple"),
+            "{e}"
+        );
+        let e = err(Network::new(vec![], vec![], vec![], vec![], None));
+        assert!(e.contains("at least 1 neuron"), "{e}");
+        let e = err(Network::new(
+            vec![1.0; 2],
+            vec![0.0; 2],
+            vec![0.0; 4],
+            vec![0.0, f64::INFINITY],
+            None,
+        ));
+        assert!(e.contains("sensor_weights[1][0]"), "{e}");
+        let e = err(Network::new(
+            vec![1.0; 2],
+            vec![0.0; 2],
+            vec![0.0; 4],
+            vec![],
+            Some(vec![0.0]),
+        ));
+        assert!(e.contains("state has 1 values"), "{e}");
+    }
+
+    #[test]
+    fn set_state_checks_and_resets() {
+        let mut n = net2();
+        n.set_state(Some(&[1.0, 2.0])).unwrap();
+        assert_eq!(n.state(), &[1.0, 2.0]);
+        assert!(n.set_state(Some(&[f64::NAN, 0.0])).is_err());
+        assert!(n.set_state(Some(&[0.0])).is_err());
+        n.set_state(None).unwrap();
+        assert_eq!(n.state(), &[0.0, 0.0]);
+    }
+
+    #[test]
+    fn compose_places_blocks_and_zero_cross_weights() {
+        let a = net2();
+        let b = Network::new(vec![5.0], vec![-1.0], vec![7.0], vec![8.0, 9.0, 10.0], None).unwrap();
+        let ab = compose(&a, &b).unwrap();
+        assert_eq!(ab.size(), 3);
+        assert_eq!(ab.tau(), &[1.0, 2.0, 5.0]);
+        assert_eq!(ab.weights(), &[1.0, 2.0, 0.0, 3.0, 4.0, 0.0, 0.0, 0.0, 7.0]);
+        assert_eq!(&ab.sensor_weights()[6..], &[8.0, 9.0, 10.0]);
+        let c = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+        assert!(compose(&a, &c).unwrap_err().to_string().contains("same M"));
+    }
+}

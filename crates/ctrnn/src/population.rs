@@ -1,0 +1,251 @@
+//! The population integrator: P networks of the same shape, stepped block by block in parallel.
+//!
+//! Networks are packed into [`Block`]s of [`LANES`] networks; rayon runs blocks on all cores, and
+//! within a block the arithmetic is vectorised across networks (see [`crate::integrate`]). Blocks
+//! are independent, so the result does not depend on the number of threads, and each network's
+//! result is bit-identical to [`Network::run`] on that network alone.
+
+use std::sync::atomic::AtomicBool;
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::integrate::{check_inputs, Integrator, Lanes, LANES};
+use crate::network::Network;
+
+/// A block of [`LANES`] networks stepped together.
+pub type Block = Lanes<LANES>;
+
+/// Input rows for a population run.
+#[derive(Clone, Copy, Debug)]
+pub enum Inputs<'a> {
+    /// One `T x M` array (row-major) shared by every network.
+    Shared(&'a [f64]),
+    /// A `P x T x M` array (row-major), one input series per network.
+    PerNetwork(&'a [f64]),
+}
+
+/// P networks of the same N and M, laid out for fast stepping.
+#[derive(Clone, Debug)]
+pub struct Population {
+    size: usize,
+    n_inputs: usize,
+    len: usize,
+    blocks: Vec<Block>,
+}
+
+impl Population {
+    /// Packs `networks` (at least one, all with the same N and M).
+    pub fn new(networks: &[Network]) -> Result<Self> {
+        let first = networks.first().ok_or_else(|| {
+            Error::InvalidArgument("a population needs at least 1 network".into())
+        })?;
+        let (n, m) = (first.size(), first.n_inputs());
+        if let Some(p) = networks
+            .iter()
+            .position(|x| (x.size(), x.n_inputs()) != (n, m))
+        {
+            return Err(Error::InvalidArgument(format!(
+                "network {p} has N = {}, M = {}; every network of a population must have N = {n}, M = {m}",
+                networks[p].size(),
+                networks[p].n_inputs()
+            )));
+        }
+        let refs: Vec<&Network> = networks.iter().collect();
+        let blocks = refs
+            .chunks(LANES)
+            .map(Block::new)
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Population {
+            size: first.size(),
+            n_inputs: first.n_inputs(),
+            len: networks.len(),
+            blocks,
+        })
+    }
+
+    /// Number of networks P.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// Always false: a population has at least one network.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+    /// Neurons per network N.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+    /// Sensors per network M.
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs
+    }
+    /// The blocks, for tasks that compute each row's inputs from the networks' outputs.
+    /// Block `b`, lane `l` is network `b * LANES + l`.
+    pub fn blocks_mut(&mut self) -> &mut [Block] {
+        &mut self.blocks
+    }
+
+    /// The current states, row-major `P x N`.
+    pub fn states(&self) -> Vec<f64> {
+        let n = self.size;
+        let mut out = vec![0.0; self.len * n];
+        for (b, block) in self.blocks.iter().enumerate() {
+            for l in 0..block.len() {
+                let p = b * LANES + l;
+                block.lane_state(l, &mut out[p * n..(p + 1) * n]);
+            }
+        }
+        out
+    }
+
+    /// Integrates every network through `steps` input rows and returns the state after every row
+    /// (`P x T x N`, row-major) when `record`, else the final states (`P x N`).
+    ///
+    /// Stops with [`Error::Interrupted`] soon after `cancel` is set.
+    pub fn run(
+        &mut self,
+        inputs: Inputs<'_>,
+        steps: usize,
+        integ: &Integrator,
+        record: bool,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        integ.validate()?;
+        let (n, m, p_len) = (self.size, self.n_inputs, self.len);
+        match inputs {
+            Inputs::Shared(x) => check_inputs(x, steps * m, "T x M")?,
+            Inputs::PerNetwork(x) => check_inputs(x, p_len * steps * m, "P x T x M")?,
+        }
+        let row_of = |b: usize| {
+            move |t: usize, row: &mut [[f64; LANES]]| match inputs {
+                Inputs::Shared(x) => {
+                    for k in 0..m {
+                        row[k] = [x[t * m + k]; LANES];
+                    }
+                }
+                Inputs::PerNetwork(x) => {
+                    for l in 0..LANES {
+                        // Padding lanes repeat the block's first network.
+                        let p = (b * LANES + if b * LANES + l < p_len { l } else { 0 }) * steps;
+                        for k in 0..m {
+                            row[k][l] = x[(p + t) * m + k];
+                        }
+                    }
+                }
+            }
+        };
+        if record {
+            let mut out = vec![0.0; p_len * steps * n];
+            self.blocks
+                .par_iter_mut()
+                .zip(out.par_chunks_mut(LANES * steps * n))
+                .enumerate()
+                .try_for_each(|(b, (block, chunk))| {
+                    block.run_rows(steps, integ, cancel, row_of(b), |t, block| {
+                        for l in 0..block.len() {
+                            let at = (l * steps + t) * n;
+                            block.lane_state(l, &mut chunk[at..at + n]);
+                        }
+                    })
+                })?;
+            Ok(out)
+        } else {
+            self.blocks
+                .par_iter_mut()
+                .enumerate()
+                .try_for_each(|(b, block)| {
+                    block.run_rows(steps, integ, cancel, row_of(b), |_, _| {})
+                })?;
+            Ok(self.states())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::Method;
+    use proptest::prelude::*;
+
+    fn arb_network(n: usize, m: usize) -> impl Strategy<Value = Network> {
+        (
+            prop::collection::vec(0.5f64..10.0, n),
+            prop::collection::vec(-16f64..16.0, n),
+            prop::collection::vec(-16f64..16.0, n * n),
+            prop::collection::vec(-16f64..16.0, n * m),
+            prop::collection::vec(-5f64..5.0, n),
+        )
+            .prop_map(|(t, th, w, s, v)| Network::new(t, th, w, s, Some(v)).unwrap())
+    }
+
+    fn arb_population() -> impl Strategy<Value = (Vec<Network>, Vec<f64>, usize, bool)> {
+        (1usize..7, 0usize..3, 1usize..20, 1usize..12, any::<bool>()).prop_flat_map(
+            |(n, m, p, t, rk4)| {
+                (
+                    prop::collection::vec(arb_network(n, m), p),
+                    prop::collection::vec(-2f64..2.0, p * t * m),
+                    Just(t),
+                    Just(rk4),
+                )
+            },
+        )
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn population_equals_single_bit_for_bit((nets, inputs, steps, rk4) in arb_population()) {
+            let integ = Integrator {
+                method: if rk4 { Method::Rk4 } else { Method::Euler },
+                dt: 0.1,
+                substeps: 3,
+            };
+            let (n, m, p_len) = (nets[0].size(), nets[0].n_inputs(), nets.len());
+            let mut pop = Population::new(&nets).unwrap();
+            let all = pop.run(Inputs::PerNetwork(&inputs), steps, &integ, true, None).unwrap();
+            for (p, net) in nets.iter().enumerate() {
+                let mut single = net.clone();
+                let own = &inputs[p * steps * m..(p + 1) * steps * m];
+                let s = single.run(own, steps, &integ).unwrap();
+                let mine = &all[p * steps * n..(p + 1) * steps * n];
+                prop_assert!(s.iter().zip(mine).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+            let finals = pop.states();
+            prop_assert_eq!(finals.len(), p_len * n);
+            // Shared inputs: the first network's series for everyone.
+            let shared = &inputs[..steps * m];
+            let mut pop = Population::new(&nets).unwrap();
+            let last = pop.run(Inputs::Shared(shared), steps, &integ, false, None).unwrap();
+            for (p, net) in nets.iter().enumerate() {
+                let mut single = net.clone();
+                single.run(shared, steps, &integ).unwrap();
+                let mine = &last[p * n..(p + 1) * n];
+                prop_assert!(single.state().iter().zip(mine).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+        }
+    }
+
+    #[test]
+    fn mixed_shapes_name_the_network() {
+        let a = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![], None).unwrap();
+        let b = Network::new(vec![1.0; 2], vec![0.0; 2], vec![0.0; 4], vec![], None).unwrap();
+        let mut nets = vec![a; 10];
+        nets.push(b);
+        let e = Population::new(&nets).unwrap_err().to_string();
+        assert!(e.contains("network 10 has N = 2"), "{e}");
+        assert!(Population::new(&[]).is_err());
+    }
+
+    #[test]
+    fn input_shape_is_checked() {
+        let a = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+        let mut pop = Population::new(&[a.clone(), a]).unwrap();
+        let integ = Integrator::default();
+        let e = pop
+            .run(Inputs::PerNetwork(&[0.0; 3]), 2, &integ, true, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("P x T x M = 4"), "{e}");
+    }
+}

@@ -1,0 +1,82 @@
+//! Conversions between Python array-likes and flat `f64` vectors, with errors that name the
+//! argument and the shape that was expected.
+
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyAny;
+
+use crate::errors::InvalidArgumentError;
+
+/// A flat row-major copy of an array and its shape.
+pub struct Dense {
+    /// The values, row-major.
+    pub data: Vec<f64>,
+    /// The shape.
+    pub shape: Vec<usize>,
+}
+
+/// Converts any array-like to a float64 array (as `numpy.asarray(x, dtype=float)` would) and
+/// copies it out. `make_err` builds the exception for a value that cannot be converted.
+pub fn dense(obj: &Bound<'_, PyAny>, name: &str, make_err: fn(String) -> PyErr) -> PyResult<Dense> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj, np.getattr("float64")?))
+        .map_err(|e| make_err(format!("{name} is not a numeric array: {e}")))?;
+    let arr = np.call_method1("ascontiguousarray", (arr,))?;
+    let arr = arr.cast_into::<PyArrayDyn<f64>>()?;
+    let ro = arr.readonly();
+    Ok(Dense {
+        shape: ro.shape().to_vec(),
+        data: ro.as_slice()?.to_vec(),
+    })
+}
+
+impl Dense {
+    /// Checks the number of dimensions; `expected` describes the shape, e.g. "(T, M)".
+    pub fn expect_ndim(
+        &self,
+        ndim: usize,
+        name: &str,
+        expected: &str,
+        make_err: fn(String) -> PyErr,
+    ) -> PyResult<()> {
+        if self.shape.len() == ndim {
+            Ok(())
+        } else {
+            Err(make_err(format!(
+                "{name} has shape {}; expected {expected}",
+                shape_str(&self.shape)
+            )))
+        }
+    }
+}
+
+/// `(2, 3)`-style rendering of a shape.
+pub fn shape_str(shape: &[usize]) -> String {
+    match shape {
+        [one] => format!("({one},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// Builds a NumPy array of the given shape from row-major data.
+pub fn to_numpy<'py>(
+    py: Python<'py>,
+    data: Vec<f64>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    PyArray1::from_vec(py, data).reshape(shape.to_vec())
+}
+
+/// The error for a malformed argument that is not a network parameter.
+pub fn arg_err(msg: String) -> PyErr {
+    InvalidArgumentError::new_err(msg)
+}

@@ -1,0 +1,27 @@
+//! The Python binding of dnnevo, built by maturin as `dnnevo._core`.
+//!
+//! This is the only crate that knows Python. It converts arguments, maps errors to the exception
+//! tree of `dnnevo.errors`, and runs long calls with the GIL released (see [`detach`]).
+
+mod arrays;
+mod detach;
+mod errors;
+mod network;
+
+use pyo3::prelude::*;
+
+/// The native core of dnnevo.
+#[pymodule]
+mod _core {
+    #[pymodule_export]
+    use super::network::{compose, run_population, PyNetwork, PyTrace};
+
+    use pyo3::prelude::*;
+
+    #[pymodule_init]
+    fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
+        m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+        m.add("LANES", ctrnn::LANES)?;
+        Ok(())
+    }
+}

@@ -1,0 +1,104 @@
+"""Type stubs for the native module ``dnnevo._core`` (checked by ``mypy.stubtest``)."""
+
+from collections.abc import Mapping, Sequence
+from os import PathLike
+from typing import Any, Literal, final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["LANES", "Network", "Trace", "__version__", "compose", "run_population"]
+
+__version__: str
+LANES: int
+
+_Array = npt.NDArray[np.float64]
+_Method = Literal["euler", "rk4"]
+
+@final
+class Trace:
+    """States, outputs and inputs after each input row, and the time at the end of each row."""
+
+    @property
+    def states(self) -> _Array: ...
+    @property
+    def outputs(self) -> _Array: ...
+    @property
+    def inputs(self) -> _Array: ...
+    @property
+    def time(self) -> _Array: ...
+
+@final
+class Network:
+    """A continuous-time recurrent neural network of N neurons and M sensors."""
+
+    def __new__(
+        cls,
+        tau: npt.ArrayLike,
+        theta: npt.ArrayLike,
+        weights: npt.ArrayLike,
+        sensor_weights: npt.ArrayLike,
+        state: npt.ArrayLike | None = None,
+    ) -> Network: ...
+    @staticmethod
+    def random(
+        size: int,
+        n_inputs: int,
+        *,
+        seed: int,
+        ranges: Mapping[str, tuple[float, float]] | None = None,
+    ) -> Network: ...
+    @property
+    def size(self) -> int: ...
+    @property
+    def n_inputs(self) -> int: ...
+    @property
+    def tau(self) -> _Array: ...
+    @property
+    def theta(self) -> _Array: ...
+    @property
+    def weights(self) -> _Array: ...
+    @property
+    def sensor_weights(self) -> _Array: ...
+    @property
+    def state(self) -> _Array: ...
+    @property
+    def outputs(self) -> _Array: ...
+    @property
+    def meta(self) -> dict[str, Any]: ...
+    def reset(self, state: npt.ArrayLike | None = None) -> None: ...
+    def run(
+        self,
+        inputs: npt.ArrayLike,
+        *,
+        dt: float = 0.1,
+        substeps: int = 1,
+        method: _Method = "euler",
+    ) -> Trace: ...
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str) -> Network: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    @staticmethod
+    def from_dict(d: Mapping[str, Any]) -> Network: ...
+    def save(
+        self, path: str | PathLike[str], *, meta: Mapping[str, Any] | None = None
+    ) -> None: ...
+    @staticmethod
+    def load(path: str | PathLike[str]) -> Network: ...
+    def copy(self) -> Network: ...
+    def __copy__(self) -> Network: ...
+    def __deepcopy__(self, memo: Any) -> Network: ...
+    def __reduce__(self) -> tuple[Any, ...]: ...
+    def __eq__(self, other: object, /) -> bool: ...
+
+def compose(a: Network, b: Network) -> Network: ...
+def run_population(
+    networks: Sequence[Network] | Mapping[str, npt.ArrayLike],
+    inputs: npt.ArrayLike,
+    *,
+    dt: float = 0.1,
+    substeps: int = 1,
+    method: _Method = "euler",
+    record: bool = True,
+) -> _Array: ...

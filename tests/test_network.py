@@ -1,0 +1,242 @@
+"""The Network API: construction, validation errors, runs, files and composition."""
+
+from __future__ import annotations
+
+import copy
+import json
+import pickle
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dnnevo
+from dnnevo import FormatError, InvalidArgumentError, InvalidNetworkError
+
+
+def make(n: int = 3, m: int = 2, seed: int = 0) -> dnnevo.Network:
+    rng = np.random.default_rng(seed)
+    return dnnevo.Network(
+        tau=rng.uniform(0.5, 10, n),
+        theta=rng.uniform(-5, 5, n),
+        weights=rng.uniform(-5, 5, (n, n)),
+        sensor_weights=rng.uniform(-5, 5, (n, m)),
+    )
+
+
+def test_properties_are_numpy_copies() -> None:
+    net = make()
+    assert (net.size, net.n_inputs) == (3, 2)
+    assert net.weights.shape == (3, 3) and net.sensor_weights.shape == (3, 2)
+    w = net.weights
+    w[0, 0] = 123.0
+    assert net.weights[0, 0] != 123.0
+    assert np.array_equal(net.state, np.zeros(3))
+
+
+def test_weights_convention_is_from_j_to_i() -> None:
+    # Neuron 1 listens to neuron 0 only; neuron 0 is pinned high by its threshold.
+    w = np.zeros((2, 2))
+    w[1, 0] = 4.0
+    net = dnnevo.Network([1.0, 1.0], [-20.0, 0.0], w, np.zeros((2, 0)))
+    trace = net.run(np.zeros((50, 0)), dt=0.1, substeps=5)
+    assert trace.states[-1, 1] == pytest.approx(4.0, rel=1e-3)
+
+
+def test_run_trace_and_state() -> None:
+    net = make()
+    inputs = np.ones((4, 2))
+    trace = net.run(inputs, dt=0.05, substeps=2)
+    assert trace.states.shape == (4, 3) and trace.outputs.shape == (4, 3)
+    assert np.array_equal(trace.inputs, inputs)
+    np.testing.assert_allclose(trace.time, [0.1, 0.2, 0.3, 0.4])
+    np.testing.assert_array_equal(net.state, trace.states[-1])
+    np.testing.assert_allclose(trace.outputs, 1 / (1 + np.exp(-(trace.states - net.theta))))
+    net.reset()
+    assert not net.state.any()
+    net.reset([1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(net.state, [1.0, 2.0, 3.0])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "fragment"),
+    [
+        ({"tau": [1.0, -1.0, 1.0]}, "tau[1] is -1"),
+        ({"tau": [1.0, 0.0, 1.0]}, "tau[1] is 0"),
+        ({"theta": [0.0, np.nan, 0.0]}, "theta[1] is NaN"),
+        ({"weights": np.full((3, 3), np.inf)}, "weights[0][0] is inf"),
+        ({"weights": np.zeros((3, 2))}, "weights has shape (3, 2); expected (N, N) = (3, 3)"),
+        ({"weights": np.zeros(9)}, "weights has shape (9,); expected (N, N)"),
+        ({"sensor_weights": np.zeros((2, 2))}, "sensor_weights has shape (2, 2)"),
+        ({"theta": [0.0]}, "theta has 1 values; expected N = 3"),
+        ({"state": [0.0, 0.0]}, "state has 2 values"),
+        ({"tau": []}, "at least 1 neuron"),
+        ({"tau": ["a", "b", "c"]}, "tau is not a numeric array"),
+        ({"tau": np.ones((3, 1))}, "tau has shape (3, 1); expected (N,)"),
+    ],
+)
+def test_bad_parameters_raise_invalid_network(kwargs: dict, fragment: str) -> None:
+    params = {
+        "tau": np.ones(3),
+        "theta": np.zeros(3),
+        "weights": np.zeros((3, 3)),
+        "sensor_weights": np.zeros((3, 1)),
+    }
+    params.update(kwargs)
+    with pytest.raises(InvalidNetworkError) as info:
+        dnnevo.Network(**params)
+    assert fragment in str(info.value)
+    assert isinstance(info.value, ValueError) and isinstance(info.value, dnnevo.DnnevoError)
+
+
+@pytest.mark.parametrize(
+    ("inputs", "kwargs", "fragment"),
+    [
+        (np.ones((5, 3)), {}, "inputs has shape (5, 3); expected (T, M) with M = 2"),
+        (np.ones(5), {}, "inputs has shape (5,)"),
+        (np.full((5, 2), np.nan), {}, "every input must be finite"),
+        (np.ones((5, 2)), {"dt": -0.1}, "dt is -0.1"),
+        (np.ones((5, 2)), {"dt": float("nan")}, "dt is NaN"),
+        (np.ones((5, 2)), {"substeps": 0}, "substeps is 0"),
+        (np.ones((5, 2)), {"substeps": -3}, "substeps is -3"),
+        (np.ones((5, 2)), {"method": "rk5"}, 'method is "rk5"'),
+    ],
+)
+def test_bad_run_arguments(inputs: np.ndarray, kwargs: dict, fragment: str) -> None:
+    with pytest.raises(InvalidArgumentError) as info:
+        make().run(inputs, **kwargs)
+    assert fragment in str(info.value)
+
+
+def test_divergent_euler_is_an_error_not_infinities() -> None:
+    net = dnnevo.Network([0.5], [0.0], [[0.0]], [[0.0]], state=[1.0])
+    with pytest.raises(InvalidArgumentError, match="diverged"):
+        net.run(np.zeros((1000, 1)), dt=5.0)
+
+
+def test_file_round_trip_is_exact(tmp_path: Path) -> None:
+    net = make(5, 2, seed=3)
+    net.run(np.ones((7, 2)))
+    path = tmp_path / "net.json"
+    net.save(path, meta={"task": "demo", "seed": 3})
+    back = dnnevo.Network.load(path)
+    assert back == net
+    for name in ("tau", "theta", "weights", "sensor_weights", "state"):
+        assert np.array_equal(getattr(back, name), getattr(net, name))
+    assert back.meta == {"task": "demo", "seed": 3}
+    assert dnnevo.Network.from_dict(net.to_dict()) == net
+    assert json.loads(path.read_text())["format"] == "dnnevo-network"
+    assert [p.name for p in tmp_path.iterdir()] == ["net.json"]
+    # Python's json module writes the same numbers back.
+    assert dnnevo.Network.from_dict(json.loads(json.dumps(net.to_dict()))) == net
+
+
+def test_copy_and_pickle() -> None:
+    net = make()
+    for other in (net.copy(), copy.copy(net), copy.deepcopy(net), pickle.loads(pickle.dumps(net))):
+        assert other == net and other is not net
+
+
+@pytest.mark.parametrize(
+    ("mutate", "fragment"),
+    [
+        (lambda d: d.update(format="other"), 'expected "dnnevo-network"'),
+        (lambda d: d.update(version=2), "version is 2"),
+        (lambda d: d.pop("tau"), "missing field `tau`"),
+        (lambda d: d.update(theta=[0.0]), "theta has 1 values"),
+        (lambda d: d.update(weights=[[0.0]]), "weights has 1 rows"),
+        (lambda d: d.update(tau=[1.0, -1.0, 1.0]), "tau[1]"),
+        (lambda d: d.update(theta=[0.0, "x", 0.0]), "theta[1]"),
+        (lambda d: d.update(extra=1), "unknown field `extra`"),
+        (lambda d: d.update(integrator={"method": "euler", "dt": 0, "substeps": 1}), "dt"),
+    ],
+)
+def test_bad_documents_raise_format_error(mutate, fragment: str) -> None:  # noqa: ANN001
+    d = make().to_dict()
+    mutate(d)
+    with pytest.raises(FormatError) as info:
+        dnnevo.Network.from_dict(d)
+    assert fragment in str(info.value)
+
+
+def test_non_finite_in_dict_is_a_format_error() -> None:
+    d = make().to_dict()
+    d["theta"][0] = float("nan")
+    with pytest.raises(FormatError):
+        dnnevo.Network.from_dict(d)
+
+
+def test_corrupt_and_truncated_files(tmp_path: Path) -> None:
+    path = tmp_path / "net.json"
+    make().save(path)
+    text = path.read_text()
+    for bad in (text[: len(text) // 2], "", "\x00\x01garbage", "[]", "null"):
+        path.write_text(bad)
+        with pytest.raises(FormatError):
+            dnnevo.Network.load(path)
+    with pytest.raises(FileNotFoundError):
+        dnnevo.Network.load(tmp_path / "missing.json")
+
+
+def test_compose_keeps_each_part_when_cross_weights_are_zero() -> None:
+    a, b = make(3, 2, seed=1), make(4, 2, seed=2)
+    ab = dnnevo.compose(a, b)
+    assert ab.size == 7
+    np.testing.assert_array_equal(ab.weights[:3, 3:], 0.0)
+    np.testing.assert_array_equal(ab.weights[3:, :3], 0.0)
+    inputs = np.random.default_rng(0).uniform(-1, 1, (40, 2))
+    ta, tb, tab = a.run(inputs, substeps=3), b.run(inputs, substeps=3), ab.run(inputs, substeps=3)
+    # Same operations in the same order: identical, not just close.
+    np.testing.assert_array_equal(tab.states[:, :3], ta.states)
+    np.testing.assert_array_equal(tab.states[:, 3:], tb.states)
+    with pytest.raises(InvalidNetworkError, match="same M"):
+        dnnevo.compose(a, make(2, 1))
+
+
+def test_population_matches_single_bit_for_bit() -> None:
+    nets = [make(4, 2, seed=s) for s in range(13)]
+    inputs = np.random.default_rng(1).uniform(-1, 1, (13, 30, 2))
+    states = dnnevo.run_population(nets, inputs, substeps=2, method="rk4")
+    assert states.shape == (13, 30, 4)
+    for p, net in enumerate(nets):
+        own = net.copy().run(inputs[p], substeps=2, method="rk4").states
+        np.testing.assert_array_equal(states[p], own)
+    final = dnnevo.run_population(nets, inputs[0], record=False)
+    assert final.shape == (13, 4)
+
+
+def test_population_from_stacked_arrays() -> None:
+    nets = [make(3, 1, seed=s) for s in range(5)]
+    stacked = {
+        name: np.stack([getattr(n, name) for n in nets])
+        for name in ("tau", "theta", "weights", "sensor_weights")
+    }
+    inputs = np.ones((10, 1))
+    np.testing.assert_array_equal(
+        dnnevo.run_population(stacked, inputs), dnnevo.run_population(nets, inputs)
+    )
+    stacked["tau"][2, 1] = -1.0
+    with pytest.raises(InvalidNetworkError, match=r"network 2: tau\[1\]"):
+        dnnevo.run_population(stacked, inputs)
+
+
+@pytest.mark.parametrize(
+    ("networks", "inputs", "error", "fragment"),
+    [
+        ([], np.ones((3, 1)), InvalidArgumentError, "at least 1 network"),
+        ([1, 2], np.ones((3, 1)), InvalidArgumentError, "networks[0] is a int"),
+        (None, np.ones((3, 1)), InvalidArgumentError, "sequence of Network"),
+        ("mixed", np.ones((3, 1)), InvalidArgumentError, "network 1 has N = 2"),
+        ("ok", np.ones((3, 2)), InvalidArgumentError, "expected (T, M) or (P, T, M)"),
+        ("ok", np.ones((4, 3, 1)), InvalidArgumentError, "with P = 2"),
+        ({"tau": np.ones((2, 3))}, np.ones((3, 1)), InvalidNetworkError, 'no "theta"'),
+    ],
+)
+def test_bad_population_arguments(networks, inputs, error, fragment) -> None:  # noqa: ANN001
+    if networks == "mixed":
+        networks = [make(3, 1), make(2, 1)]
+    elif networks == "ok":
+        networks = [make(3, 1), make(3, 1)]
+    with pytest.raises(error) as info:
+        dnnevo.run_population(networks, inputs)
+    assert fragment in str(info.value)

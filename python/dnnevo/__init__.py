@@ -10,7 +10,9 @@
 
 from __future__ import annotations
 
+from dnnevo import plot, presets
 from dnnevo._core import LANES, Network, Trace, __version__, compose, run_population
+from dnnevo.config import EvolutionConfig, IntegratorConfig, Ranges
 from dnnevo.errors import (
     ConfigError,
     DnnevoError,
@@ -19,10 +21,22 @@ from dnnevo.errors import (
     InvalidArgumentError,
     InvalidNetworkError,
 )
+from dnnevo.evolve import EvolutionResult, evaluate, evolve, resume
+from dnnevo.ga import GeneticAlgorithm
 
 __all__ = [
     "LANES",
     "ConfigError",
+    "EvolutionConfig",
+    "EvolutionResult",
+    "GeneticAlgorithm",
+    "IntegratorConfig",
+    "Ranges",
+    "evaluate",
+    "evolve",
+    "plot",
+    "presets",
+    "resume",
     "DnnevoError",
     "FitnessError",
     "FormatError",

@@ -7,7 +7,20 @@ from typing import Any, Literal, final
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["LANES", "Network", "Trace", "__version__", "compose", "run_population"]
+__all__ = [
+    "LANES",
+    "Evolution",
+    "Network",
+    "Trace",
+    "__version__",
+    "compose",
+    "decode",
+    "encode",
+    "evaluate",
+    "run_population",
+    "task_layout",
+    "task_names",
+]
 
 __version__: str
 LANES: int
@@ -102,3 +115,47 @@ def run_population(
     method: _Method = "euler",
     record: bool = True,
 ) -> _Array: ...
+
+@final
+class Evolution:
+    """The GA state behind ``dnnevo.GeneticAlgorithm``."""
+
+    def __new__(
+        cls,
+        config: str,
+        size: int,
+        n_inputs: int,
+        seed: int,
+        seeds: Sequence[Network] | None = None,
+        fill: str = "mutants",
+    ) -> Evolution: ...
+    @property
+    def generation(self) -> int: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def genome_length(self) -> int: ...
+    def genomes(self) -> _Array: ...
+    def networks(self) -> list[Network]: ...
+    def tell(self, fitness: npt.ArrayLike) -> dict[str, float]: ...
+    def step(
+        self, task: str, params: str, threads: int | None = None
+    ) -> tuple[dict[str, float], _Array]: ...
+    def champion(self) -> tuple[Network, float, int] | None: ...
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str) -> Evolution: ...
+
+def evaluate(
+    task: str,
+    params: str,
+    population: npt.ArrayLike | Sequence[Network],
+    *,
+    generation: int,
+    seed: int,
+    threads: int | None = None,
+) -> _Array: ...
+def task_layout(task: str, params: str) -> tuple[int, int]: ...
+def task_names() -> list[str]: ...
+def decode(size: int, n_inputs: int, genes: npt.ArrayLike) -> Network: ...
+def encode(net: Network) -> _Array: ...

@@ -1,32 +1,239 @@
-"""The ``dnnevo`` command line."""
+"""The ``dnnevo`` command line. Every failure is one line on stderr and exit status 2
+(``--debug`` shows the traceback)."""
 
 from __future__ import annotations
 
 import argparse
+import csv
+import io
+import os
 import sys
+import time
+from pathlib import Path
+
+import numpy as np
 
 import dnnevo
+from dnnevo import presets
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import DnnevoError
+from dnnevo.rundir import RunDir, write_atomic
 
 EXAMPLES = """examples:
-  dnnevo --version
+  dnnevo presets                                   list the experiments
+  dnnevo run sequence-1bit --quick --out runs/demo a 10-second demo run
+  dnnevo run sequence-1bit --seed 3                the paper's 1-bit experiment (1000 x 500)
+  dnnevo run sequence-1bit --set population=200 --set mutation_rate=0.02
+  dnnevo resume runs/demo                          continue a stopped run
+  dnnevo show runs/demo                            summary and fitness.png
+  dnnevo evaluate runs/demo --trials 200           re-score the champion on fresh conditions
+  dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
 """
+
+
+def _parse_seeds(text: str) -> list[int]:
+    seeds: list[int] = []
+    try:
+        for part in text.split(","):
+            lo, sep, hi = part.partition("-")
+            seeds.extend(range(int(lo), int(hi) + 1) if sep else [int(lo)])
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a seed list such as 0-9 or 1,4,7"
+        ) from None
+    if not seeds:
+        raise argparse.ArgumentTypeError("the seed list is empty")
+    return seeds
+
+
+def _nonnegative(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value} is negative")
+    return value
+
+
+def _positive(text: str) -> int:
+    value = _nonnegative(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError("must be >= 1")
+    return value
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        sys.stderr.write(f"dnnevo: error: {message} (see 'dnnevo --help')\n")
+        raise SystemExit(2)
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``dnnevo`` command."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="dnnevo",
-        description="Evolve continuous-time recurrent neural networks (Yamauchi & Beer).",
+        description="Evolve continuous-time recurrent neural networks (after Yamauchi & Beer).",
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"dnnevo {dnnevo.__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    def run_options(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a setting, e.g. population=200 or integrator.dt=0.05")
+        p.add_argument("--quick", action="store_true", help="small population, few generations")
+        p.add_argument("--threads", type=_positive, help="worker threads (default: all cores)")
+
+    p = sub.add_parser("run", help="run a preset", epilog="example: dnnevo run sequence-1bit --quick --out runs/demo")
+    p.add_argument("preset", help="preset name (see 'dnnevo presets')")
+    p.add_argument("--seed", type=_nonnegative, default=0, help="random seed (default 0)")
+    p.add_argument("--out", type=Path, help="run folder (default runs/PRESET-seedN)")
+    p.add_argument("--force", action="store_true", help="overwrite a non-empty run folder")
+    p.add_argument("--seed-from", action="append", default=[], type=Path, metavar="RUN",
+                   help="seed the initial population with RUN's champion (repeatable)")
+    run_options(p)
+
+    p = sub.add_parser("resume", help="continue a stopped run", epilog="example: dnnevo resume runs/demo")
+    p.add_argument("dir", type=Path)
+    p.add_argument("--threads", type=_positive)
+
+    p = sub.add_parser("show", help="summarise a run and write fitness.png", epilog="example: dnnevo show runs/demo")
+    p.add_argument("dir", type=Path)
+
+    sub.add_parser("presets", help="list the presets")
+
+    p = sub.add_parser("sweep", help="independent runs over seeds",
+                       epilog="example: dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep")
+    p.add_argument("preset")
+    p.add_argument("--seeds", type=_parse_seeds, default=_parse_seeds("0-9"), help="e.g. 0-9 or 1,4,7")
+    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--force", action="store_true")
+    run_options(p)
+
+    p = sub.add_parser("evaluate", help="re-score a champion on fresh random conditions",
+                       epilog="example: dnnevo evaluate runs/demo --trials 200")
+    p.add_argument("dir", type=Path)
+    p.add_argument("--trials", type=_positive, default=100, help="fresh evaluations (default 100)")
+    p.add_argument("--seed", type=_nonnegative, default=None, help="seed of the fresh conditions")
     return parser
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    config = presets.get(args.preset, quick=args.quick, overrides=args.set)
+    out = args.out or Path("runs") / f"{args.preset}{'-quick' if args.quick else ''}-seed{args.seed}"
+    seeds = [dnnevo.Network.load(RunDir(r).best) for r in args.seed_from]
+    result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,
+                           seeds=seeds, force=args.force)
+    return _report(result)
+
+
+def _report(result: dnnevo.EvolutionResult) -> int:
+    h = result.history
+    wall = h["elapsed_s"][-1] if len(h.get("elapsed_s", [])) else 0.0
+    print(f"best fitness {result.best_fitness:.4f} (generation {result.best_generation}); "
+          f"{len(h['generation'])} generations in {wall:.1f} s; run folder {result.run_dir}")
+    return 130 if result.interrupted else 0
+
+
+def _cmd_resume(args: argparse.Namespace) -> int:
+    return _report(dnnevo.resume(args.dir, threads=args.threads))
+
+
+def _cmd_show(args: argparse.Namespace) -> int:
+    run = RunDir(args.dir)
+    history = run.read_log()
+    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
+    last = history[-1]
+    best = max(history, key=lambda r: r["best"])
+    print(f"{args.dir}: task {config.task}, population {config.population}, "
+          f"{len(history)}/{config.generations} generations, {last['elapsed_s']:.1f} s")
+    print(f"best fitness {best['best']:.4f} at generation {int(best['generation'])}; "
+          f"last generation: best {last['best']:.4f}, mean {last['mean']:.4f}")
+    from dnnevo.plot import plot_fitness
+
+    arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
+    ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
+    ax.figure.savefig(run.path / "fitness.png", dpi=120)
+    print(f"wrote {run.path / 'fitness.png'}")
+    return 0
+
+
+def _cmd_presets(args: argparse.Namespace) -> int:
+    width = max(map(len, presets.names()))
+    for name in presets.names():
+        print(f"{name:<{width}}  {presets.PRESETS[name].summary}")
+    return 0
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    config = presets.get(args.preset, quick=args.quick, overrides=args.set)
+    RunDir(args.out).create(force=args.force)
+    rows = []
+    for seed in args.seeds:
+        t0 = time.perf_counter()
+        result = dnnevo.evolve(config.task, config, seed=seed, out=args.out / f"seed-{seed}",
+                               threads=args.threads, force=args.force)
+        rows.append({"seed": seed, "best_fitness": result.best_fitness,
+                     "best_generation": result.best_generation, "first_success": "",
+                     "wall_s": round(time.perf_counter() - t0, 2)})
+        if result.interrupted:
+            break
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    write_atomic(args.out / "summary.csv", buf.getvalue())
+    print(f"{'seed':>5} {'best':>8} {'at gen':>7} {'success':>8} {'wall s':>8}")
+    for r in rows:
+        print(f"{r['seed']:>5} {r['best_fitness']:>8.4f} {r['best_generation']:>7} "
+              f"{r['first_success'] or '-':>8} {r['wall_s']:>8.1f}")
+    print(f"wrote {args.out / 'summary.csv'}")
+    return 0
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    run = RunDir(args.dir)
+    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
+    champion = dnnevo.Network.load(run.best)
+    seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
+    fitness = np.array([
+        dnnevo.evaluate(config.task, [champion], generation=k, seed=seed, config=config)[0]
+        for k in range(args.trials)
+    ])
+    print(f"{args.dir}: champion re-scored on {args.trials} fresh evaluations (seed {seed}): "
+          f"mean fitness {fitness.mean():.4f} ± {fitness.std():.4f}, min {fitness.min():.4f}")
+    return 0
+
+
+COMMANDS = {
+    "run": _cmd_run,
+    "resume": _cmd_resume,
+    "show": _cmd_show,
+    "presets": _cmd_presets,
+    "sweep": _cmd_sweep,
+    "evaluate": _cmd_evaluate,
+}
 
 
 def main(argv: list[str] | None = None) -> int:
     """Runs the command line; returns the exit status."""
     parser = build_parser()
-    parser.parse_args(argv)
-    parser.print_help(sys.stdout)
-    return 0
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 0
+    try:
+        return COMMANDS[args.command](args)
+    except (DnnevoError, OSError) as e:
+        if args.debug:
+            raise
+        sys.stderr.write(f"dnnevo: error: {e}\n")
+        return 2
+    except KeyboardInterrupt:
+        sys.stderr.write("dnnevo: interrupted\n")
+        return 130

@@ -363,7 +363,7 @@ fn derivative<const L: usize>(
             out[j][l] = sigmoid(v[j][l] - net.theta[j][l]);
         }
     }
-    // Rows go four at a time: four independent sums keep the adder busy, and each sum still adds
+    // Rows go ROWS at a time: independent sums keep the adders busy, and each sum still adds
     // its terms in the order j = 0, 1, ..., so the result does not depend on the blocking.
     let mut i = 0;
     while i + ROWS <= n {

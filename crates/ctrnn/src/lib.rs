@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod evolve;
 pub mod ga;
 pub mod genome;
 pub mod integrate;
@@ -25,6 +26,7 @@ pub mod population;
 pub mod rng;
 
 pub use error::{Error, Result};
+pub use evolve::{Evolution, Fill, Stats, Task};
 pub use ga::{GaConfig, Selection};
 pub use genome::{Layout, Ranges};
 pub use integrate::{Integrator, Lanes, Method, LANES};

@@ -6,6 +6,7 @@
 mod arrays;
 mod detach;
 mod errors;
+mod evolution;
 mod network;
 
 use pyo3::prelude::*;
@@ -13,6 +14,8 @@ use pyo3::prelude::*;
 /// The native core of dnnevo.
 #[pymodule]
 mod _core {
+    #[pymodule_export]
+    use super::evolution::{decode, encode, evaluate, task_layout, task_names, PyEvolution};
     #[pymodule_export]
     use super::network::{compose, run_population, PyNetwork, PyTrace};
 

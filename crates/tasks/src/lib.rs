@@ -1,4 +1,24 @@
 //! The experiments of Yamauchi & Beer, each coupling a [`ctrnn::Network`] with its environment and
 //! scoring it: sequence learning (§5), one-dimensional navigation (§4) and landmark recognition
 //! (§3).
+//!
+//! Every experiment implements [`ctrnn::Task`], so an evolution run scores a whole generation
+//! with one call; [`registry::build`] makes a task from its name and a JSON object of parameters.
+//!
+//! # Example
+//! ```
+//! use ctrnn::Task;
+//! let task = tasks::build("sequence", &serde_json::json!({"targets": ["0", "1"]}))?;
+//! assert_eq!(task.layout().n_inputs, 2);
+//! # Ok::<(), ctrnn::Error>(())
+//! ```
 #![warn(missing_docs)]
+
+pub mod registry;
+pub mod sequence;
+
+pub use registry::{build, names};
+pub use sequence::{
+    performance, Assessment, PerfBase, Scores, SequenceConfig, SequenceTask, TargetReport,
+    TrialRecord,
+};

@@ -1,0 +1,227 @@
+"""Evolution settings: a frozen dataclass that reads and writes TOML.
+
+Every field has one meaning and one default here; presets (``dnnevo.presets``) override fields by
+name. A run folder's ``config.toml`` is this dataclass plus the run's seed and dnnevo's version,
+so a run can always be repeated from its folder.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+import tomli_w
+
+from dnnevo.errors import ConfigError
+
+__all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides"]
+
+SELECTIONS = ("proportional", "rank")
+FILLS = ("mutants", "random")
+METHODS = ("euler", "rk4")
+
+
+@dataclass(frozen=True)
+class Ranges:
+    """Allowed interval of each parameter kind; genes are drawn and resampled uniformly in it."""
+
+    tau: tuple[float, float] = (0.5, 10.0)
+    theta: tuple[float, float] = (-16.0, 16.0)
+    weights: tuple[float, float] = (-16.0, 16.0)
+    sensor_weights: tuple[float, float] = (-16.0, 16.0)
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            try:
+                lo, hi = (float(v) for v in value)
+            except (TypeError, ValueError):
+                raise ConfigError(f"ranges.{f.name} is {value!r}; expected [low, high]") from None
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+                raise ConfigError(f"ranges.{f.name} is [{lo}, {hi}]; expected finite low < high")
+            object.__setattr__(self, f.name, (lo, hi))
+        if self.tau[0] <= 0:
+            raise ConfigError(f"ranges.tau starts at {self.tau[0]}; time constants must be > 0")
+
+
+@dataclass(frozen=True)
+class IntegratorConfig:
+    """How networks are integrated: each input row is held for ``substeps`` steps of ``dt``."""
+
+    method: str = "euler"
+    dt: float = 0.1
+    substeps: int = 10
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise ConfigError(f"integrator.method is {self.method!r}; expected one of {METHODS}")
+        if not (isinstance(self.dt, int | float) and math.isfinite(self.dt) and self.dt > 0):
+            raise ConfigError(f"integrator.dt is {self.dt!r}; it must be a number > 0")
+        if not (isinstance(self.substeps, int) and self.substeps >= 1):
+            raise ConfigError(f"integrator.substeps is {self.substeps!r}; it must be an integer >= 1")
+
+
+@dataclass(frozen=True)
+class EvolutionConfig:
+    """Everything an evolution run needs besides its seed.
+
+    >>> cfg = EvolutionConfig(population=50, generations=10)
+    >>> EvolutionConfig.from_toml(cfg.to_toml()) == cfg
+    True
+    """
+
+    task: str = "sequence"
+    """Built-in task name (see ``dnnevo tasks``); ignored when ``evolve`` gets a Python callable."""
+    population: int = 100
+    generations: int = 100
+    crossover_rate: float = 0.5
+    mutation_rate: float = 0.025
+    elitism: int = 0
+    """How many of the best individuals are copied unchanged (0 = the paper's GA)."""
+    selection: str = "proportional"
+    """``"proportional"`` (the paper's) or ``"rank"``."""
+    fill: str = "mutants"
+    """With seed networks: fill the rest of the population with ``"mutants"`` or ``"random"``."""
+    size: int = 5
+    """Neurons per network."""
+    n_inputs: int = 2
+    """Sensors per network; a built-in task checks it matches."""
+    integrator: IntegratorConfig = field(default_factory=IntegratorConfig)
+    ranges: Ranges = field(default_factory=Ranges)
+    task_params: Mapping[str, Any] = field(default_factory=dict)
+    """Task-specific settings, passed to the task as they are."""
+
+    def __post_init__(self) -> None:
+        def integer(name: str, low: int) -> None:
+            value = getattr(self, name)
+            if not (isinstance(value, int) and not isinstance(value, bool) and value >= low):
+                raise ConfigError(f"{name} is {value!r}; it must be an integer >= {low}")
+
+        integer("population", 2)
+        integer("generations", 1)
+        integer("elitism", 0)
+        integer("size", 1)
+        integer("n_inputs", 0)
+        for name in ("crossover_rate", "mutation_rate"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and 0.0 <= value <= 1.0):
+                raise ConfigError(f"{name} is {value!r}; it must be in [0, 1]")
+        if self.elitism >= self.population:
+            raise ConfigError(
+                f"elitism is {self.elitism}; it must be < population ({self.population})"
+            )
+        if self.selection not in SELECTIONS:
+            raise ConfigError(f"selection is {self.selection!r}; expected one of {SELECTIONS}")
+        if self.fill not in FILLS:
+            raise ConfigError(f"fill is {self.fill!r}; expected one of {FILLS}")
+        if not isinstance(self.task, str) or not self.task:
+            raise ConfigError(f"task is {self.task!r}; expected a task name")
+        if isinstance(self.integrator, Mapping):
+            object.__setattr__(self, "integrator", _build(IntegratorConfig, self.integrator, "integrator"))
+        if isinstance(self.ranges, Mapping):
+            object.__setattr__(self, "ranges", _build(Ranges, self.ranges, "ranges"))
+        if not isinstance(self.task_params, Mapping):
+            raise ConfigError(f"task_params is {self.task_params!r}; expected a table")
+        object.__setattr__(self, "task_params", dict(self.task_params))
+
+    # -- conversions -------------------------------------------------------------------------
+
+    def to_dict(self) -> dict[str, Any]:
+        """A plain dict (tuples become lists), as written to TOML."""
+        d = dataclasses.asdict(self)
+        d["ranges"] = {k: list(v) for k, v in d["ranges"].items()}
+        return d
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> EvolutionConfig:
+        """Builds a config from a dict; unknown keys are an error that names them."""
+        return _build(cls, d, "config")
+
+    def to_toml(self, run: Mapping[str, Any] | None = None) -> str:
+        """TOML text; ``run`` (seed, dnnevo version, ...) is written as a ``[run]`` table."""
+        d = self.to_dict()
+        if run:
+            d = {"run": dict(run), **d}
+        return tomli_w.dumps(d)
+
+    @classmethod
+    def from_toml(cls, text: str) -> EvolutionConfig:
+        """Reads TOML written by :meth:`to_toml` (a ``[run]`` table is ignored)."""
+        try:
+            d = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise ConfigError(f"not valid TOML: {e}") from None
+        d.pop("run", None)
+        return cls.from_dict(d)
+
+    def ga_json(self) -> dict[str, Any]:
+        """The GA settings in the form the Rust core reads."""
+        return {
+            "population": self.population,
+            "crossover_rate": float(self.crossover_rate),
+            "mutation_rate": float(self.mutation_rate),
+            "elitism": self.elitism,
+            "selection": self.selection,
+            "ranges": {k: list(v) for k, v in dataclasses.asdict(self.ranges).items()},
+        }
+
+    def task_json(self) -> dict[str, Any]:
+        """The built-in task's parameters: size and integrator, then ``task_params``."""
+        return {
+            "size": self.size,
+            "integrator": dataclasses.asdict(self.integrator),
+            **self.task_params,
+        }
+
+
+def _build(cls: type, d: Mapping[str, Any], where: str) -> Any:
+    if not isinstance(d, Mapping):
+        raise ConfigError(f"{where} is {d!r}; expected a table")
+    known = {f.name for f in fields(cls)}
+    unknown = sorted(set(d) - known)
+    if unknown:
+        raise ConfigError(
+            f"{where} has unknown key {unknown[0]!r}; known keys: {', '.join(sorted(known))}"
+        )
+    try:
+        return cls(**d)
+    except TypeError as e:
+        raise ConfigError(f"{where}: {e}") from None
+
+
+def _parse_value(text: str) -> Any:
+    """A ``--set`` value: TOML syntax (``3``, ``0.5``, ``true``, ``["0", "1"]``), else a string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> EvolutionConfig:
+    """Applies ``key=value`` overrides, e.g. ``population=50``, ``integrator.dt=0.05``,
+    ``ranges.tau=[1, 5]`` or ``task_params.targets=["01", "10"]``."""
+    d = config.to_dict()
+    for item in assignments:
+        key, sep, raw = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ConfigError(f"--set {item!r} is not key=value")
+        value = _parse_value(raw.strip())
+        head, _, sub = key.partition(".")
+        if head not in d:
+            raise ConfigError(f"unknown setting {key!r}; known settings: {', '.join(sorted(d))}")
+        if sub:
+            if not isinstance(d[head], dict):
+                raise ConfigError(f"{head} is not a table, so {key!r} cannot be set")
+            if head != "task_params" and sub not in d[head]:
+                raise ConfigError(
+                    f"unknown setting {key!r}; {head} has {', '.join(sorted(d[head]))}"
+                )
+            d[head] = {**d[head], sub: value}
+        else:
+            d[head] = value
+    return EvolutionConfig.from_dict(d)

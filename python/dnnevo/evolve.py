@@ -1,0 +1,289 @@
+"""The generation loop: evolve with a built-in task or a Python fitness function, with a run
+folder, checkpoints, Ctrl-C/SIGTERM handling and resume.
+
+The loop itself is Python, one call into Rust per generation; all the work of a generation
+(decoding, evaluating on all cores, breeding) happens in Rust with the GIL released.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from dnnevo import _core
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import ConfigError, FitnessError
+from dnnevo.ga import GeneticAlgorithm
+from dnnevo.progress import Progress
+from dnnevo.rundir import RunDir
+
+__all__ = ["EvolutionResult", "evaluate", "evolve", "resume"]
+
+FitnessFn = Callable[[list[_core.Network]], npt.ArrayLike]
+Callback = Callable[[dict[str, float], GeneticAlgorithm], Any]
+
+#: Seconds between two checkpoints (one is also written at the end and on interruption).
+CHECKPOINT_SECONDS = 10.0
+
+
+@dataclass(frozen=True)
+class EvolutionResult:
+    """What a run produced."""
+
+    best: _core.Network
+    """The best network of the run (in its initial state)."""
+    best_fitness: float
+    best_generation: int
+    history: dict[str, npt.NDArray[np.float64]]
+    """Per-generation arrays: generation, best, mean, std, min, evals_per_s, elapsed_s."""
+    config: EvolutionConfig
+    seed: int
+    run_dir: Path | None
+    interrupted: bool = False
+
+
+def evaluate(
+    task: str,
+    genomes: npt.ArrayLike | Sequence[_core.Network],
+    *,
+    generation: int,
+    seed: int,
+    config: EvolutionConfig | None = None,
+    threads: int | None = None,
+) -> npt.NDArray[np.float64]:
+    """Scores genomes (P, G) or networks with a built-in task: a pure function of (task config,
+    genomes, generation, seed), bit-identical to the scores inside :func:`evolve`."""
+    config = _task_config(task, config)
+    return _core.evaluate(
+        config.task,
+        json.dumps(config.task_json()),
+        genomes,
+        generation=generation,
+        seed=seed,
+        threads=threads,
+    )
+
+
+def _task_config(task: str, config: EvolutionConfig | None) -> EvolutionConfig:
+    """The config for a built-in task name or preset name."""
+    from dnnevo import presets
+
+    if config is not None:
+        if task != config.task and task not in presets.names():
+            raise ConfigError(f"task {task!r} does not match config.task {config.task!r}")
+        return config
+    if task in presets.names():
+        return presets.get(task)
+    if task in _core.task_names():
+        return EvolutionConfig(task=task)
+    raise ConfigError(
+        f"unknown task {task!r}; built-in tasks: {', '.join(_core.task_names())}; "
+        f"presets: {', '.join(presets.names())}"
+    )
+
+
+def evolve(
+    task: str | FitnessFn,
+    config: EvolutionConfig | None = None,
+    *,
+    seed: int = 0,
+    out: str | Path | None = None,
+    progress: bool = True,
+    callback: Callback | None = None,
+    threads: int | None = None,
+    seeds: Sequence[_core.Network] | None = None,
+    force: bool = False,
+) -> EvolutionResult:
+    """Evolves networks for ``task`` and returns the champion and the history.
+
+    ``task`` is a built-in task or preset name, or a Python callable ``fitness(networks) ->
+    array`` (slower, but works with everything else, checkpoints included). With ``out`` the run
+    writes a run folder (see :mod:`dnnevo.rundir`); an existing non-empty folder is refused unless
+    ``force``. ``callback(stats, ga)`` runs after every generation; returning True stops the run.
+    ``seeds`` are networks placed first in the initial population (e.g. from :func:`compose`).
+    """
+    if callable(task):
+        config = config or EvolutionConfig()
+    else:
+        config = _task_config(task, config)
+        _check_layout(config)
+    run = RunDir(out) if out is not None else None
+    if run is not None:
+        run.create(force=force)
+        run.config.write_text(config.to_toml(run=_run_table(seed)), encoding="utf-8")
+    ga = GeneticAlgorithm(config, seed=seed, seeds=seeds)
+    return _loop(ga, task, [], run, progress=progress, callback=callback, threads=threads)
+
+
+def resume(
+    run_dir: str | Path,
+    task: FitnessFn | None = None,
+    *,
+    progress: bool = True,
+    callback: Callback | None = None,
+    threads: int | None = None,
+) -> EvolutionResult:
+    """Continues a stopped run from its checkpoint; the result is identical to a run that was
+    never stopped. A run with a Python fitness function needs it passed again as ``task``."""
+    run = RunDir(run_dir)
+    state, history = run.read_checkpoint()
+    ga = GeneticAlgorithm.from_state_dict(state)
+    fitness: str | FitnessFn = task if task is not None else ga.config.task
+    return _loop(ga, fitness, history, run, progress=progress, callback=callback, threads=threads)
+
+
+def _run_table(seed: int) -> dict[str, Any]:
+    return {"seed": seed, "dnnevo_version": _core.__version__}
+
+
+def _check_layout(config: EvolutionConfig) -> None:
+    size, n_inputs = _core.task_layout(config.task, json.dumps(config.task_json()))
+    if (size, n_inputs) != (config.size, config.n_inputs):
+        raise ConfigError(
+            f"the {config.task} task drives networks with {n_inputs} inputs; "
+            f"the config has size = {config.size}, n_inputs = {config.n_inputs}"
+        )
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt() -> Iterator[None]:
+    """Turns SIGTERM into KeyboardInterrupt while the loop runs (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+def _loop(
+    ga: GeneticAlgorithm,
+    task: str | FitnessFn,
+    history: list[dict[str, float]],
+    run: RunDir | None,
+    *,
+    progress: bool,
+    callback: Callback | None,
+    threads: int | None,
+) -> EvolutionResult:
+    config = ga.config
+    bar = Progress(config.generations, start=ga.generation) if progress else None
+    task_json = None if callable(task) else json.dumps(config.task_json())
+    t_start = time.perf_counter() - (history[-1]["elapsed_s"] if history else 0.0)
+    last_checkpoint = time.perf_counter()
+    best_seen = ga.best_fitness
+    interrupted = False
+
+    def save_state() -> None:
+        if run is not None:
+            run.write_checkpoint(ga.state_dict(), history)
+
+    try:
+        with _sigterm_as_interrupt():
+            while ga.generation < config.generations:
+                t0 = time.perf_counter()
+                if callable(task):
+                    networks = ga.ask().networks
+                    fitness = np.asarray(task(networks), dtype=np.float64)
+                    if fitness.shape != (config.population,):
+                        raise FitnessError(
+                            f"the fitness function returned shape {fitness.shape}; "
+                            f"expected ({config.population},)"
+                        )
+                    stats = ga.tell(fitness)
+                else:
+                    assert task_json is not None
+                    stats, _ = ga._evo.step(task, task_json, threads)
+                seconds = time.perf_counter() - t0
+                row = {
+                    "generation": float(stats["generation"]),
+                    "best": stats["best"],
+                    "mean": stats["mean"],
+                    "std": stats["std"],
+                    "min": stats["min"],
+                    "evals_per_s": config.population / seconds if seconds > 0 else 0.0,
+                    "elapsed_s": time.perf_counter() - t_start,
+                }
+                history.append(row)
+                if run is not None:
+                    run.write_log(history)
+                    if ga.best_fitness is not None and ga.best_fitness != best_seen:
+                        best_seen = ga.best_fitness
+                        _write_best(run, ga)
+                    if time.perf_counter() - last_checkpoint >= CHECKPOINT_SECONDS:
+                        save_state()
+                        last_checkpoint = time.perf_counter()
+                if bar is not None:
+                    bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"])
+                if callback is not None and callback(stats, ga) is True:
+                    break
+            save_state()
+    except KeyboardInterrupt:
+        interrupted = True
+        save_state()
+        if bar is not None:
+            bar.close()
+            bar = None
+        if run is None:
+            raise
+        print(
+            f"\ninterrupted at generation {ga.generation}; checkpoint saved. "
+            f"Resume with: dnnevo resume {run.path}",
+            file=sys.stderr,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    return _result(ga, history, run, interrupted)
+
+
+def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
+    champ = ga._evo.champion()
+    assert champ is not None
+    net, fitness, generation = champ
+    meta = {
+        "task": ga.config.task,
+        "seed": ga.seed,
+        "generation": generation,
+        "fitness": fitness,
+        "dnnevo_version": _core.__version__,
+    }
+    net.save(run.best, meta=meta)
+
+
+def _result(
+    ga: GeneticAlgorithm, history: list[dict[str, float]], run: RunDir | None, interrupted: bool
+) -> EvolutionResult:
+    champ = ga._evo.champion()
+    if champ is None:
+        raise FitnessError("no generation was scored, so there is no champion")
+    net, fitness, generation = champ
+    columns = history[0].keys() if history else ()
+    arrays = {k: np.array([row[k] for row in history]) for k in columns}
+    return EvolutionResult(
+        best=net,
+        best_fitness=fitness,
+        best_generation=generation,
+        history=arrays,
+        config=ga.config,
+        seed=ga.seed,
+        run_dir=run.path if run else None,
+        interrupted=interrupted,
+    )

@@ -1,0 +1,104 @@
+"""Ask/tell access to the paper's genetic algorithm, for fitness functions written in Python.
+
+>>> import numpy as np, dnnevo
+>>> ga = dnnevo.GeneticAlgorithm(dnnevo.EvolutionConfig(population=20, size=2, n_inputs=1), seed=0)
+>>> genomes, networks = ga.ask()
+>>> genomes.shape, len(networks)
+((20, 10), 20)
+>>> stats = ga.tell(np.array([n.tau[0] for n in networks]))
+>>> ga.generation
+1
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from dnnevo import _core
+from dnnevo.config import EvolutionConfig
+
+__all__ = ["Ask", "GeneticAlgorithm"]
+
+
+class Ask(NamedTuple):
+    """The population to score: genomes (P, G) and the same individuals as Networks."""
+
+    genomes: npt.NDArray[np.float64]
+    networks: list[_core.Network]
+
+
+class GeneticAlgorithm:
+    """The paper's GA over networks of ``config.size`` neurons and ``config.n_inputs`` sensors.
+
+    Genome layout (G = N * (2 + M + N) genes): for each neuron i in turn, its tau, its theta,
+    its M sensor weights and its N incoming weights (``weights[i][:]``).
+    """
+
+    def __init__(
+        self,
+        config: EvolutionConfig | None = None,
+        *,
+        seed: int = 0,
+        seeds: Sequence[_core.Network] | None = None,
+    ) -> None:
+        self.config = config or EvolutionConfig()
+        self._evo = _core.Evolution(
+            json.dumps(self.config.ga_json()),
+            self.config.size,
+            self.config.n_inputs,
+            int(seed),
+            list(seeds or []),
+            self.config.fill,
+        )
+
+    @property
+    def seed(self) -> int:
+        """The run's seed."""
+        return self._evo.seed
+
+    @property
+    def generation(self) -> int:
+        """The generation the current population belongs to."""
+        return self._evo.generation
+
+    def ask(self) -> Ask:
+        """The current population."""
+        return Ask(self._evo.genomes(), self._evo.networks())
+
+    def tell(self, fitness: npt.ArrayLike) -> dict[str, float]:
+        """Scores the current population (one finite fitness each; >= 0 under proportional
+        selection) and breeds the next. Returns best, mean, std and min of the scored generation."""
+        return self._evo.tell(fitness)
+
+    @property
+    def best(self) -> _core.Network | None:
+        """The best network scored so far, or None before the first ``tell``."""
+        champ = self._evo.champion()
+        return None if champ is None else champ[0]
+
+    @property
+    def best_fitness(self) -> float | None:
+        """The fitness of :attr:`best`."""
+        champ = self._evo.champion()
+        return None if champ is None else champ[1]
+
+    def state_dict(self) -> dict[str, Any]:
+        """Everything needed to continue bit for bit (JSON-serialisable)."""
+        return {"config": self.config.to_dict(), "evolution": self._evo.to_json()}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restores a state from :meth:`state_dict`."""
+        self.config = EvolutionConfig.from_dict(state["config"])
+        self._evo = _core.Evolution.from_json(state["evolution"])
+
+    @classmethod
+    def from_state_dict(cls, state: dict[str, Any]) -> GeneticAlgorithm:
+        """A GA restored from :meth:`state_dict`."""
+        ga = cls.__new__(cls)
+        ga.load_state_dict(state)
+        return ga

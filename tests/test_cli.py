@@ -1,0 +1,76 @@
+"""The dnnevo command: every command works and every error is one line with exit status 2."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+
+def dnnevo(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "dnnevo", *args], capture_output=True,
+                          text=True, cwd=cwd, timeout=600)
+
+
+def test_help_shows_a_working_example() -> None:
+    r = dnnevo("--help")
+    assert r.returncode == 0 and "dnnevo run sequence-1bit --quick" in r.stdout
+
+
+def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
+    out = tmp_path / "demo"
+    r = dnnevo("run", "sequence-1bit", "--quick", "--out", str(out), "--seed", "1")
+    assert r.returncode == 0, r.stderr
+    assert "best fitness" in r.stdout
+    r = dnnevo("show", str(out))
+    assert r.returncode == 0 and (out / "fitness.png").stat().st_size > 1000
+    r = dnnevo("evaluate", str(out), "--trials", "5", "--seed", "1")
+    assert r.returncode == 0 and "mean fitness" in r.stdout
+    r = dnnevo("resume", str(out))  # already finished: nothing to do, still a clean exit
+    assert r.returncode == 0, r.stderr
+    sweep = tmp_path / "sweep"
+    r = dnnevo("sweep", "sequence-1bit", "--quick", "--seeds", "0-1", "--out", str(sweep),
+               "--set", "generations=2")
+    assert r.returncode == 0, r.stderr
+    assert len((sweep / "summary.csv").read_text().splitlines()) == 3
+    r = dnnevo("presets")
+    assert r.returncode == 0 and "sequence-1bit" in r.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["run", "no-such-preset"], "unknown preset 'no-such-preset'"),
+        (["run", "sequence-1bit", "--quick", "--set", "populaton=3"], "unknown setting 'populaton'"),
+        (["run", "sequence-1bit", "--quick", "--set", "population=1"], "population is 1"),
+        (["run", "sequence-1bit", "--quick", "--set", "nonsense"], "is not key=value"),
+        (["run", "sequence-1bit", "--seed", "-1"], "-1 is negative"),
+        (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
+        (["resume", "/no/such/dir"], "has no checkpoint.json"),
+        (["show", "/no/such/dir"], "has no log.csv"),
+        (["evaluate", "/no/such/dir"], "No such file"),
+        (["sweep", "sequence-1bit", "--seeds", "a-b", "--out", "x"], "not a seed list"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_errors_are_one_line(args: list[str], fragment: str, tmp_path: Path) -> None:
+    r = dnnevo(*args, cwd=tmp_path)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert fragment in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "Traceback" not in r.stderr
+
+
+def test_non_empty_out_is_refused(tmp_path: Path) -> None:
+    (tmp_path / "x").mkdir()
+    (tmp_path / "x" / "keep.txt").write_text("mine")
+    r = dnnevo("run", "sequence-1bit", "--quick", "--out", str(tmp_path / "x"))
+    assert r.returncode == 2 and "not empty" in r.stderr
+    assert (tmp_path / "x" / "keep.txt").read_text() == "mine"
+
+
+def test_debug_shows_traceback(tmp_path: Path) -> None:
+    r = dnnevo("--debug", "run", "no-such-preset", cwd=tmp_path)
+    assert r.returncode != 0 and "Traceback" in r.stderr

@@ -1,0 +1,203 @@
+"""The evolution engine: ask/tell, determinism over threads, run folders, resume, signals."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dnnevo
+from dnnevo import ConfigError, EvolutionConfig, FitnessError
+
+SQUARE = np.repeat([1.0, 0.0, 1.0, 0.0], 10)[:, None]
+
+
+def follow_square(networks: list[dnnevo.Network]) -> np.ndarray:
+    """Fitness: neuron 0's firing rate should follow a slow square wave given as input."""
+    out = np.array([n.copy().run(SQUARE, substeps=10).outputs[:, 0] for n in networks])
+    return 1.0 - np.abs(out - SQUARE[:, 0]).mean(axis=1)
+
+
+SMALL = EvolutionConfig(population=40, generations=6, size=2, n_inputs=1)
+
+
+def test_ask_tell_solves_a_small_problem() -> None:
+    ga = dnnevo.GeneticAlgorithm(EvolutionConfig(population=60, size=2, n_inputs=1), seed=1)
+    firsts = []
+    for _ in range(12):
+        genomes, networks = ga.ask()
+        assert genomes.shape == (60, 2 * (2 + 1 + 2))
+        stats = ga.tell(follow_square(networks))
+        firsts.append(stats["mean"])
+    assert ga.best is not None and ga.best_fitness is not None
+    assert ga.best_fitness > 0.8
+    assert firsts[-1] > firsts[0] + 0.1, firsts
+
+
+def test_state_dict_round_trip_continues_identically() -> None:
+    a = dnnevo.GeneticAlgorithm(SMALL, seed=4)
+    for _ in range(2):
+        a.tell(follow_square(a.ask().networks))
+    b = dnnevo.GeneticAlgorithm.from_state_dict(json.loads(json.dumps(a.state_dict())))
+    for _ in range(3):
+        fa = a.tell(follow_square(a.ask().networks))
+        fb = b.tell(follow_square(b.ask().networks))
+        assert fa == fb
+    np.testing.assert_array_equal(a.ask().genomes, b.ask().genomes)
+
+
+@pytest.mark.parametrize(
+    ("fitness", "error", "fragment"),
+    [
+        (np.full(40, np.nan), FitnessError, "individual 0 is NaN"),
+        (-np.ones(40), FitnessError, "rank"),
+        (np.ones(3), FitnessError, "3 fitness values"),
+        (np.ones((40, 1)), FitnessError, "expected (P,)"),
+    ],
+)
+def test_bad_fitness_is_refused(fitness: np.ndarray, error: type, fragment: str) -> None:
+    ga = dnnevo.GeneticAlgorithm(SMALL, seed=0)
+    with pytest.raises(error) as info:
+        ga.tell(fitness)
+    assert fragment in str(info.value)
+    assert ga.generation == 0
+
+
+def test_seeding_puts_networks_first() -> None:
+    seed_net = dnnevo.Network.random(2, 1, seed=9)
+    ga = dnnevo.GeneticAlgorithm(SMALL, seed=0, seeds=[seed_net])
+    assert ga.ask().networks[0] == seed_net
+    with pytest.raises(ConfigError, match="seed network 0 has N = 3"):
+        dnnevo.GeneticAlgorithm(SMALL, seed=0, seeds=[dnnevo.Network.random(3, 1, seed=1)])
+
+
+def test_builtin_run_is_identical_with_one_and_two_threads(tmp_path: Path) -> None:
+    config = dnnevo.presets.get("sequence-1bit", quick=True)
+    one = dnnevo.evolve("sequence", config, seed=5, threads=1, out=tmp_path / "1", progress=False)
+    two = dnnevo.evolve("sequence", config, seed=5, threads=2, out=tmp_path / "2", progress=False)
+    for key in ("best", "mean", "std", "min"):
+        np.testing.assert_array_equal(one.history[key], two.history[key])
+    assert one.best == two.best
+    assert (tmp_path / "1/best.json").read_bytes() == (tmp_path / "2/best.json").read_bytes()
+
+
+def test_evaluate_matches_in_run_scores() -> None:
+    config = dnnevo.presets.get("sequence-1bit", quick=True)
+    ga = dnnevo.GeneticAlgorithm(config, seed=11)
+    genomes, networks = ga.ask()
+    from_genomes = dnnevo.evaluate("sequence", genomes, generation=0, seed=11, config=config)
+    from_networks = dnnevo.evaluate("sequence", networks, generation=0, seed=11, config=config)
+    stats, fitness = ga._evo.step("sequence", json.dumps(config.task_json()), None)
+    np.testing.assert_array_equal(from_genomes, fitness)
+    np.testing.assert_array_equal(from_networks, fitness)
+
+
+def test_run_folder_contents(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    result = dnnevo.evolve(follow_square, SMALL, seed=2, out=out, progress=False)
+    assert sorted(p.name for p in out.iterdir()) == [
+        "best.json", "checkpoint.json", "config.toml", "log.csv"]
+    assert EvolutionConfig.from_toml((out / "config.toml").read_text()) == SMALL
+    assert "seed = 2" in (out / "config.toml").read_text()
+    assert len((out / "log.csv").read_text().splitlines()) == 1 + SMALL.generations
+    best = dnnevo.Network.load(out / "best.json")
+    assert best == result.best
+    assert best.meta["fitness"] == result.best_fitness
+    assert result.history["best"].shape == (SMALL.generations,)
+    assert result.run_dir == out
+    with pytest.raises(dnnevo.DnnevoError, match="not empty"):
+        dnnevo.evolve(follow_square, SMALL, seed=2, out=out, progress=False)
+    dnnevo.evolve(follow_square, SMALL, seed=3, out=out, progress=False, force=True)
+
+
+def test_stopped_and_resumed_run_equals_uninterrupted(tmp_path: Path) -> None:
+    full = dnnevo.evolve(follow_square, SMALL, seed=7, out=tmp_path / "full", progress=False)
+    stop_at_3 = lambda stats, ga: ga.generation >= 3  # noqa: E731
+    part = dnnevo.evolve(follow_square, SMALL, seed=7, out=tmp_path / "part", progress=False,
+                         callback=stop_at_3)
+    assert len(part.history["best"]) == 3
+    resumed = dnnevo.resume(tmp_path / "part", follow_square, progress=False)
+    for key in ("generation", "best", "mean", "std", "min"):
+        np.testing.assert_array_equal(full.history[key], resumed.history[key])
+    assert full.best == resumed.best
+    assert (tmp_path / "full/best.json").read_bytes() == (tmp_path / "part/best.json").read_bytes()
+
+
+SCRIPT = """
+import sys, time
+sys.path.insert(0, {tests!r})
+import dnnevo
+from test_evolve import SMALL, follow_square
+def slow(nets):
+    time.sleep(0.15)
+    return follow_square(nets)
+cfg = dnnevo.EvolutionConfig.from_dict({{**SMALL.to_dict(), "generations": 40}})
+dnnevo.evolve(slow, cfg, seed=8, out={out!r}, progress=False)
+"""
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_signal_checkpoints_and_resume_is_identical(tmp_path: Path, sig: int) -> None:
+    out = tmp_path / "run"
+    script = SCRIPT.format(tests=str(Path(__file__).parent), out=str(out))
+    proc = subprocess.Popen([sys.executable, "-c", script], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        log = out / "log.csv"
+        if log.exists() and len(log.read_text().splitlines()) >= 4:
+            break
+        time.sleep(0.05)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=60)
+    assert "checkpoint saved" in err and f"dnnevo resume {out}" in err, err
+    assert "Traceback" not in err
+    cfg = EvolutionConfig.from_dict({**SMALL.to_dict(), "generations": 40})
+    resumed = dnnevo.resume(out, follow_square, progress=False)
+    full = dnnevo.evolve(follow_square, cfg, seed=8, progress=False)
+    for key in ("best", "mean", "std", "min"):
+        np.testing.assert_array_equal(full.history[key], resumed.history[key])
+    assert full.best == resumed.best
+
+
+def test_callable_with_wrong_shape() -> None:
+    with pytest.raises(FitnessError, match=r"returned shape \(3,\)"):
+        dnnevo.evolve(lambda nets: np.ones(3), SMALL, progress=False)
+
+
+def test_config_validation_messages() -> None:
+    for kwargs, fragment in [
+        ({"population": 1}, "population is 1"),
+        ({"crossover_rate": 1.5}, "crossover_rate is 1.5; it must be in [0, 1]"),
+        ({"mutation_rate": -0.1}, "mutation_rate is -0.1"),
+        ({"elitism": 100}, "elitism is 100"),
+        ({"selection": "tournament"}, "selection is 'tournament'"),
+        ({"integrator": {"dt": 0}}, "integrator.dt is 0"),
+        ({"ranges": {"tau": (0, 1)}}, "ranges.tau starts at 0.0"),
+        ({"ranges": {"tau": (2, 1)}}, "ranges.tau is [2.0, 1.0]"),
+    ]:
+        with pytest.raises(ConfigError) as info:
+            EvolutionConfig(**kwargs)
+        assert fragment in str(info.value)
+    with pytest.raises(ConfigError, match="unknown key 'populaton'"):
+        EvolutionConfig.from_dict({"populaton": 3})
+
+
+def test_env_thread_count_does_not_change_results(tmp_path: Path) -> None:
+    outs = []
+    for threads in ("1", "2"):
+        out = tmp_path / threads
+        env = {**os.environ, "RAYON_NUM_THREADS": threads}
+        subprocess.run(
+            [sys.executable, "-m", "dnnevo", "run", "sequence-1bit", "--quick", "--seed", "3",
+             "--out", str(out)], env=env, check=True, capture_output=True)
+        outs.append((out / "best.json").read_bytes())
+        assert (out / "log.csv").exists()
+    assert outs[0] == outs[1]

@@ -18,8 +18,12 @@ __all__ = [
     "encode",
     "evaluate",
     "run_population",
+    "sequence_assess",
+    "sequence_timings",
+    "sequence_trial",
     "task_layout",
     "task_names",
+    "task_success",
 ]
 
 __version__: str
@@ -157,5 +161,17 @@ def evaluate(
 ) -> _Array: ...
 def task_layout(task: str, params: str) -> tuple[int, int]: ...
 def task_names() -> list[str]: ...
+def task_success(task: str, params: str, net: Network, seed: int) -> bool | None: ...
 def decode(size: int, n_inputs: int, genes: npt.ArrayLike) -> Network: ...
 def encode(net: Network) -> _Array: ...
+def sequence_timings(
+    params: str, seed: int, generation: int, trial: int
+) -> list[tuple[int, int]]: ...
+def sequence_trial(
+    params: str,
+    net: Network,
+    pattern: str,
+    timing: Sequence[tuple[int, int]],
+    reset: bool = True,
+) -> str: ...
+def sequence_assess(params: str, net: Network, trials_per_target: int, seed: int) -> str: ...

@@ -27,6 +27,7 @@ EXAMPLES = """examples:
   dnnevo resume runs/demo                          continue a stopped run
   dnnevo show runs/demo                            summary and fitness.png
   dnnevo evaluate runs/demo --trials 200           re-score the champion on fresh conditions
+  dnnevo plot runs/demo                            fitness curve and the paper's figures
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
 """
 
@@ -95,7 +96,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, help="run folder (default runs/PRESET-seedN)")
     p.add_argument("--force", action="store_true", help="overwrite a non-empty run folder")
     p.add_argument("--seed-from", action="append", default=[], type=Path, metavar="RUN",
-                   help="seed the initial population with RUN's champion (repeatable)")
+                   help="seed the initial population with RUN's champion (repeatable); "
+                        "champions whose sizes add up to the preset's size are composed")
     run_options(p)
 
     p = sub.add_parser("resume", help="continue a stopped run", epilog="example: dnnevo resume runs/demo")
@@ -118,18 +120,36 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("evaluate", help="re-score a champion on fresh random conditions",
                        epilog="example: dnnevo evaluate runs/demo --trials 200")
     p.add_argument("dir", type=Path)
-    p.add_argument("--trials", type=_positive, default=100, help="fresh evaluations (default 100)")
+    p.add_argument("--trials", type=_positive, default=100,
+                   help="fresh trials per target, or evaluations for other tasks (default 100)")
     p.add_argument("--seed", type=_nonnegative, default=None, help="seed of the fresh conditions")
+
+    p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
+                       epilog="example: dnnevo plot runs/demo")
+    p.add_argument("dir", type=Path)
+    p.add_argument("--seed", type=_nonnegative, default=0, help="seed of the trials shown")
     return parser
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
     config = presets.get(args.preset, quick=args.quick, overrides=args.set)
     out = args.out or Path("runs") / f"{args.preset}{'-quick' if args.quick else ''}-seed{args.seed}"
-    seeds = [dnnevo.Network.load(RunDir(r).best) for r in args.seed_from]
+    seeds = _seed_networks(args.seed_from, config.size)
     result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,
                            seeds=seeds, force=args.force)
     return _report(result)
+
+
+def _seed_networks(runs: list[Path], size: int) -> list[dnnevo.Network]:
+    """The champions of ``runs``; when their sizes add up to ``size`` they are composed in order
+    (the first run's output neuron stays the output), as in the paper's incremental route."""
+    nets = [dnnevo.Network.load(RunDir(r).best) for r in runs]
+    if len(nets) > 1 and sum(n.size for n in nets) == size:
+        composite = nets[0]
+        for other in nets[1:]:
+            composite = dnnevo.compose(composite, other)
+        return [composite]
+    return nets
 
 
 def _report(result: dnnevo.EvolutionResult) -> int:
@@ -179,7 +199,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         result = dnnevo.evolve(config.task, config, seed=seed, out=args.out / f"seed-{seed}",
                                threads=args.threads, force=args.force)
         rows.append({"seed": seed, "best_fitness": result.best_fitness,
-                     "best_generation": result.best_generation, "first_success": "",
+                     "best_generation": result.best_generation,
+                     "first_success": "" if result.first_success is None else result.first_success,
                      "wall_s": round(time.perf_counter() - t0, 2)})
         if result.interrupted:
             break
@@ -191,7 +212,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     print(f"{'seed':>5} {'best':>8} {'at gen':>7} {'success':>8} {'wall s':>8}")
     for r in rows:
         print(f"{r['seed']:>5} {r['best_fitness']:>8.4f} {r['best_generation']:>7} "
-              f"{r['first_success'] or '-':>8} {r['wall_s']:>8.1f}")
+              f"{'-' if r['first_success'] == '' else r['first_success']:>8} {r['wall_s']:>8.1f}")
     print(f"wrote {args.out / 'summary.csv'}")
     return 0
 
@@ -201,6 +222,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
     champion = dnnevo.Network.load(run.best)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
+    if config.task == "sequence":
+        return _evaluate_sequence(args, config, champion, seed)
     fitness = np.array([
         dnnevo.evaluate(config.task, [champion], generation=k, seed=seed, config=config)[0]
         for k in range(args.trials)
@@ -210,6 +233,80 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _evaluate_sequence(
+    args: argparse.Namespace, config: EvolutionConfig, champion: dnnevo.Network, seed: int
+) -> int:
+    from dnnevo import sequence
+
+    report = sequence.assess(config, champion, args.trials, seed)
+    print(f"{args.dir}: champion on {args.trials} fresh trials per target (seed {seed}).")
+    print("A trial is correct when every trigger from index 2 x len(target) on is; a target is "
+          "learnt when >= 90% of trials are correct.")
+    print(f"{'target':>8} {'mean P':>8} {'correct':>8}  verdict")
+    for t in report["targets"]:
+        verdict = "learnt" if t["succeeded"] else "NOT learnt"
+        print(f"{t['target'] + '*':>8} {t['mean_performance']:>8.3f} "
+              f"{t['success_fraction']:>8.1%}  {verdict}")
+    print(f"overall: {'SUCCESS' if report['success'] else 'failure'}")
+    targets = list(config.task_params.get("targets", ["0", "1"]))
+    if len(targets) >= 2:
+        timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
+        _, _, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
+        after = "never settled" if needed is None else f"settled after {needed} trigger(s)"
+        print(f"switch test ({targets[-1]}* for 8 triggers, then {targets[0]}* without reset): "
+              f"{after}")
+    return 0 if report["success"] else 1
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    import matplotlib.pyplot as plt
+
+    from dnnevo.plot import plot_fitness
+
+    run = RunDir(args.dir)
+    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
+    history = run.read_log()
+    arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
+    written = []
+    ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
+    ax.figure.savefig(run.path / "fitness.png", dpi=120)
+    plt.close(ax.figure)
+    written.append("fitness.png")
+    if config.task == "sequence":
+        written += _plot_sequence(run, config, args.seed)
+    print(f"wrote {', '.join(str(run.path / w) for w in written)}")
+    return 0
+
+
+def _plot_sequence(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
+    import matplotlib.pyplot as plt
+
+    from dnnevo import sequence
+    from dnnevo.plot import plot_sequence_trial
+
+    champion = dnnevo.Network.load(run.best)
+    targets = list(config.task_params.get("targets", ["0", "1"]))
+    fig, axes = plt.subplots(len(targets), 1, figsize=(9, 2.6 * len(targets)),
+                             layout="constrained", squeeze=False)
+    for k, (target, ax) in enumerate(zip(targets, axes[:, 0], strict=True)):
+        record = sequence.run_trial(config, champion, target, sequence.timings(config, seed, 0, k))
+        plot_sequence_trial(record, ax=ax, title=f"{target}* positive trial")
+    fig.savefig(run.path / "fig4-trials.png", dpi=120)
+    plt.close(fig)
+    written = ["fig4-trials.png"]
+    if len(targets) >= 2:
+        timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
+        a, b, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
+        fig, ax = plt.subplots(figsize=(11, 3), layout="constrained")
+        plot_sequence_trial(a, ax=ax, follow=b, title=(
+            f"{targets[-1]}* for 8 triggers, then {targets[0]}* without reset "
+            f"({'settled after ' + str(needed) + ' trigger(s)' if needed is not None else 'never settled'})"))
+        fig.savefig(run.path / "fig5-switch.png", dpi=120)
+        plt.close(fig)
+        written.append("fig5-switch.png")
+    return written
+
+
 COMMANDS = {
     "run": _cmd_run,
     "resume": _cmd_resume,
@@ -217,6 +314,7 @@ COMMANDS = {
     "presets": _cmd_presets,
     "sweep": _cmd_sweep,
     "evaluate": _cmd_evaluate,
+    "plot": _cmd_plot,
 }
 
 

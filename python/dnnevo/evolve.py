@@ -35,6 +35,8 @@ Callback = Callable[[dict[str, float], GeneticAlgorithm], Any]
 
 #: Seconds between two checkpoints (one is also written at the end and on interruption).
 CHECKPOINT_SECONDS = 10.0
+#: Mixed into the run's seed for the fresh conditions of the champion's success checks.
+SUCCESS_SEED_SALT = 0x5EED_C0DE
 
 
 @dataclass(frozen=True)
@@ -46,11 +48,18 @@ class EvolutionResult:
     best_fitness: float
     best_generation: int
     history: dict[str, npt.NDArray[np.float64]]
-    """Per-generation arrays: generation, best, mean, std, min, evals_per_s, elapsed_s."""
+    """Per-generation arrays: generation, best, mean, std, min, champion_success, evals_per_s,
+    elapsed_s."""
     config: EvolutionConfig
     seed: int
     run_dir: Path | None
     interrupted: bool = False
+
+    @property
+    def first_success(self) -> int | None:
+        """The first generation whose champion met the task's success criterion, if any."""
+        hits = np.flatnonzero(self.history.get("champion_success", np.array([])) == 1.0)
+        return int(self.history["generation"][hits[0]]) if len(hits) else None
 
 
 def evaluate(
@@ -189,6 +198,7 @@ def _loop(
     t_start = time.perf_counter() - (history[-1]["elapsed_s"] if history else 0.0)
     last_checkpoint = time.perf_counter()
     best_seen = ga.best_fitness
+    success = history[-1]["champion_success"] if history else float("nan")
     interrupted = False
 
     def save_state() -> None:
@@ -212,21 +222,24 @@ def _loop(
                     assert task_json is not None
                     stats, _ = ga._evo.step(task, task_json, threads)
                 seconds = time.perf_counter() - t0
+                if ga.best_fitness != best_seen:
+                    best_seen = ga.best_fitness
+                    success = _champion_success(ga, task_json)
+                    if run is not None:
+                        _write_best(run, ga)
                 row = {
                     "generation": float(stats["generation"]),
                     "best": stats["best"],
                     "mean": stats["mean"],
                     "std": stats["std"],
                     "min": stats["min"],
+                    "champion_success": success,
                     "evals_per_s": config.population / seconds if seconds > 0 else 0.0,
                     "elapsed_s": time.perf_counter() - t_start,
                 }
                 history.append(row)
                 if run is not None:
                     run.write_log(history)
-                    if ga.best_fitness is not None and ga.best_fitness != best_seen:
-                        best_seen = ga.best_fitness
-                        _write_best(run, ga)
                     if time.perf_counter() - last_checkpoint >= CHECKPOINT_SECONDS:
                         save_state()
                         last_checkpoint = time.perf_counter()
@@ -252,6 +265,16 @@ def _loop(
         if bar is not None:
             bar.close()
     return _result(ga, history, run, interrupted)
+
+
+def _champion_success(ga: GeneticAlgorithm, task_json: str | None) -> float:
+    """1.0 or 0.0 when the built-in task has a success criterion, else NaN."""
+    champ = ga._evo.champion()
+    if task_json is None or champ is None:
+        return float("nan")
+    seed = (ga.seed ^ SUCCESS_SEED_SALT) & 0xFFFF_FFFF_FFFF_FFFF
+    verdict = _core.task_success(ga.config.task, task_json, champ[0], seed)
+    return float("nan") if verdict is None else float(verdict)
 
 
 def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:

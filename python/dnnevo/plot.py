@@ -14,7 +14,9 @@ import numpy.typing as npt
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["plot_fitness"]
+    from dnnevo.sequence import TrialRecord
+
+__all__ = ["plot_fitness", "plot_sequence_trial"]
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -45,4 +47,38 @@ def plot_fitness(
     ax.legend(loc="lower right")
     if title:
         ax.set_title(title)
+    return ax
+
+
+def plot_sequence_trial(
+    record: TrialRecord,
+    ax: Axes | None = None,
+    *,
+    follow: TrialRecord | None = None,
+    title: str | None = None,
+) -> Axes:
+    """The paper's Fig. 4/5: trigger and reinforcement inputs and the output neuron over time,
+    with each trigger's expected bit. ``follow`` appends a second trial run without a reset."""
+    ax = _axes(ax)
+    records = [record] if follow is None else [record, follow]
+    trigger = np.concatenate([r.trigger for r in records])
+    reinforcement = np.concatenate([r.reinforcement for r in records])
+    output = np.concatenate([r.output for r in records])
+    t = np.arange(len(output))
+    ax.fill_between(t, 0, trigger, step="pre", color="0.85", label="trigger")
+    ax.plot(t, reinforcement, drawstyle="steps-pre", color="tab:green", label="reinforcement")
+    ax.plot(t, output, color="tab:red", label="output f(v0)")
+    ax.axhline(0.5, color="0.5", lw=0.6, ls=":")
+    starts = np.flatnonzero(np.diff(np.concatenate([[0.0], trigger])) > 0)
+    bits = np.concatenate([r.targets for r in records])
+    for s, bit in zip(starts, bits, strict=False):
+        ax.text(s + 5, 1.05, str(bit), ha="center", fontsize=8)
+    if follow is not None:
+        ax.axvline(len(record.output), color="k", lw=0.8, ls="--")
+    ax.set_ylim(-0.05, 1.15)
+    ax.set_xlim(0, len(t))
+    ax.set_xlabel("time step")
+    ax.legend(loc="center right", fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=10)
     return ax

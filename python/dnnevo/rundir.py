@@ -3,7 +3,9 @@
 A run folder holds:
 
 - ``config.toml``: the complete, resolved config, with the seed and the dnnevo version;
-- ``log.csv``: one row per generation (best, mean, std, min fitness, evaluations per second);
+- ``log.csv``: one row per generation: best, mean, std and min fitness; whether the champion so
+  far meets the task's success criterion (1 or 0, ``nan`` when the task has none); evaluations
+  per second and elapsed seconds;
 - ``best.json``: the champion in the ``dnnevo-network`` format, with meta;
 - ``checkpoint.json``: the GA state and the history, enough to continue bit for bit.
 """
@@ -22,7 +24,16 @@ from dnnevo.errors import DnnevoError
 
 __all__ = ["LOG_COLUMNS", "RunDir", "write_atomic"]
 
-LOG_COLUMNS = ("generation", "best", "mean", "std", "min", "evals_per_s", "elapsed_s")
+LOG_COLUMNS = (
+    "generation",
+    "best",
+    "mean",
+    "std",
+    "min",
+    "champion_success",
+    "evals_per_s",
+    "elapsed_s",
+)
 CHECKPOINT_FORMAT = "dnnevo-checkpoint"
 CHECKPOINT_VERSION = 1
 

@@ -35,6 +35,13 @@ pub trait Task: Send + Sync {
         seed: u64,
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<f64>>;
+
+    /// Whether `net` meets the task's success criterion on fresh conditions drawn from `seed`;
+    /// `None` (the default) when the task has no criterion.
+    fn succeeds(&self, net: &Network, seed: u64) -> Result<Option<bool>> {
+        let _ = (net, seed);
+        Ok(None)
+    }
 }
 
 /// Summary statistics of one generation's fitness.

@@ -247,7 +247,7 @@ impl<const L: usize> Lanes<L> {
             for k in 0..m {
                 let s = &self.sensor_weights[i * m + k];
                 for l in 0..L {
-                    acc[l] += s[l] * inputs[k][l];
+                    acc[l] = s[l].mul_add(inputs[k][l], acc[l]);
                 }
             }
             self.scratch.ext[i] = acc;
@@ -273,7 +273,7 @@ impl<const L: usize> Lanes<L> {
         derivative(&net, state, d, &mut s.out, &s.ext);
         for (v, (h, d)) in state.iter_mut().zip(s.h.iter().zip(d.iter())) {
             for l in 0..L {
-                v[l] += h[l] * d[l];
+                v[l] = h[l].mul_add(d[l], v[l]);
             }
         }
     }
@@ -299,7 +299,7 @@ impl<const L: usize> Lanes<L> {
         for i in 0..state.len() {
             for l in 0..L {
                 let sum = k1[i][l] + 2.0 * k2[i][l] + 2.0 * k3[i][l] + k4[i][l];
-                state[i][l] += s.h6[i][l] * sum;
+                state[i][l] = s.h6[i][l].mul_add(sum, state[i][l]);
             }
         }
     }
@@ -373,7 +373,7 @@ fn derivative<const L: usize>(
             for (r, a) in acc.iter_mut().enumerate() {
                 let w = &net.weights[(i + r) * n + j];
                 for l in 0..L {
-                    a[l] += w[l] * o[l];
+                    a[l] = w[l].mul_add(o[l], a[l]);
                 }
             }
         }
@@ -389,7 +389,7 @@ fn derivative<const L: usize>(
         let w = &net.weights[i * n..(i + 1) * n];
         for j in 0..n {
             for l in 0..L {
-                acc[l] += w[j][l] * out[j][l];
+                acc[l] = w[j][l].mul_add(out[j][l], acc[l]);
             }
         }
         for l in 0..L {
@@ -406,7 +406,7 @@ const ROWS: usize = 4;
 fn offset<const L: usize>(probe: &mut [[f64; L]], v: &[[f64; L]], h: &[[f64; L]], k: &[[f64; L]]) {
     for i in 0..v.len() {
         for l in 0..L {
-            probe[i][l] = v[i][l] + h[i][l] * k[i][l];
+            probe[i][l] = h[i][l].mul_add(k[i][l], v[i][l]);
         }
     }
 }

@@ -257,6 +257,21 @@ pub fn task_layout(task: &str, params: &str) -> PyResult<(usize, usize)> {
     Ok((layout.size, layout.n_inputs))
 }
 
+/// Whether `net` meets the built-in task's success criterion on fresh conditions from `seed`
+/// (None when the task has none).
+#[pyfunction]
+pub fn task_success(
+    py: Python<'_>,
+    task: &str,
+    params: &str,
+    net: &PyNetwork,
+    seed: u64,
+) -> PyResult<Option<bool>> {
+    let task = build_task(task, params)?;
+    let net = &net.inner;
+    py.detach(|| task.succeeds(net, seed)).py_err()
+}
+
 /// The names of the built-in tasks.
 #[pyfunction]
 pub fn task_names() -> Vec<&'static str> {

@@ -8,6 +8,7 @@ mod detach;
 mod errors;
 mod evolution;
 mod network;
+mod sequence;
 
 use pyo3::prelude::*;
 
@@ -15,9 +16,13 @@ use pyo3::prelude::*;
 #[pymodule]
 mod _core {
     #[pymodule_export]
-    use super::evolution::{decode, encode, evaluate, task_layout, task_names, PyEvolution};
+    use super::evolution::{
+        decode, encode, evaluate, task_layout, task_names, task_success, PyEvolution,
+    };
     #[pymodule_export]
     use super::network::{compose, run_population, PyNetwork, PyTrace};
+    #[pymodule_export]
+    use super::sequence::{sequence_assess, sequence_timings, sequence_trial};
 
     use pyo3::prelude::*;
 

@@ -73,6 +73,10 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 /// The fraction of trials a network must get right, after the warm-up, to have learnt a target.
 pub const SUCCESS_FRACTION: f64 = 0.9;
 
+/// Trials per target when a run checks whether its champion has succeeded yet (`dnnevo sweep`'s
+/// "first success" generation). `dnnevo evaluate` uses as many as asked.
+pub const SUCCESS_TRIALS: usize = 20;
+
 /// The base of the performance score.
 ///
 /// In JSON and TOML it is a number in [0, 1) or the string `"generation-mean"`.
@@ -887,6 +891,11 @@ impl Task for SequenceTask {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<f64>> {
         Ok(self.scores(networks, generation, seed, cancel)?.fitness)
+    }
+
+    /// [`SequenceTask::assess`] with [`SUCCESS_TRIALS`] trials per target.
+    fn succeeds(&self, net: &Network, seed: u64) -> Result<Option<bool>> {
+        Ok(Some(self.assess(net, SUCCESS_TRIALS, seed)?.success))
     }
 }
 

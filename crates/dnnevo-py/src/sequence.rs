@@ -1,0 +1,66 @@
+//! The sequence-learning task's detailed API for `dnnevo.sequence`: trial timings, one recorded
+//! trial, and the success assessment. Results cross as JSON, decoded by the Python wrapper.
+
+use pyo3::prelude::*;
+use tasks::sequence::SequenceTask;
+
+use crate::errors::{ConfigError, IntoPy};
+use crate::network::PyNetwork;
+
+fn task(params: &str) -> PyResult<SequenceTask> {
+    let value: serde_json::Value = serde_json::from_str(params)
+        .map_err(|e| ConfigError::new_err(format!("task parameters: {e}")))?;
+    SequenceTask::from_params(&value).py_err()
+}
+
+fn to_json<T: serde::Serialize>(value: &T) -> String {
+    serde_json::to_string(value).expect("task records always serialise")
+}
+
+/// The (delay, gap) of every trigger of a trial, as evolution drew them.
+#[pyfunction]
+pub fn sequence_timings(
+    params: &str,
+    seed: u64,
+    generation: u64,
+    trial: usize,
+) -> PyResult<Vec<(usize, usize)>> {
+    Ok(task(params)?.timings(seed, generation, trial))
+}
+
+/// One trial of `pattern` (e.g. "01") with the given timings, recorded step by step, as JSON.
+/// With `reset` false the trial continues from the network's state.
+#[pyfunction]
+#[pyo3(signature = (params, net, pattern, timing, reset=true))]
+pub fn sequence_trial(
+    py: Python<'_>,
+    params: &str,
+    net: &PyNetwork,
+    pattern: &str,
+    timing: Vec<(usize, usize)>,
+    reset: bool,
+) -> PyResult<String> {
+    let task = task(params)?;
+    let net = &net.inner;
+    let record = py
+        .detach(|| task.run_pattern(net, pattern, &timing, reset))
+        .py_err()?;
+    Ok(to_json(&record))
+}
+
+/// Assesses a network on fresh timings, `trials_per_target` trials per target, as JSON.
+#[pyfunction]
+pub fn sequence_assess(
+    py: Python<'_>,
+    params: &str,
+    net: &PyNetwork,
+    trials_per_target: usize,
+    seed: u64,
+) -> PyResult<String> {
+    let task = task(params)?;
+    let net = &net.inner;
+    let report = py
+        .detach(|| task.assess(net, trials_per_target, seed))
+        .py_err()?;
+    Ok(to_json(&report))
+}

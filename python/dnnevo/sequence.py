@@ -1,0 +1,114 @@
+"""Sequence learning (paper §5): trial timings, recorded trials, the success assessment and the
+"switch" test, for a network and an :class:`EvolutionConfig` of the ``sequence`` task.
+
+Success rule (from ``crates/tasks/src/sequence.rs``): on fresh random timings, a network learns a
+target when, in at least 90% of trials, every trigger from index ``2 * len(target)`` on is
+correct (the mean output over the trigger window is on the target bit's side of 0.5). It
+succeeds on B when it learns every target in B.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from dnnevo import _core
+from dnnevo.config import EvolutionConfig
+
+__all__ = ["TrialRecord", "assess", "run_trial", "switch_trial", "timings"]
+
+
+@dataclass(frozen=True)
+class TrialRecord:
+    """One trial, time step by time step (arrays of length T, ``outputs`` is (T, N))."""
+
+    target: str
+    trigger: npt.NDArray[np.float64]
+    reinforcement: npt.NDArray[np.float64]
+    output: npt.NDArray[np.float64]
+    outputs: npt.NDArray[np.float64]
+    targets: npt.NDArray[np.int64]
+    """The expected bit of each trigger."""
+    r: npt.NDArray[np.float64]
+    """The reinforcement earned by each trigger."""
+    mean_output: npt.NDArray[np.float64]
+    trigger_correct: npt.NDArray[np.bool_]
+    final_state: npt.NDArray[np.float64]
+
+
+def _params(config: EvolutionConfig) -> str:
+    if config.task != "sequence":
+        raise ValueError(f"config.task is {config.task!r}; expected 'sequence'")
+    return json.dumps(config.task_json())
+
+
+def timings(config: EvolutionConfig, seed: int, generation: int, trial: int) -> list[tuple[int, int]]:
+    """The (delay, gap) of each trigger of ``trial`` in ``generation``, as evolution drew them."""
+    return _core.sequence_timings(_params(config), seed, generation, trial)
+
+
+def run_trial(
+    config: EvolutionConfig,
+    net: _core.Network,
+    pattern: str,
+    timing: list[tuple[int, int]],
+    *,
+    reset: bool = True,
+) -> TrialRecord:
+    """Runs one trial of ``pattern`` (e.g. ``"01"``); with ``reset=False`` it continues from
+    ``net.state``."""
+    d: dict[str, Any] = json.loads(
+        _core.sequence_trial(_params(config), net, pattern, list(timing), reset)
+    )
+    return TrialRecord(
+        target=d["target"],
+        trigger=np.array(d["trigger"]),
+        reinforcement=np.array(d["reinforcement"]),
+        output=np.array(d["output"]),
+        outputs=np.array(d["outputs"]),
+        targets=np.array(d["targets"], dtype=np.int64),
+        r=np.array(d["r"]),
+        mean_output=np.array(d["mean_output"]),
+        trigger_correct=np.array(d["trigger_correct"], dtype=bool),
+        final_state=np.array(d["final_state"]),
+    )
+
+
+def assess(
+    config: EvolutionConfig, net: _core.Network, trials_per_target: int, seed: int
+) -> dict[str, Any]:
+    """Mean performance and success fraction per target on fresh timings, and the verdict."""
+    return json.loads(_core.sequence_assess(_params(config), net, trials_per_target, seed))
+
+
+def switch_trial(
+    config: EvolutionConfig,
+    net: _core.Network,
+    first: str,
+    second: str,
+    timing: list[tuple[int, int]],
+    *,
+    switch_after: int = 8,
+) -> tuple[TrialRecord, TrialRecord, int | None]:
+    """The paper's Fig. 5 test: ``first`` for ``switch_after`` triggers, then ``second`` without
+    a reset. Returns both records and how many triggers after the switch the network needed before
+    every later trigger was correct (None if it never settled)."""
+    a = run_trial(config, net, first, timing[:switch_after])
+    cont = net.copy()
+    cont.reset(a.final_state)
+    b = run_trial(config, cont, _rotate(second, switch_after), timing[switch_after:], reset=False)
+    correct = b.trigger_correct
+    for k in range(len(correct)):
+        if correct[k:].all():
+            return a, b, k
+    return a, b, None
+
+
+def _rotate(pattern: str, shift: int) -> str:
+    """``pattern`` continued from trigger ``shift``, so a switch keeps the sequence's phase."""
+    s = shift % len(pattern)
+    return pattern[s:] + pattern[:s]

@@ -162,8 +162,15 @@ def test_bad_documents_raise_format_error(mutate, fragment: str) -> None:  # noq
 def test_non_finite_in_dict_is_a_format_error() -> None:
     d = make().to_dict()
     d["theta"][0] = float("nan")
-    with pytest.raises(FormatError):
+    with pytest.raises(FormatError, match=r"theta\[0\] is NaN"):
         dnnevo.Network.from_dict(d)
+    d = make().to_dict()
+    d["meta"] = {"labels": [object()]}
+    with pytest.raises(FormatError, match=r"meta.labels\[0\] is a object"):
+        dnnevo.Network.from_dict(d)
+    # NumPy arrays and scalars are accepted where lists and floats are.
+    d = {k: np.asarray(v) if isinstance(v, list) else v for k, v in make().to_dict().items()}
+    assert dnnevo.Network.from_dict(d) == make()
 
 
 def test_corrupt_and_truncated_files(tmp_path: Path) -> None:

@@ -35,6 +35,8 @@ Callback = Callable[[dict[str, float], GeneticAlgorithm], Any]
 
 #: Seconds between two checkpoints (one is also written at the end and on interruption).
 CHECKPOINT_SECONDS = 10.0
+#: Seconds between two rewrites of log.csv (it is also rewritten with every checkpoint).
+LOG_SECONDS = 1.0
 #: Mixed into the run's seed for the fresh conditions of the champion's success checks.
 SUCCESS_SEED_SALT = 0x5EED_C0DE
 
@@ -196,13 +198,14 @@ def _loop(
     bar = Progress(config.generations, start=ga.generation) if progress else None
     task_json = None if callable(task) else json.dumps(config.task_json())
     t_start = time.perf_counter() - (history[-1]["elapsed_s"] if history else 0.0)
-    last_checkpoint = time.perf_counter()
+    last_checkpoint = last_log = time.perf_counter()
     best_seen = ga.best_fitness
     success = history[-1]["champion_success"] if history else float("nan")
     interrupted = False
 
     def save_state() -> None:
         if run is not None:
+            run.write_log(history)
             run.write_checkpoint(ga.state_dict(), history)
 
     try:
@@ -242,7 +245,7 @@ def _loop(
                     run.write_log(history)
                     if time.perf_counter() - last_checkpoint >= CHECKPOINT_SECONDS:
                         save_state()
-                        last_checkpoint = time.perf_counter()
+                        last_checkpoint = last_log = time.perf_counter()
                 if bar is not None:
                     bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"])
                 if callback is not None and callback(stats, ga) is True:

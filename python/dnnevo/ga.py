@@ -84,8 +84,7 @@ class GeneticAlgorithm:
     @property
     def best_fitness(self) -> float | None:
         """The fitness of :attr:`best`."""
-        champ = self._evo.champion()
-        return None if champ is None else champ[1]
+        return self._evo.champion_fitness
 
     def state_dict(self) -> dict[str, Any]:
         """Everything needed to continue bit for bit (JSON-serialisable)."""

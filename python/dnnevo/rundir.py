@@ -3,7 +3,8 @@
 A run folder holds:
 
 - ``config.toml``: the complete, resolved config, with the seed and the dnnevo version;
-- ``log.csv``: one row per generation: best, mean, std and min fitness; whether the champion so
+- ``log.csv``: one row per generation (rewritten at most every second, and at every
+  checkpoint, so it may trail the run by a second): best, mean, std and min fitness; whether the champion so
   far meets the task's success criterion (1 or 0, ``nan`` when the task has none); evaluations
   per second and elapsed seconds;
 - ``best.json``: the champion in the ``dnnevo-network`` format, with meta;
@@ -13,7 +14,6 @@ A run folder holds:
 from __future__ import annotations
 
 import csv
-import io
 import json
 import os
 import tempfile
@@ -79,12 +79,9 @@ class RunDir:
 
     def write_log(self, history: list[dict[str, float]]) -> None:
         """Rewrites ``log.csv`` from the whole history (atomic, so never torn)."""
-        buf = io.StringIO()
-        writer = csv.DictWriter(buf, fieldnames=LOG_COLUMNS, lineterminator="\n")
-        writer.writeheader()
-        for row in history:
-            writer.writerow({k: row[k] for k in LOG_COLUMNS})
-        write_atomic(self.log, buf.getvalue())
+        lines = [",".join(LOG_COLUMNS)]
+        lines += [",".join(repr(float(row[k])) for k in LOG_COLUMNS) for row in history]
+        write_atomic(self.log, "\n".join(lines) + "\n")
 
     def write_checkpoint(self, state: dict[str, Any], history: list[dict[str, float]]) -> None:
         """Writes the GA state and the history."""

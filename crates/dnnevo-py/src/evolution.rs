@@ -182,6 +182,12 @@ impl PyEvolution {
         Ok((stats_dict(py, &stats)?, to_numpy(py, fitness, &[n])?))
     }
 
+    /// The fitness of the best individual so far, or None.
+    #[getter]
+    fn champion_fitness(&self) -> Option<f64> {
+        self.inner.champion.as_ref().map(|c| c.fitness)
+    }
+
     /// The best individual so far as (network, fitness, generation), or None.
     fn champion(&self) -> PyResult<Option<(PyNetwork, f64, u64)>> {
         let Some(c) = &self.inner.champion else {

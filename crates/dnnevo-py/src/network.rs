@@ -105,16 +105,80 @@ fn json_module(py: Python<'_>) -> PyResult<Bound<'_, PyModule>> {
     py.import("json")
 }
 
-/// Converts a Python dict (JSON-compatible) to a JSON object.
+/// Converts a Python dict (JSON-compatible) to a JSON object; the error for a value JSON cannot
+/// hold (NaN, infinity, an object) names where it is, e.g. `theta[0]`.
 fn dict_to_map(d: &Bound<'_, PyAny>, what: &str) -> PyResult<Map<String, Value>> {
-    let text: String = json_module(d.py())?
-        .call_method1("dumps", (d,))
-        .map_err(|e| FormatError::new_err(format!("{what} is not JSON-serialisable: {e}")))?
-        .extract()?;
-    match serde_json::from_str::<Value>(&text) {
-        Ok(Value::Object(m)) => Ok(m),
-        Ok(_) => Err(FormatError::new_err(format!("{what} must be a dict"))),
-        Err(e) => Err(FormatError::new_err(format!("{what}: {e}"))),
+    match to_value(d, String::new()).map_err(|e| FormatError::new_err(format!("{what}: {e}")))? {
+        Value::Object(m) => Ok(m),
+        _ => Err(FormatError::new_err(format!("{what} must be a dict"))),
+    }
+}
+
+/// A Python value as JSON; the error says where the first unrepresentable value is.
+fn to_value(obj: &Bound<'_, PyAny>, path: String) -> Result<Value, String> {
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString, PyTuple};
+    let at = |p: &str| {
+        if p.is_empty() {
+            "the top level".to_string()
+        } else {
+            p.to_string()
+        }
+    };
+    if obj.is_none() {
+        Ok(Value::Null)
+    } else if let Ok(b) = obj.cast::<PyBool>() {
+        Ok(Value::Bool(b.is_true()))
+    } else if let Ok(i) = obj.cast::<PyInt>() {
+        i.extract::<i64>()
+            .map(Value::from)
+            .map_err(|_| format!("{} is an integer too large for JSON", at(&path)))
+    } else if let Ok(f) = obj.cast::<PyFloat>() {
+        let x = f.value();
+        serde_json::Number::from_f64(x)
+            .map(Value::Number)
+            .ok_or_else(|| format!("{} is {x}; every value must be finite", at(&path)))
+    } else if let Ok(s) = obj.cast::<PyString>() {
+        Ok(Value::String(s.to_string()))
+    } else if let Ok(d) = obj.cast::<PyDict>() {
+        let mut map = Map::new();
+        for (k, v) in d.iter() {
+            let key = k
+                .cast::<PyString>()
+                .map_err(|_| format!("a key of {} is not a string", at(&path)))?
+                .to_string();
+            let sub = if path.is_empty() {
+                key.clone()
+            } else {
+                format!("{path}.{key}")
+            };
+            map.insert(key, to_value(&v, sub)?);
+        }
+        Ok(Value::Object(map))
+    } else if obj.is_instance_of::<PyList>()
+        || obj.is_instance_of::<PyTuple>()
+        || obj.hasattr("tolist").unwrap_or(false)
+    {
+        let seq = if obj.hasattr("tolist").unwrap_or(false) {
+            obj.call_method0("tolist").map_err(|e| e.to_string())?
+        } else {
+            obj.clone()
+        };
+        if !(seq.is_instance_of::<PyList>() || seq.is_instance_of::<PyTuple>()) {
+            return to_value(&seq, path);
+        }
+        let mut items = Vec::new();
+        for (k, item) in seq.try_iter().map_err(|e| e.to_string())?.enumerate() {
+            let item = item.map_err(|e| e.to_string())?;
+            items.push(to_value(&item, format!("{path}[{k}]"))?);
+        }
+        Ok(Value::Array(items))
+    } else {
+        let kind = obj
+            .get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_default();
+        Err(format!("{} is a {kind}, which JSON cannot hold", at(&path)))
     }
 }
 

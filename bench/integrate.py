@@ -1,0 +1,247 @@
+"""Benchmark: dnnevo's population integrator against a batched NumPy einsum implementation.
+
+Workload (per network size N in {5, 10, 30}):
+  P = 1000 random networks (dnnevo.Network.random(N, 2, seed=k)), T = 1000 forward-Euler steps
+  (substeps=1, dt=0.1), M = 2 inputs shared by every network: input 0 is a square pulse train
+  (10 steps on, 10 off), input 1 a slower one (50 on, 50 off).
+
+dnnevo is timed with run_population(..., record=False) on all cores; NumPy with the same
+equations, batched over the population with einsum, on one core (NumPy's einsum does not thread).
+Each figure is the median of timed runs after one warm-up run (--repeats for dnnevo, at most 3 for
+NumPy), in network-steps per second (P x steps / seconds). NumPy may be timed over fewer steps
+(--numpy-steps) to save time: the figure is a per-step throughput. The final states of both codes
+after the full T steps are compared network by network (rtol = atol = 1e-9). A few random networks
+are chaotic and amplify rounding differences over 1000 steps; a mismatch is reported as such
+(not as a disagreement) when NumPy with a different summation order misses by as much.
+
+    python bench/integrate.py [--repeats 7] [--quick] [--numpy-steps 200]
+
+Exits with 1 if the two codes disagree; a ratio below its target is reported, not an error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+
+import numpy as np
+
+import dnnevo
+
+SIZES = (5, 10, 30)
+TARGETS = {5: 20.0, 10: 16.0, 30: 10.0}  # minimum dnnevo / numpy speed-up
+DT = 0.1
+N_INPUTS = 2
+
+
+def pulse_inputs(steps: int) -> np.ndarray:
+    """(steps, 2): a square pulse train (period 20) and a slower one (period 100), values 0/1."""
+    t = np.arange(steps)
+    fast = (t // 10) % 2 == 0
+    slow = (t // 50) % 2 == 0
+    return np.stack([fast, slow], axis=1).astype(np.float64)
+
+
+def numpy_final_states(params, inputs, dt=DT):
+    """Forward Euler over the rows of `inputs` (T, M), batched over P networks with einsum.
+
+    v += dt/tau * (-v + W f(v - theta) + S I), f(x) = 1 / (1 + exp(-x)). Returns v (P, N).
+    """
+    tau, theta, weights, sensor, v = params
+    v = v.copy()
+    h = dt / tau
+    with np.errstate(over="ignore"):  # exp overflow -> rate 0, the right limit
+        return _euler_loop(v, h, theta, weights, sensor, inputs)
+
+
+def _euler_loop(v, h, theta, weights, sensor, inputs):
+    for row in inputs:
+        rates = 1.0 / (1.0 + np.exp(theta - v))
+        drive = np.einsum("pij,pj->pi", weights, rates)
+        drive += np.einsum("pik,k->pi", sensor, row)
+        drive -= v
+        drive *= h
+        v += drive
+    return v
+
+
+def numpy_final_states_reordered(params, inputs, dt=DT):
+    """The same Euler steps, summing each neuron's inputs in reverse order.
+
+    Used only to tell rounding-sensitive networks apart: where two NumPy summation orders
+    already differ by more than the tolerance after T steps, the network amplifies rounding
+    (it is chaotic), and dnnevo cannot be expected to match either order more closely.
+    """
+    tau, theta, weights, sensor, v = params
+    v = v.copy()
+    h = dt / tau
+    w_rev = np.ascontiguousarray(weights[:, :, ::-1])
+    with np.errstate(over="ignore"):
+        for row in inputs:
+            rates = 1.0 / (1.0 + np.exp(theta - v))
+            drive = (w_rev * rates[:, None, ::-1]).sum(axis=2)
+            drive += np.einsum("pik,k->pi", sensor, row)
+            v = v + h * (drive - v)
+    return v
+
+
+def compare(ours, theirs, params, inputs, tol=1e-9):
+    """Per-network agreement of final states (P, N): (agreeing, rounding-sensitive, unexplained).
+
+    A network agrees if every state is within rtol = atol = `tol`. A network that does not is
+    rounding-sensitive if NumPy with another summation order misses by at least 1/100 of
+    dnnevo's miss (rounding differences, amplified the same way); otherwise its mismatch is
+    unexplained: a real disagreement.
+    """
+    def miss(a, b):  # per network, in units of the tolerance
+        return (np.abs(a - b) / (tol + tol * np.abs(b))).max(axis=1)
+
+    ours_miss = miss(ours, theirs)
+    bad = np.flatnonzero(ours_miss > 1.0)
+    if bad.size == 0:
+        return len(ours), bad, bad
+    subset = tuple(x[bad] for x in params)
+    self_miss = miss(numpy_final_states_reordered(subset, inputs), theirs[bad])
+    explained = self_miss * 100.0 >= ours_miss[bad]
+    return len(ours) - bad.size, bad[explained], bad[~explained]
+
+
+def median_time(fn, repeats: int):
+    """(median seconds of `repeats` timed calls after one warm-up call, the last result)."""
+    result = fn()  # warm-up
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), result
+
+
+def describe_machine() -> None:
+    print(f"python {platform.python_version()}, numpy {np.__version__}, "
+          f"dnnevo {getattr(dnnevo, '__version__', '?')}, {platform.machine()}")
+    try:
+        with open("/proc/cpuinfo") as f:
+            info = f.read()
+        model = next(line.split(":", 1)[1].strip() for line in info.splitlines()
+                     if line.startswith("model name"))
+        flags = set(next(line.split(":", 1)[1].split() for line in info.splitlines()
+                         if line.startswith("flags")))
+        vector = "avx512f" if "avx512f" in flags else "avx2" if "avx2" in flags else "no avx2"
+        print(f"cpu: {model} ({vector})")
+    except (OSError, StopIteration):
+        pass
+    try:
+        usable = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        usable = os.cpu_count()
+    print(f"threads: {usable} usable by this process ({os.cpu_count()} logical CPUs)")
+    for var in ("RAYON_NUM_THREADS", "OPENBLAS_CORETYPE", "OMP_NUM_THREADS"):
+        if var in os.environ:
+            print(f"{var}={os.environ[var]}")
+
+
+def bench_size(n: int, args) -> dict:
+    nets = [dnnevo.Network.random(n, N_INPUTS, seed=k) for k in range(args.population)]
+    inputs = pulse_inputs(args.steps)
+    p = len(nets)
+
+    def run_dnnevo():
+        return dnnevo.run_population(nets, inputs, dt=DT, substeps=1, method="euler",
+                                     record=False)
+
+    t_dnnevo, ours = median_time(run_dnnevo, args.repeats)
+
+    params = (
+        np.stack([net.tau for net in nets]),
+        np.stack([net.theta for net in nets]),
+        np.stack([net.weights for net in nets]),
+        np.stack([net.sensor_weights for net in nets]),
+        np.stack([net.state for net in nets]),
+    )
+    np_steps = min(args.numpy_steps, args.steps)
+    np_inputs = inputs[:np_steps]
+    t_numpy, theirs = median_time(lambda: numpy_final_states(params, np_inputs),
+                                  args.numpy_repeats)
+
+    # Agreement over the full workload.
+    ours = np.asarray(ours)
+    if np_steps < args.steps:
+        theirs = numpy_final_states(params, inputs)
+    n_close, sensitive, unexplained = compare(ours, theirs, params, inputs)
+    return dict(
+        n=n,
+        p=p,
+        dnnevo=p * args.steps / t_dnnevo,
+        numpy=p * np_steps / t_numpy,
+        n_close=n_close,
+        sensitive=sensitive,
+        unexplained=unexplained,
+        max_diff=float(np.max(np.abs(ours - theirs))),
+    )
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=int, default=7,
+                    help="timed dnnevo runs per size; the median is reported (default 7)")
+    ap.add_argument("--quick", action="store_true",
+                    help="a smoke run: fewer networks, steps and repeats (figures are rougher)")
+    ap.add_argument("--numpy-steps", type=int, default=None,
+                    help="steps of the timed NumPy runs (default: all T; fewer save time)")
+    args = ap.parse_args(argv)
+    if args.repeats < 1:
+        ap.error("--repeats must be >= 1")
+    args.population, args.steps = 1000, 1000
+    args.numpy_repeats = max(1, min(args.repeats, 3))
+    if args.quick:
+        args.population, args.steps = 200, 200
+        args.repeats, args.numpy_repeats = min(args.repeats, 3), 1
+    if args.numpy_steps is None:
+        args.numpy_steps = args.steps
+    if args.numpy_steps < 1:
+        ap.error("--numpy-steps must be >= 1")
+
+    describe_machine()
+    print(f"workload: P = {args.population} networks, T = {args.steps} Euler steps, dt = {DT}, "
+          f"M = {N_INPUTS} shared pulse-train inputs; median of {args.repeats} (dnnevo) / "
+          f"{args.numpy_repeats} (numpy, {min(args.numpy_steps, args.steps)} steps) runs"
+          f"{' [quick]' if args.quick else ''}")
+    print()
+    header = (f"{'N':>3}  {'dnnevo net-steps/s':>18}  {'numpy net-steps/s':>17}  "
+              f"{'ratio':>7}  {'target':>7}  {'met':>3}")
+    print(header)
+    print("-" * len(header))
+    start = time.perf_counter()
+    results = []
+    for n in SIZES:
+        r = bench_size(n, args)
+        results.append(r)
+        ratio = r["dnnevo"] / r["numpy"]
+        target = TARGETS[n]
+        print(f"{n:>3}  {r['dnnevo']:>18.4g}  {r['numpy']:>17.4g}  {ratio:>6.1f}x  "
+              f"{'>=' + format(target, 'g') + 'x':>7}  {'yes' if ratio >= target else 'NO':>3}",
+              flush=True)
+    print()
+    ok = True
+    for r in results:
+        line = (f"agreement, N = {r['n']}: {r['n_close']}/{r['p']} networks' final states agree "
+                f"within rtol 1e-9 (max |diff| over all {r['max_diff']:.1e})")
+        if len(r["sensitive"]):
+            line += (f"; {len(r['sensitive'])} rounding-sensitive (NumPy with another summation "
+                     f"order misses by a similar amount): {r['sensitive'].tolist()}")
+        if len(r["unexplained"]):
+            ok = False
+            line += f"; DISAGREE: networks {r['unexplained'].tolist()}"
+        print(line)
+    print("agreement: OK" if ok else "agreement: FAILED")
+    print(f"total benchmark time: {time.perf_counter() - start:.1f} s")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,178 @@
+"""Benchmark: one generation of the 1-bit sequence-learning experiment at the paper's size, dnnevo
+against a batched NumPy implementation of the same task.
+
+Workload (preset sequence-1bit, paper §5.2):
+  P = 1000 networks of N = 5 neurons (the GA's initial population, uniform over the ranges),
+  4 trials (2 per target of B = {0*, 1*}) of 10 triggers, trigger and reinforcement 10 time steps,
+  delay and gap uniform in [10, 40], 10 forward-Euler steps of dt = 0.1 per time step.
+
+Figures, in seconds per generation (median of timed runs after one warm-up, over generations
+0, 1, 2, ... so the timings vary as in a run):
+  dnnevo evaluate   dnnevo.evaluate("sequence", genomes, generation=g, seed=0, config=cfg), all cores
+                    (and with threads=1, for a per-core comparison)
+  dnnevo generation one whole generation of the GA on the Rust side (evaluate + breed), as
+                    dnnevo.evolve runs it (GeneticAlgorithm._evo.step)
+  numpy evaluate    tests/sequence_reference.py, batched over P with einsum, one core, with the
+                    same timings (dnnevo.sequence.timings); --numpy-repeats runs (default 1)
+The projection is 500 generations (the paper's run) at that rate, against the target of 60 s.
+The fitness values of dnnevo and NumPy are compared network by network (atol 1e-9).
+
+    python bench/sequence.py [--repeats 7] [--numpy-repeats 1] [--quick]
+
+Exits with 1 if the two codes disagree; a missed target is reported, not an error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import dnnevo
+import dnnevo.sequence
+
+GENERATIONS = 500  # the paper's 1-bit run
+TARGET_S = 60.0  # the whole run, wall time
+TOL = 1e-9
+
+
+def load_reference():
+    path = Path(__file__).resolve().parent.parent / "tests" / "sequence_reference.py"
+    spec = importlib.util.spec_from_file_location("dnnevo_bench_sequence_reference", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+ref = load_reference()
+
+
+def describe_machine() -> None:
+    print(f"python {platform.python_version()}, numpy {np.__version__}, "
+          f"dnnevo {getattr(dnnevo, '__version__', '?')}, {platform.machine()}")
+    print(f"threads: {threads()} usable by this process ({os.cpu_count()} logical CPUs)")
+    for var in ("RAYON_NUM_THREADS", "OMP_NUM_THREADS"):
+        if var in os.environ:
+            print(f"{var}={os.environ[var]}")
+
+
+def threads() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def timed(fn):
+    start = time.perf_counter()
+    result = fn()
+    return time.perf_counter() - start, result
+
+
+def median_time(fn, repeats: int):
+    """Median seconds of `repeats` timed calls `fn(i)` after a warm-up call `fn(0)`."""
+    fn(0)
+    return statistics.median(timed(lambda: fn(i))[0] for i in range(repeats))
+
+
+def numpy_fitness(cfg, params, generation: int, seed: int):
+    """The reference fitness of one generation, with the timings evolution draws."""
+    p = cfg.task_params
+    n_trials = len(p["targets"]) * p["trials_per_target"]
+    timings = [dnnevo.sequence.timings(cfg, seed, generation, t) for t in range(n_trials)]
+    f, _ = ref.fitness(params, p["targets"], timings, p["trials_per_target"],
+                       perf_base=p["perf_base"], dt=cfg.integrator.dt,
+                       substeps=cfg.integrator.substeps)
+    return f
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=int, default=7,
+                    help="timed dnnevo runs; the median is reported (default 7)")
+    ap.add_argument("--numpy-repeats", type=int, default=1,
+                    help="timed NumPy generations (default 1; about 1-2 s each)")
+    ap.add_argument("--quick", action="store_true", help="fewer repeats (figures are rougher)")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.repeats = min(args.repeats, 3)
+        args.numpy_repeats = 1
+    if args.repeats < 1 or args.numpy_repeats < 1:
+        ap.error("--repeats and --numpy-repeats must be >= 1")
+
+    cfg = dnnevo.presets.get("sequence-1bit")
+    seed = 0
+    ga = dnnevo.GeneticAlgorithm(cfg, seed=seed)
+    genomes = ga.ask().genomes
+    params = ref.decode_genomes(genomes, cfg.size, cfg.n_inputs)
+    task_json = json.dumps(cfg.task_json())
+
+    describe_machine()
+    print(f"workload: preset sequence-1bit, P = {cfg.population}, N = {cfg.size}, "
+          f"{len(cfg.task_params['targets']) * cfg.task_params['trials_per_target']} trials x 10 "
+          f"triggers, {cfg.integrator.substeps} Euler steps of dt = {cfg.integrator.dt} per time "
+          f"step; median of {args.repeats} (dnnevo) / {args.numpy_repeats} (numpy) runs"
+          f"{' [quick]' if args.quick else ''}")
+    print()
+    start = time.perf_counter()
+
+    def dnnevo_evaluate(g):
+        return dnnevo.evaluate("sequence", genomes, generation=g, seed=seed, config=cfg)
+
+    t_eval = median_time(dnnevo_evaluate, args.repeats)
+    t_eval1 = median_time(
+        lambda g: dnnevo.evaluate("sequence", genomes, generation=g, seed=seed, config=cfg,
+                                  threads=1), args.repeats)
+
+    def dnnevo_generation(_):
+        return ga._evo.step("sequence", task_json, None)
+
+    t_gen = median_time(dnnevo_generation, args.repeats)
+
+    numpy_times = []
+    agree = None
+    for g in range(args.numpy_repeats):
+        t, theirs = timed(lambda: numpy_fitness(cfg, params, g, seed))
+        numpy_times.append(t)
+        if g == 0:
+            ours = dnnevo_evaluate(0)
+            diff = np.abs(ours - theirs)
+            agree = (int(np.sum(diff <= TOL)), len(diff), float(diff.max()))
+    t_numpy = statistics.median(numpy_times)
+
+    rows = [("dnnevo evaluate", t_eval), ("dnnevo evaluate, 1 thread", t_eval1),
+            ("dnnevo generation (eval + GA)", t_gen),
+            ("numpy evaluate (1 core)", t_numpy)]
+    header = (f"{'code':<30}  {'s/generation':>12}  {'generations/s':>13}  "
+              f"{'500 gens':>10}  {'target':>7}  {'met':>3}")
+    print(header)
+    print("-" * len(header))
+    for name, t in rows:
+        total = t * GENERATIONS
+        print(f"{name:<30}  {t:>12.4f}  {1.0 / t:>13.2f}  {total:>9.1f}s  "
+              f"{'<=' + format(TARGET_S, 'g') + 's':>7}  {'yes' if total <= TARGET_S else 'NO':>3}")
+    print()
+    print(f"speed-up, dnnevo evaluate vs numpy: {t_numpy / t_eval:.1f}x "
+          f"(one core each: {t_numpy / t_eval1:.1f}x; dnnevo on {threads()} threads: "
+          f"{t_eval1 / t_eval:.2f}x its 1-thread speed)")
+    print(f"speed-up, dnnevo generation vs numpy evaluate alone: {t_numpy / t_gen:.1f}x")
+    print(f"GA share of a dnnevo generation: {max(0.0, t_gen - t_eval) / t_gen:.2%} "
+          f"(difference of two medians; noisy)")
+    n_ok, n, max_diff = agree
+    ok = n_ok == n
+    print(f"agreement, generation 0: {n_ok}/{n} fitness values within {TOL:g} "
+          f"(max |diff| {max_diff:.1e}): {'OK' if ok else 'FAILED'}")
+    print(f"total benchmark time: {time.perf_counter() - start:.1f} s")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -105,7 +106,9 @@ def test_run_folder_contents(tmp_path: Path) -> None:
     result = dnnevo.evolve(follow_square, SMALL, seed=2, out=out, progress=False)
     assert sorted(p.name for p in out.iterdir()) == [
         "best.json", "checkpoint.json", "config.toml", "log.csv"]
-    assert EvolutionConfig.from_toml((out / "config.toml").read_text()) == SMALL
+    saved = EvolutionConfig.from_toml((out / "config.toml").read_text())
+    assert saved.task == "python:test_evolve.follow_square"
+    assert dataclasses.replace(saved, task=SMALL.task) == SMALL
     assert "seed = 2" in (out / "config.toml").read_text()
     assert len((out / "log.csv").read_text().splitlines()) == 1 + SMALL.generations
     best = dnnevo.Network.load(out / "best.json")
@@ -124,6 +127,8 @@ def test_stopped_and_resumed_run_equals_uninterrupted(tmp_path: Path) -> None:
     part = dnnevo.evolve(follow_square, SMALL, seed=7, out=tmp_path / "part", progress=False,
                          callback=stop_at_3)
     assert len(part.history["best"]) == 3
+    with pytest.raises(dnnevo.DnnevoError, match="Python fitness function"):
+        dnnevo.resume(tmp_path / "part", progress=False)
     resumed = dnnevo.resume(tmp_path / "part", follow_square, progress=False)
     for key in ("generation", "best", "mean", "std", "min"):
         np.testing.assert_array_equal(full.history[key], resumed.history[key])

@@ -8,6 +8,7 @@ The loop itself is Python, one call into Rust per generation; all the work of a 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import signal
 import sys
@@ -23,7 +24,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError, FitnessError
+from dnnevo.errors import ConfigError, DnnevoError, FitnessError
 from dnnevo.ga import GeneticAlgorithm
 from dnnevo.progress import Progress
 from dnnevo.rundir import RunDir
@@ -33,6 +34,8 @@ __all__ = ["EvolutionResult", "evaluate", "evolve", "resume"]
 FitnessFn = Callable[[list[_core.Network]], npt.ArrayLike]
 Callback = Callable[[dict[str, float], GeneticAlgorithm], Any]
 
+#: Prefix of ``config.task`` for runs whose fitness is a Python callable (then named after it).
+PYTHON_TASK = "python:"
 #: Seconds between two checkpoints (one is also written at the end and on interruption).
 CHECKPOINT_SECONDS = 10.0
 #: Seconds between two rewrites of log.csv (it is also rewritten with every checkpoint).
@@ -125,7 +128,9 @@ def evolve(
     ``seeds`` are networks placed first in the initial population (e.g. from :func:`compose`).
     """
     if callable(task):
-        config = config or EvolutionConfig()
+        name = getattr(task, "__qualname__", type(task).__qualname__)
+        module = getattr(task, "__module__", None) or "?"
+        config = dataclasses.replace(config or EvolutionConfig(), task=f"{PYTHON_TASK}{module}.{name}")
     else:
         config = _task_config(task, config)
         _check_layout(config)
@@ -150,6 +155,11 @@ def resume(
     run = RunDir(run_dir)
     state, history = run.read_checkpoint()
     ga = GeneticAlgorithm.from_state_dict(state)
+    if task is None and ga.config.task.startswith(PYTHON_TASK):
+        raise DnnevoError(
+            f"{run.path} was evolved with a Python fitness function ({ga.config.task}); resume it "
+            "from Python: dnnevo.resume(dir, task=fitness)"
+        )
     fitness: str | FitnessFn = task if task is not None else ga.config.task
     return _loop(ga, fitness, history, run, progress=progress, callback=callback, threads=threads)
 

@@ -24,9 +24,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import importlib.util
-import os
-import platform
 import statistics
 import sys
 import tempfile
@@ -39,41 +36,13 @@ import dnnevo
 import dnnevo.sequence
 from dnnevo.evolve import CHECKPOINT_SECONDS
 from dnnevo.rundir import RunDir
+from _common import describe_machine, load_reference, median_time
 
 TARGET_SHARE = 0.01
 GENERATIONS = 500  # the paper's 1-bit run
 
 
-def load_reference():
-    path = Path(__file__).resolve().parent.parent / "tests" / "sequence_reference.py"
-    spec = importlib.util.spec_from_file_location("dnnevo_bench_sequence_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 ref = load_reference()
-
-
-def describe_machine() -> None:
-    print(f"python {platform.python_version()}, numpy {np.__version__}, "
-          f"dnnevo {getattr(dnnevo, '__version__', '?')}, {platform.machine()}")
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        usable = os.cpu_count()
-    print(f"threads: {usable} usable by this process ({os.cpu_count()} logical CPUs)")
-
-
-def median_time(fn, repeats: int) -> float:
-    """Median seconds of `repeats` timed calls `fn(i)` after a warm-up call."""
-    fn(0)
-    times = []
-    for i in range(repeats):
-        start = time.perf_counter()
-        fn(i)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 class NumpyGA:
@@ -129,12 +98,12 @@ class NumpyGA:
 def part_a(cfg, args):
     ga = dnnevo.GeneticAlgorithm(cfg, seed=0)
     genomes = ga.ask().genomes
-    t_eval = median_time(lambda g: dnnevo.evaluate("sequence", genomes, generation=g, seed=0,
-                                                   config=cfg), args.eval_repeats)
+    t_eval, _ = median_time(lambda g: dnnevo.evaluate("sequence", genomes, generation=g, seed=0,
+                                                      config=cfg), args.eval_repeats)
     fitness = np.random.default_rng(1).random(cfg.population)
-    t_tell = median_time(lambda _: ga._evo.tell(fitness), args.repeats)
+    t_tell, _ = median_time(lambda _: ga._evo.tell(fitness), args.repeats)
     npga = NumpyGA(cfg, genomes)
-    t_numpy = median_time(lambda _: npga.tell(fitness), args.repeats)
+    t_numpy, _ = median_time(lambda _: npga.tell(fitness), args.repeats)
 
     run_cfg = dataclasses.replace(cfg, generations=args.generations)
     with tempfile.TemporaryDirectory(dir=args.out_dir) as tmp:
@@ -145,8 +114,8 @@ def part_a(cfg, args):
         run = RunDir(Path(tmp) / "run")
         rows = [{k: float(v[i % args.generations]) for k, v in result.history.items()}
                 for i in range(GENERATIONS)]
-        t_log = median_time(lambda _: run.write_log(rows), 5)
-        t_ckpt = median_time(lambda _: run.write_checkpoint(ga.state_dict(), rows), 3)
+        t_log, _ = median_time(lambda _: run.write_log(rows), 5)
+        t_ckpt, _ = median_time(lambda _: run.write_checkpoint(ga.state_dict(), rows), 3)
     h = result.history
     per_gen = float(h["elapsed_s"][-1]) / args.generations  # the loop, without the run's setup
     step = cfg.population / h["evals_per_s"]  # seconds of each generation's Rust step

@@ -22,15 +22,13 @@ Exits with 1 if the two codes disagree; a ratio below its target is reported, no
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import statistics
 import sys
 import time
 
 import numpy as np
 
 import dnnevo
+from _common import describe_machine, median_time
 
 SIZES = (5, 10, 30)
 TARGETS = {5: 20.0, 10: 16.0, 30: 10.0}  # minimum dnnevo / numpy speed-up
@@ -110,47 +108,12 @@ def compare(ours, theirs, params, inputs, tol=1e-9):
     return len(ours) - bad.size, bad[explained], bad[~explained]
 
 
-def median_time(fn, repeats: int):
-    """(median seconds of `repeats` timed calls after one warm-up call, the last result)."""
-    result = fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times), result
-
-
-def describe_machine() -> None:
-    print(f"python {platform.python_version()}, numpy {np.__version__}, "
-          f"dnnevo {getattr(dnnevo, '__version__', '?')}, {platform.machine()}")
-    try:
-        with open("/proc/cpuinfo") as f:
-            info = f.read()
-        model = next(line.split(":", 1)[1].strip() for line in info.splitlines()
-                     if line.startswith("model name"))
-        flags = set(next(line.split(":", 1)[1].split() for line in info.splitlines()
-                         if line.startswith("flags")))
-        vector = "avx512f" if "avx512f" in flags else "avx2" if "avx2" in flags else "no avx2"
-        print(f"cpu: {model} ({vector})")
-    except (OSError, StopIteration):
-        pass
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        usable = os.cpu_count()
-    print(f"threads: {usable} usable by this process ({os.cpu_count()} logical CPUs)")
-    for var in ("RAYON_NUM_THREADS", "OPENBLAS_CORETYPE", "OMP_NUM_THREADS"):
-        if var in os.environ:
-            print(f"{var}={os.environ[var]}")
-
-
 def bench_size(n: int, args) -> dict:
     nets = [dnnevo.Network.random(n, N_INPUTS, seed=k) for k in range(args.population)]
     inputs = pulse_inputs(args.steps)
     p = len(nets)
 
-    def run_dnnevo():
+    def run_dnnevo(_):
         return dnnevo.run_population(nets, inputs, dt=DT, substeps=1, method="euler",
                                      record=False)
 
@@ -165,7 +128,7 @@ def bench_size(n: int, args) -> dict:
     )
     np_steps = min(args.numpy_steps, args.steps)
     np_inputs = inputs[:np_steps]
-    t_numpy, theirs = median_time(lambda: numpy_final_states(params, np_inputs),
+    t_numpy, theirs = median_time(lambda _: numpy_final_states(params, np_inputs),
                                   args.numpy_repeats)
 
     # Agreement over the full workload.

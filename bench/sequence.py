@@ -25,62 +25,23 @@ Exits with 1 if the two codes disagree; a missed target is reported, not an erro
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
-import os
-import platform
 import statistics
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
 import dnnevo
 import dnnevo.sequence
+from _common import describe_machine, load_reference, median_time, threads, timed
 
 GENERATIONS = 500  # the paper's 1-bit run
 TARGET_S = 60.0  # the whole run, wall time
 TOL = 1e-9
 
 
-def load_reference():
-    path = Path(__file__).resolve().parent.parent / "tests" / "sequence_reference.py"
-    spec = importlib.util.spec_from_file_location("dnnevo_bench_sequence_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 ref = load_reference()
-
-
-def describe_machine() -> None:
-    print(f"python {platform.python_version()}, numpy {np.__version__}, "
-          f"dnnevo {getattr(dnnevo, '__version__', '?')}, {platform.machine()}")
-    print(f"threads: {threads()} usable by this process ({os.cpu_count()} logical CPUs)")
-    for var in ("RAYON_NUM_THREADS", "OMP_NUM_THREADS"):
-        if var in os.environ:
-            print(f"{var}={os.environ[var]}")
-
-
-def threads() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
-def timed(fn):
-    start = time.perf_counter()
-    result = fn()
-    return time.perf_counter() - start, result
-
-
-def median_time(fn, repeats: int):
-    """Median seconds of `repeats` timed calls `fn(i)` after a warm-up call `fn(0)`."""
-    fn(0)
-    return statistics.median(timed(lambda: fn(i))[0] for i in range(repeats))
 
 
 def numpy_fitness(cfg, params, generation: int, seed: int):
@@ -127,15 +88,15 @@ def main(argv=None) -> int:
     def dnnevo_evaluate(g):
         return dnnevo.evaluate("sequence", genomes, generation=g, seed=seed, config=cfg)
 
-    t_eval = median_time(dnnevo_evaluate, args.repeats)
-    t_eval1 = median_time(
+    t_eval, _ = median_time(dnnevo_evaluate, args.repeats)
+    t_eval1, _ = median_time(
         lambda g: dnnevo.evaluate("sequence", genomes, generation=g, seed=seed, config=cfg,
                                   threads=1), args.repeats)
 
     def dnnevo_generation(_):
         return ga._evo.step("sequence", task_json, None)
 
-    t_gen = median_time(dnnevo_generation, args.repeats)
+    t_gen, _ = median_time(dnnevo_generation, args.repeats)
 
     numpy_times = []
     agree = None

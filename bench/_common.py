@@ -1,0 +1,76 @@
+"""Helpers shared by the benchmark scripts in bench/ (integrate.py, sequence.py, evolve.py).
+
+The scripts are run as `python bench/X.py`, so Python puts bench/ first on sys.path and they
+import this module as `_common`.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import platform
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+import dnnevo
+
+
+def load_reference():
+    """tests/sequence_reference.py (the batched NumPy reference of the sequence task), loaded
+    as a module by path (tests/ is not a package)."""
+    path = Path(__file__).resolve().parent.parent / "tests" / "sequence_reference.py"
+    spec = importlib.util.spec_from_file_location("dnnevo_bench_sequence_reference", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def threads() -> int:
+    """Number of CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def describe_machine() -> None:
+    """Print the versions, CPU model and vector extensions, usable threads and the thread-related
+    environment variables that are set."""
+    print(f"python {platform.python_version()}, numpy {np.__version__}, "
+          f"dnnevo {getattr(dnnevo, '__version__', '?')}, {platform.machine()}")
+    try:
+        with open("/proc/cpuinfo") as f:
+            info = f.read()
+        model = next(line.split(":", 1)[1].strip() for line in info.splitlines()
+                     if line.startswith("model name"))
+        flags = set(next(line.split(":", 1)[1].split() for line in info.splitlines()
+                         if line.startswith("flags")))
+        vector = "avx512f" if "avx512f" in flags else "avx2" if "avx2" in flags else "no avx2"
+        print(f"cpu: {model} ({vector})")
+    except (OSError, StopIteration):
+        pass
+    print(f"threads: {threads()} usable by this process ({os.cpu_count()} logical CPUs)")
+    for var in ("RAYON_NUM_THREADS", "OPENBLAS_CORETYPE", "OMP_NUM_THREADS"):
+        if var in os.environ:
+            print(f"{var}={os.environ[var]}")
+
+
+def timed(fn):
+    """(seconds of one call `fn()`, its result)."""
+    start = time.perf_counter()
+    result = fn()
+    return time.perf_counter() - start, result
+
+
+def median_time(fn, repeats: int):
+    """(median seconds of `repeats` timed calls `fn(i)`, i = 0 .. repeats-1, after a warm-up
+    call `fn(0)`; the last call's result)."""
+    result = fn(0)  # warm-up
+    times = []
+    for i in range(repeats):
+        t, result = timed(lambda: fn(i))
+        times.append(t)
+    return statistics.median(times), result

@@ -209,10 +209,11 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     writer.writeheader()
     writer.writerows(rows)
     write_atomic(args.out / "summary.csv", buf.getvalue())
-    print(f"{'seed':>5} {'best':>8} {'at gen':>7} {'success':>8} {'wall s':>8}")
+    print("first success: the first generation whose champion met the task's success rule")
+    print(f"{'seed':>5} {'best':>8} {'at gen':>7} {'first success':>14} {'wall s':>8}")
     for r in rows:
         print(f"{r['seed']:>5} {r['best_fitness']:>8.4f} {r['best_generation']:>7} "
-              f"{'-' if r['first_success'] == '' else r['first_success']:>8} {r['wall_s']:>8.1f}")
+              f"{'-' if r['first_success'] == '' else r['first_success']:>14} {r['wall_s']:>8.1f}")
     print(f"wrote {args.out / 'summary.csv'}")
     return 0
 

@@ -80,3 +80,13 @@ def test_non_empty_out_is_refused(tmp_path: Path) -> None:
 def test_debug_shows_traceback(tmp_path: Path) -> None:
     r = dnnevo("--debug", "run", "no-such-preset", cwd=tmp_path)
     assert r.returncode != 0 and "Traceback" in r.stderr
+
+
+def test_console_script_is_installed() -> None:
+    from importlib.metadata import entry_points
+
+    (script,) = [e for e in entry_points(group="console_scripts") if e.name == "dnnevo"]
+    assert script.value == "dnnevo.cli:main"
+    r = subprocess.run([str(Path(sys.executable).parent / "dnnevo"), "--version"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and r.stdout.startswith("dnnevo ")

@@ -177,21 +177,30 @@ def _check_layout(config: EvolutionConfig) -> None:
         )
 
 
-@contextlib.contextmanager
-def _sigterm_as_interrupt() -> Iterator[None]:
-    """Turns SIGTERM into KeyboardInterrupt while the loop runs (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
+class _StopRequest:
+    """Ctrl-C and SIGTERM ask the loop to stop after the generation in progress; a second
+    signal stops at once."""
 
-    def handler(signum: int, frame: Any) -> None:
-        raise KeyboardInterrupt
+    def __init__(self) -> None:
+        self.requested = False
 
-    old = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, old)
+    def __call__(self, signum: int, frame: Any) -> None:
+        if self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+
+    @contextlib.contextmanager
+    def installed(self) -> Iterator[_StopRequest]:
+        """Installs the handler for SIGINT and SIGTERM (main thread only)."""
+        if threading.current_thread() is not threading.main_thread():
+            yield self
+            return
+        old = {sig: signal.signal(sig, self) for sig in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            yield self
+        finally:
+            for sig, handler in old.items():
+                signal.signal(sig, handler)
 
 
 def _loop(
@@ -212,6 +221,7 @@ def _loop(
     best_seen = ga.best_fitness
     success = history[-1]["champion_success"] if history else float("nan")
     interrupted = False
+    saved = ""
 
     def save_state() -> None:
         if run is not None:
@@ -219,8 +229,8 @@ def _loop(
             run.write_checkpoint(ga.state_dict(), history)
 
     try:
-        with _sigterm_as_interrupt():
-            while ga.generation < config.generations:
+        with _StopRequest().installed() as stop:
+            while ga.generation < config.generations and not stop.requested:
                 t0 = time.perf_counter()
                 if callable(task):
                     networks = ga.ask().networks
@@ -240,7 +250,7 @@ def _loop(
                     success = _champion_success(ga, task_json)
                     if run is not None:
                         _write_best(run, ga)
-                row = {
+                history.append({
                     "generation": float(stats["generation"]),
                     "best": stats["best"],
                     "mean": stats["mean"],
@@ -249,34 +259,38 @@ def _loop(
                     "champion_success": success,
                     "evals_per_s": config.population / seconds if seconds > 0 else 0.0,
                     "elapsed_s": time.perf_counter() - t_start,
-                }
-                history.append(row)
-                if run is not None:
+                })
+                now = time.perf_counter()
+                if run is not None and now - last_checkpoint >= CHECKPOINT_SECONDS:
+                    save_state()
+                    last_checkpoint = last_log = now
+                elif run is not None and now - last_log >= LOG_SECONDS:
                     run.write_log(history)
-                    if time.perf_counter() - last_checkpoint >= CHECKPOINT_SECONDS:
-                        save_state()
-                        last_checkpoint = last_log = time.perf_counter()
+                    last_log = now
                 if bar is not None:
+                    row = history[-1]
                     bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"])
                 if callback is not None and callback(stats, ga) is True:
                     break
+            interrupted = stop.requested
             save_state()
+            saved = f"at generation {ga.generation}; checkpoint saved"
     except KeyboardInterrupt:
+        # A second signal, or an interrupt outside the loop's own handler: keep the checkpoint
+        # only if the history still matches the population.
         interrupted = True
-        save_state()
-        if bar is not None:
-            bar.close()
-            bar = None
+        if len(history) == ga.generation:
+            save_state()
+            saved = f"at generation {ga.generation}; checkpoint saved"
+        else:
+            saved = "mid-generation; the previous checkpoint is kept"
         if run is None:
             raise
-        print(
-            f"\ninterrupted at generation {ga.generation}; checkpoint saved. "
-            f"Resume with: dnnevo resume {run.path}",
-            file=sys.stderr,
-        )
     finally:
         if bar is not None:
             bar.close()
+    if interrupted and run is not None:
+        print(f"interrupted {saved}. Resume with: dnnevo resume {run.path}", file=sys.stderr)
     return _result(ga, history, run, interrupted)
 
 

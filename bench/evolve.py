@@ -34,7 +34,7 @@ import numpy as np
 
 import dnnevo
 import dnnevo.sequence
-from dnnevo.evolve import CHECKPOINT_SECONDS
+from dnnevo.evolve import CHECKPOINT_SECONDS, LOG_SECONDS
 from dnnevo.rundir import RunDir
 from _common import describe_machine, load_reference, median_time
 
@@ -199,7 +199,9 @@ def main(argv=None) -> int:
     row("  of which Python bookkeeping (from history)", a["bookkeeping"])
     row(f"  run setup + final checkpoint, / {args.generations} gens", a["setup"] / args.generations,
         False)
-    row(f"log.csv rewrite at generation {GENERATIONS}", a["log500"])
+    row(f"log.csv rewrite at generation {GENERATIONS} ({a['log500'] * 1e3:.1f} ms) "
+        f"every {LOG_SECONDS:g} s, per generation",
+        a["log500"] * a["per_gen"] / LOG_SECONDS)
     row(f"checkpoint ({a['ckpt'] * 1e3:.0f} ms) every {CHECKPOINT_SECONDS:g} s, per generation",
         a["ckpt"] * a["per_gen"] / CHECKPOINT_SECONDS)
     row(f"numpy GA step (median of {args.repeats})", a["numpy"], False)

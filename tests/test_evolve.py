@@ -72,6 +72,12 @@ def test_bad_fitness_is_refused(fitness: np.ndarray, error: type, fragment: str)
     assert ga.generation == 0
 
 
+@pytest.mark.parametrize("seed", [-1, 2**64, 1.5, "3", True])
+def test_bad_seed_is_a_config_error(seed: object) -> None:
+    with pytest.raises(ConfigError, match="seed is"):
+        dnnevo.GeneticAlgorithm(SMALL, seed=seed)  # type: ignore[arg-type]
+
+
 def test_seeding_puts_networks_first() -> None:
     seed_net = dnnevo.Network.random(2, 1, seed=9)
     ga = dnnevo.GeneticAlgorithm(SMALL, seed=0, seeds=[seed_net])

@@ -21,6 +21,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
+from dnnevo.errors import ConfigError
 
 __all__ = ["Ask", "GeneticAlgorithm"]
 
@@ -47,6 +48,8 @@ class GeneticAlgorithm:
         seeds: Sequence[_core.Network] | None = None,
     ) -> None:
         self.config = config or EvolutionConfig()
+        if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not 0 <= seed < 2**64:
+            raise ConfigError(f"seed is {seed!r}; it must be an integer in [0, 2**64)")
         self._evo = _core.Evolution(
             json.dumps(self.config.ga_json()),
             self.config.size,

@@ -18,6 +18,13 @@ __all__ = [
     "encode",
     "evaluate",
     "run_population",
+    "nav1d_assess",
+    "nav1d_chains",
+    "nav1d_exact",
+    "nav1d_fresh_chains",
+    "nav1d_record",
+    "nav1d_system_assess",
+    "nav1d_system_record",
     "sequence_assess",
     "sequence_timings",
     "sequence_trial",
@@ -177,3 +184,24 @@ def sequence_trial(
     reset: bool = True,
 ) -> str: ...
 def sequence_assess(params: str, net: Network, trials_per_target: int, seed: int) -> str: ...
+def nav1d_chains(params: str, seed: int, generation: int) -> str: ...
+def nav1d_fresh_chains(params: str, count: int, trials: int, seed: int) -> str: ...
+def nav1d_exact(params: str, environment: str, goal: str) -> str: ...
+def nav1d_record(params: str, net: Network, conditions: str, reset: bool = True) -> str: ...
+def nav1d_assess(params: str, net: Network, chains: int, seed: int) -> str: ...
+def nav1d_system_assess(
+    classifier: tuple[str, Network],
+    far: tuple[str, Network],
+    near: tuple[str, Network],
+    environments: int,
+    trials: int,
+    seed: int,
+    persist_state: bool = True,
+) -> str: ...
+def nav1d_system_record(
+    classifier: tuple[str, Network],
+    far: tuple[str, Network],
+    near: tuple[str, Network],
+    conditions: str,
+    persist_state: bool = True,
+) -> str: ...

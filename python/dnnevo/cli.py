@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 import dnnevo
-from dnnevo import presets
+from dnnevo import _cli_nav1d, presets
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import DnnevoError
 from dnnevo.rundir import RunDir, write_atomic
@@ -29,6 +29,8 @@ EXAMPLES = """examples:
   dnnevo evaluate runs/demo --trials 200           re-score the champion on fresh conditions
   dnnevo plot runs/demo                            fitness curve and the paper's figures
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
+  dnnevo run nav1d-classifier --out runs/cls       the paper's navigation classifier (6 s)
+  dnnevo nav1d-system --classifier runs/cls --far runs/far --near runs/near
 """
 
 
@@ -121,13 +123,16 @@ def build_parser() -> argparse.ArgumentParser:
                        epilog="example: dnnevo evaluate runs/demo --trials 200")
     p.add_argument("dir", type=Path)
     p.add_argument("--trials", type=_positive, default=100,
-                   help="fresh trials per target, or evaluations for other tasks (default 100)")
+                   help="fresh trials per target (sequence), fresh chains of trials (nav1d), "
+                        "or evaluations for other tasks (default 100)")
     p.add_argument("--seed", type=_nonnegative, default=None, help="seed of the fresh conditions")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        epilog="example: dnnevo plot runs/demo")
     p.add_argument("dir", type=Path)
     p.add_argument("--seed", type=_nonnegative, default=0, help="seed of the trials shown")
+
+    _cli_nav1d.add_system_parser(sub)
     return parser
 
 
@@ -225,6 +230,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     if config.task == "sequence":
         return _evaluate_sequence(args, config, champion, seed)
+    if config.task == "nav1d":
+        return _cli_nav1d.evaluate(args, config, champion, seed)
     fitness = np.array([
         dnnevo.evaluate(config.task, [champion], generation=k, seed=seed, config=config)[0]
         for k in range(args.trials)
@@ -275,6 +282,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     written.append("fitness.png")
     if config.task == "sequence":
         written += _plot_sequence(run, config, args.seed)
+    if config.task == "nav1d":
+        written += _cli_nav1d.plot(run, config, args.seed)
     print(f"wrote {', '.join(str(run.path / w) for w in written)}")
     return 0
 
@@ -316,6 +325,7 @@ COMMANDS = {
     "sweep": _cmd_sweep,
     "evaluate": _cmd_evaluate,
     "plot": _cmd_plot,
+    "nav1d-system": _cli_nav1d.system,
 }
 
 

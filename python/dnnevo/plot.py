@@ -14,9 +14,10 @@ import numpy.typing as npt
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
+    from dnnevo.nav1d import Record as Nav1dRecord
     from dnnevo.sequence import TrialRecord
 
-__all__ = ["plot_fitness", "plot_sequence_trial"]
+__all__ = ["plot_fitness", "plot_nav1d_path", "plot_nav1d_traces", "plot_sequence_trial", "plot_traces"]
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -82,3 +83,96 @@ def plot_sequence_trial(
     if title:
         ax.set_title(title, fontsize=10)
     return ax
+
+
+def plot_nav1d_path(
+    record: Nav1dRecord,
+    ax: Axes | None = None,
+    *,
+    half_length: float = 20.0,
+    landmark_width: float = 4.0,
+    title: str | None = None,
+) -> Axes:
+    """The paper's Fig. 2: the agent's position over time in a chain of trials, with each
+    trial's landmark (shaded) and goal (a star at its end) marked, and trial boundaries dashed."""
+    ax = _axes(ax)
+    t = np.arange(1, len(record.x) + 1)
+    x = np.where(record.moving, record.x, np.nan)
+    ax.plot(t, x, color="tab:blue", lw=1.4, label="agent x(t)")
+    bounds = np.flatnonzero(np.diff(record.trial)) + 1
+    edges = np.concatenate([[0], bounds, [len(t)]])
+    for k, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+        if k >= len(record.conditions):
+            break
+        c = record.conditions[k]
+        ax.fill_between([a, b], c.landmark - landmark_width / 2, c.landmark + landmark_width / 2,
+                        color="tab:orange", alpha=0.3, lw=0, label="landmark" if k == 0 else None)
+        goal = half_length if c.goal == "right" else -half_length
+        reached = k < len(record.reached) and record.reached[k]
+        ax.plot([b if reached else a], [goal], marker="*", ms=11, ls="none",
+                color="tab:green" if reached else "tab:red",
+                label=("goal" if k == 0 else None))
+        if k:
+            ax.axvline(a, color="k", lw=0.6, ls="--")
+    ax.axhline(half_length, color="0.4", lw=0.8)
+    ax.axhline(-half_length, color="0.4", lw=0.8)
+    ax.set_ylim(-1.1 * half_length, 1.1 * half_length)
+    ax.set_xlim(0, len(t))
+    ax.set_xlabel("time step")
+    ax.set_ylabel("position x")
+    ax.legend(loc="lower right", fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return ax
+
+
+def plot_traces(
+    inputs: Mapping[str, npt.ArrayLike],
+    outputs: npt.ArrayLike,
+    ax: Axes | None = None,
+    *,
+    labels: list[str] | None = None,
+    highlight: int | None = None,
+    title: str | None = None,
+) -> Axes:
+    """Stacked traces in the style of the paper's Figs. 1 and 3: each input, then each neuron's
+    firing rate (columns of the (T, N) ``outputs``), one band per trace, all on [0, 1]. The band of
+    neuron ``highlight`` gets a 0.5 line."""
+    ax = _axes(ax)
+    out = np.asarray(outputs, dtype=float)
+    series = [(name, np.asarray(v, dtype=float), "tab:green") for name, v in inputs.items()]
+    names = labels or [f"neuron {i}" for i in range(out.shape[1])]
+    series += [(names[i], out[:, i], "tab:red" if i == highlight else "tab:blue")
+               for i in range(out.shape[1])]
+    t = np.arange(1, out.shape[0] + 1)
+    ticks = []
+    for row, (name, y, color) in enumerate(series):
+        base = (len(series) - 1 - row) * 1.3
+        ax.plot(t, base + y, color=color, lw=1.1)
+        ax.axhline(base, color="0.85", lw=0.5)
+        if row >= len(inputs) and row - len(inputs) == highlight:
+            ax.axhline(base + 0.5, color="0.3", lw=0.7, ls=":")
+        ticks.append((base + 0.5, name))
+    ax.set_yticks([p for p, _ in ticks], [n for _, n in ticks], fontsize=8)
+    ax.set_xlim(0, len(t))
+    ax.set_xlabel("time step")
+    if title:
+        ax.set_title(title, fontsize=10)
+    return ax
+
+
+def plot_nav1d_traces(
+    record: Nav1dRecord, ax: Axes | None = None, *, classifier: int = 2,
+    motors: tuple[int, int] = (0, 1), title: str | None = None,
+) -> Axes:
+    """The paper's Fig. 3: landmark and reinforcement inputs and every neuron's output over a
+    trial, with the classifier's 0.5 line."""
+    n = record.outputs.shape[1]
+    labels = [f"neuron {i}" for i in range(n)]
+    labels[motors[0]] = f"left motor ({motors[0]})"
+    labels[motors[1]] = f"right motor ({motors[1]})"
+    if classifier < n:
+        labels[classifier] = f"classifier ({classifier})"
+    return plot_traces({"landmark": record.landmark, "reinforcement": record.reinforcement},
+                       record.outputs, ax, labels=labels, highlight=classifier if classifier < n else None,
+                       title=title)

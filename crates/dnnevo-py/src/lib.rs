@@ -7,6 +7,8 @@ mod arrays;
 mod detach;
 mod errors;
 mod evolution;
+mod json;
+mod nav1d;
 mod network;
 mod sequence;
 
@@ -18,6 +20,11 @@ mod _core {
     #[pymodule_export]
     use super::evolution::{
         decode, encode, evaluate, task_layout, task_names, task_success, PyEvolution,
+    };
+    #[pymodule_export]
+    use super::nav1d::{
+        nav1d_assess, nav1d_chains, nav1d_exact, nav1d_fresh_chains, nav1d_record,
+        nav1d_system_assess, nav1d_system_record,
     };
     #[pymodule_export]
     use super::network::{compose, run_population, PyNetwork, PyTrace};

@@ -4,17 +4,12 @@
 use pyo3::prelude::*;
 use tasks::sequence::SequenceTask;
 
-use crate::errors::{ConfigError, IntoPy};
+use crate::errors::IntoPy;
+use crate::json::{self, to_json};
 use crate::network::PyNetwork;
 
 fn task(params: &str) -> PyResult<SequenceTask> {
-    let value: serde_json::Value = serde_json::from_str(params)
-        .map_err(|e| ConfigError::new_err(format!("task parameters: {e}")))?;
-    SequenceTask::from_params(&value).py_err()
-}
-
-fn to_json<T: serde::Serialize>(value: &T) -> String {
-    serde_json::to_string(value).expect("task records always serialise")
+    SequenceTask::from_params(&json::params(params)?).py_err()
 }
 
 /// The (delay, gap) of every trigger of a trial, as evolution drew them.

@@ -14,6 +14,8 @@
 //! ```
 #![warn(missing_docs)]
 
+mod common;
+pub mod nav1d;
 pub mod registry;
 pub mod sequence;
 

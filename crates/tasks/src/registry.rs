@@ -4,15 +4,16 @@
 //! # Example
 //! ```
 //! let e = tasks::build("maze", &serde_json::json!({})).err().unwrap().to_string();
-//! assert!(e.contains("unknown task \"maze\"; known tasks: sequence"), "{e}");
+//! assert!(e.contains("unknown task \"maze\"; known tasks: sequence, nav1d"), "{e}");
 //! ```
 
 use ctrnn::{Error, Result, Task};
 
+use crate::nav1d::Nav1dTask;
 use crate::sequence::SequenceTask;
 
 /// The names [`build`] knows, in the order they are listed in messages.
-const NAMES: &[&str] = &["sequence"];
+const NAMES: &[&str] = &["sequence", "nav1d"];
 
 /// The names of the known tasks.
 pub fn names() -> &'static [&'static str] {
@@ -22,7 +23,8 @@ pub fn names() -> &'static [&'static str] {
 /// Makes the task `name` from `params`, a JSON object of its config fields (`null` means all
 /// defaults).
 ///
-/// - `"sequence"`: a [`SequenceConfig`](crate::sequence::SequenceConfig).
+/// - `"sequence"`: a [`SequenceConfig`](crate::sequence::SequenceConfig);
+/// - `"nav1d"`: a [`Nav1dConfig`](crate::nav1d::Nav1dConfig).
 ///
 /// Unknown names, unknown or mistyped parameters and out-of-range values are [`Error::Config`]
 /// errors that say what was wrong and what is allowed.
@@ -40,6 +42,7 @@ pub fn names() -> &'static [&'static str] {
 pub fn build(name: &str, params: &serde_json::Value) -> Result<Box<dyn Task>> {
     match name {
         "sequence" => Ok(Box::new(SequenceTask::from_params(params)?)),
+        "nav1d" => Ok(Box::new(Nav1dTask::from_params(params)?)),
         _ => Err(Error::Config(format!(
             "unknown task {name:?}; known tasks: {}",
             NAMES.join(", ")
@@ -84,7 +87,7 @@ mod tests {
         assert!(matches!(e, Error::Config(_)));
         assert_eq!(
             e.to_string(),
-            "invalid config: unknown task \"x\"; known tasks: sequence"
+            "invalid config: unknown task \"x\"; known tasks: sequence, nav1d"
         );
     }
 }

@@ -61,14 +61,19 @@
 //! ```
 
 use std::fmt;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 use ctrnn::{
     Error, Integrator, Lanes, Layout, Method, Network, Population, Purpose, Result, Stream, Task,
     LANES,
 };
 use rayon::prelude::*;
+
+use crate::common::{check_inputs, config_from_params, interrupted, Diverged};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+/// What the two sensors are, for error messages.
+const SENSORS: &str = "trigger, reinforcement";
 
 /// The fraction of trials a network must get right, after the warm-up, to have learnt a target.
 pub const SUCCESS_FRACTION: f64 = 0.9;
@@ -249,16 +254,7 @@ impl SequenceConfig {
     /// Reads a config from a JSON object of its fields (`null` means all defaults) and validates
     /// it. Unknown fields are errors that name the field.
     pub fn from_params(params: &serde_json::Value) -> Result<Self> {
-        let config = match params {
-            serde_json::Value::Null => SequenceConfig::default(),
-            serde_json::Value::Object(_) => SequenceConfig::deserialize(params)
-                .map_err(|e| Error::Config(format!("sequence: {e}")))?,
-            other => {
-                return Err(Error::Config(format!(
-                    "sequence: the parameters must be a JSON object of config fields; got {other}"
-                )))
-            }
-        };
+        let config: SequenceConfig = config_from_params("sequence", params)?;
         config.validate()?;
         Ok(config)
     }
@@ -443,26 +439,6 @@ struct Outcome<const L: usize> {
     mean_output: Vec<[f64; L]>,
 }
 
-/// A lane whose state stopped being finite.
-struct Diverged {
-    lane: usize,
-    neuron: usize,
-    value: f64,
-}
-
-impl Diverged {
-    /// The error, with the lane's network numbered from `first`.
-    fn error(self, first: usize) -> Error {
-        Error::InvalidArgument(format!(
-            "integration diverged: state[{}] of network {} became {}; use a smaller dt \
-             (Euler needs dt / tau well below 2)",
-            self.neuron,
-            first + self.lane,
-            self.value
-        ))
-    }
-}
-
 /// Runs one trial of target `bits` on every lane of `lanes` in lockstep, lane `l` with its own
 /// `timings[l]` (all of the same length). `observe(inputs, lanes)` sees each time step's inputs and
 /// the state after it. With `full` the trial runs to the end of the last gap; otherwise it stops
@@ -523,16 +499,7 @@ fn run_lanes<const L: usize>(
         }
         observe(&inputs, lanes);
     }
-    for neuron in 0..lanes.size() {
-        let row = lanes.state(neuron);
-        if let Some(lane) = (0..lanes.len()).find(|&l| !row[l].is_finite()) {
-            return Err(Diverged {
-                lane,
-                neuron,
-                value: row[lane],
-            });
-        }
-    }
+    Diverged::find(lanes)?;
     Ok(Outcome { r, mean_output })
 }
 
@@ -551,22 +518,6 @@ fn draw_timings(config: &SequenceConfig, mut stream: Stream, n: usize) -> Vec<(u
 /// Bits of a target string that has been validated.
 fn to_bits(target: &str) -> Vec<u8> {
     target.bytes().map(|b| b - b'0').collect()
-}
-
-/// Checks that a network has the task's two sensors.
-fn check_inputs(p: usize, net: &Network) -> Result<()> {
-    if net.n_inputs() != 2 {
-        return Err(Error::InvalidArgument(format!(
-            "network {p} has M = {} sensors; sequence learning needs M = 2 \
-             (trigger, reinforcement)",
-            net.n_inputs()
-        )));
-    }
-    Ok(())
-}
-
-fn interrupted(cancel: Option<&AtomicBool>) -> bool {
-    cancel.is_some_and(|c| c.load(Ordering::Relaxed))
 }
 
 impl SequenceTask {
@@ -632,9 +583,7 @@ impl SequenceTask {
     ) -> Result<Scores> {
         let config = &self.config;
         let (n_trials, k) = (config.n_trials(), config.triggers);
-        for (p, net) in networks.iter().enumerate() {
-            check_inputs(p, net)?;
-        }
+        check_inputs(networks, 2, SENSORS)?;
         if networks.is_empty() {
             return Ok(Scores {
                 trials: n_trials,
@@ -755,7 +704,7 @@ impl SequenceTask {
                 "target is {pattern:?}; it must be a non-empty string of '0' and '1'"
             )));
         }
-        check_inputs(0, net)?;
+        check_inputs(std::slice::from_ref(net), 2, SENSORS)?;
         let bits = to_bits(pattern);
         let mut lanes = Lanes::<1>::new(&[net])?;
         let n = net.size();
@@ -811,7 +760,7 @@ impl SequenceTask {
     /// Performance uses the numeric `perf_base`, or 0.5 when it is `"generation-mean"`.
     /// Every target must have more triggers than its warm-up, or nothing would be judged.
     pub fn assess(&self, net: &Network, trials_per_target: usize, seed: u64) -> Result<Assessment> {
-        check_inputs(0, net)?;
+        check_inputs(std::slice::from_ref(net), 2, SENSORS)?;
         if trials_per_target == 0 {
             return Err(Error::InvalidArgument(
                 "trials_per_target is 0; assessing needs at least 1 trial per target".into(),

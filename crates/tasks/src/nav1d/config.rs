@@ -1,0 +1,244 @@
+//! The settings of the one-dimensional navigation experiments: the world's geometry and timing,
+//! which neurons are motors and classifier, and what an evaluation scores.
+
+use ctrnn::{Error, Integrator, Method, Result};
+use serde::{Deserialize, Serialize};
+
+use super::world::Environment;
+
+/// What an evaluation scores.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Objective {
+    /// Goal seeking (the far and near networks, §4.2): one trial per environment and goal side,
+    /// each from a reset state; a trial scores 1 when the agent reaches the goal, else 0.
+    Goal,
+    /// Environment classification (§4.2): one trial per environment and goal side, each from a
+    /// reset state; a trial scores `f(v_C)` in a landmark-near environment and `1 - f(v_C)` in a
+    /// landmark-far one, read at the end of the trial's reinforcement period.
+    Classify,
+    /// One network for the whole task (beyond the paper): chains of `trials_per_environment`
+    /// trials in one environment without a reset, each trial's goal side drawn at random; the
+    /// score is the goal rate over trials 2..k of every chain.
+    Single,
+}
+
+impl Objective {
+    /// The name used in configs: `"goal"`, `"classify"` or `"single"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::Goal => "goal",
+            Objective::Classify => "classify",
+            Objective::Single => "single",
+        }
+    }
+}
+
+/// The one-dimensional navigation settings. Every number of the world lives here.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Nav1dConfig {
+    /// What an evaluation scores. Default `"goal"`.
+    pub objective: Objective,
+    /// The environment types evaluations use (`"far"`, `"near"`), without repeats. Default
+    /// `["far", "near"]`.
+    pub environments: Vec<Environment>,
+    /// Neurons per network N. Default 5.
+    pub size: usize,
+    /// Whether the network has the reinforcement (goal) sensor as input 1, after the landmark
+    /// sensor (input 0). The paper's goal-seeking networks have only the landmark sensor; its
+    /// classifier has both. Default true.
+    pub reinforcement_input: bool,
+    /// The left motor neuron. Default 0.
+    pub left_motor: usize,
+    /// The right motor neuron. Default 1.
+    pub right_motor: usize,
+    /// The classifier neuron (`f(v_C) >= 0.5` means landmark-near); used by `"classify"` and by
+    /// the integrated system. Default 2.
+    pub classifier: usize,
+    /// The line runs over `[-half_length, half_length]`; its ends are the goal and the wall.
+    /// Default 20.
+    pub half_length: f64,
+    /// Where the agent starts each trial. Default 0 (the centre).
+    pub start: f64,
+    /// Distance of the landmark's centre from the line's centre. Default 10.
+    pub landmark_offset: f64,
+    /// Width of the landmark segment; the sensor reads 1 while `|x - centre| <= width / 2`.
+    /// Default 4.
+    pub landmark_width: f64,
+    /// A trial ends after this many time steps if the agent has reached neither end. Default 1000.
+    pub max_steps: usize,
+    /// Time steps after a trial ends: reinforcement input 1 if the agent reached the goal, no
+    /// input otherwise. Default 50.
+    pub reinforcement_steps: usize,
+    /// With `"goal"`: run each environment's goal-left and goal-right trials as two chains,
+    /// left-right and right-left, without a reset in between, so that the network meets a trial
+    /// that starts from the state the last one left, as it does in the integrated system. Its
+    /// success check then uses chains of `trials_per_environment` trials. Default false (the
+    /// paper's trials, each from a reset state).
+    pub chained: bool,
+    /// Trials per chain with `"single"` (the first trial is for learning, trials 2.. are scored)
+    /// and in the success check of a `chained` goal task. Default 5.
+    pub trials_per_environment: usize,
+    /// Chains per environment type in one `"single"` evaluation. Default 2.
+    pub chains_per_environment: usize,
+    /// Half-width of a uniform random shift of the start position in each trial. Default 0 (the
+    /// paper's fixed start).
+    pub start_jitter: f64,
+    /// Half-width of a uniform random shift of the landmark's centre in each trial. Default 0.
+    pub landmark_jitter: f64,
+    /// How one time step is integrated; the agent moves `dt * substeps * velocity` per time step.
+    /// Default 10 Euler steps of dt = 0.1.
+    pub integrator: Integrator,
+}
+
+impl Default for Nav1dConfig {
+    fn default() -> Self {
+        Nav1dConfig {
+            objective: Objective::Goal,
+            environments: vec![Environment::Far, Environment::Near],
+            size: 5,
+            reinforcement_input: true,
+            left_motor: 0,
+            right_motor: 1,
+            classifier: 2,
+            half_length: 20.0,
+            start: 0.0,
+            landmark_offset: 10.0,
+            landmark_width: 4.0,
+            max_steps: 1000,
+            reinforcement_steps: 50,
+            chained: false,
+            trials_per_environment: 5,
+            chains_per_environment: 2,
+            start_jitter: 0.0,
+            landmark_jitter: 0.0,
+            integrator: Integrator {
+                method: Method::Euler,
+                dt: 0.1,
+                substeps: 10,
+            },
+        }
+    }
+}
+
+impl Nav1dConfig {
+    /// Checks every field; the error names the field and says what is allowed.
+    ///
+    /// # Example
+    /// ```
+    /// use tasks::nav1d::Nav1dConfig;
+    /// let bad = Nav1dConfig { landmark_offset: 25.0, ..Nav1dConfig::default() };
+    /// let e = bad.validate().unwrap_err().to_string();
+    /// assert!(e.contains("landmark_offset"), "{e}");
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        let config = |msg: String| Err(Error::Config(msg));
+        if self.environments.is_empty() {
+            return config("environments is empty; give \"far\", \"near\" or both".into());
+        }
+        if self.environments.len() == 2 && self.environments[0] == self.environments[1] {
+            return config("environments repeats an environment; list each at most once".into());
+        }
+        for (name, value) in [
+            ("size", self.size),
+            ("max_steps", self.max_steps),
+            ("trials_per_environment", self.trials_per_environment),
+            ("chains_per_environment", self.chains_per_environment),
+        ] {
+            if value == 0 {
+                return config(format!("{name} is 0; it must be >= 1"));
+            }
+        }
+        let mut neurons = vec![
+            ("left_motor", self.left_motor),
+            ("right_motor", self.right_motor),
+        ];
+        if self.objective != Objective::Goal {
+            neurons.push(("classifier", self.classifier));
+        }
+        for (k, &(name, i)) in neurons.iter().enumerate() {
+            if i >= self.size {
+                return config(format!(
+                    "{name} is {i}; it must be a neuron index below size ({})",
+                    self.size
+                ));
+            }
+            if let Some((other, _)) = neurons[..k].iter().find(|(_, j)| *j == i) {
+                return config(format!(
+                    "{name} is {i}, the same neuron as {other}; they must differ"
+                ));
+            }
+        }
+        if self.chained && self.objective != Objective::Goal {
+            return config("chained is true; it applies to the \"goal\" objective only".into());
+        }
+        if self.objective == Objective::Single && self.trials_per_environment < 2 {
+            return config(format!(
+                "trials_per_environment is {}; \"single\" scores trials 2..k, so it must be >= 2",
+                self.trials_per_environment
+            ));
+        }
+        for (name, value) in [
+            ("half_length", self.half_length),
+            ("start", self.start),
+            ("landmark_offset", self.landmark_offset),
+            ("landmark_width", self.landmark_width),
+            ("start_jitter", self.start_jitter),
+            ("landmark_jitter", self.landmark_jitter),
+        ] {
+            if !value.is_finite() {
+                return config(format!("{name} is {value}; it must be finite"));
+            }
+        }
+        let h = self.half_length;
+        if h <= 0.0 {
+            return config(format!("half_length is {h}; it must be > 0"));
+        }
+        if self.landmark_width <= 0.0 {
+            return config(format!(
+                "landmark_width is {}; it must be > 0",
+                self.landmark_width
+            ));
+        }
+        if self.start_jitter < 0.0 || self.landmark_jitter < 0.0 {
+            return config(format!(
+                "start_jitter is {} and landmark_jitter is {}; both must be >= 0",
+                self.start_jitter, self.landmark_jitter
+            ));
+        }
+        if self.start.abs() + self.start_jitter >= h {
+            return config(format!(
+                "start is {} with start_jitter {}; the agent must start strictly inside \
+                 (-half_length, half_length) = (-{h}, {h})",
+                self.start, self.start_jitter
+            ));
+        }
+        let reach = self.landmark_offset.abs() + self.landmark_jitter + self.landmark_width / 2.0;
+        if self.landmark_offset <= 0.0 || reach >= h {
+            return config(format!(
+                "landmark_offset is {} (width {}, jitter {}); the landmark must lie inside \
+                 (0, half_length = {h}) on its side",
+                self.landmark_offset, self.landmark_width, self.landmark_jitter
+            ));
+        }
+        self.integrator.validate().map_err(|e| match e {
+            Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
+            other => other,
+        })
+    }
+
+    /// Sensors per network: 2 with the reinforcement input, else 1.
+    pub fn n_inputs(&self) -> usize {
+        if self.reinforcement_input {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// Simulated time of one time step, `dt * substeps`.
+    pub fn step_time(&self) -> f64 {
+        self.integrator.dt * self.integrator.substeps as f64
+    }
+}

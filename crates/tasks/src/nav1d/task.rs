@@ -1,0 +1,455 @@
+//! The one-dimensional navigation task: its trial conditions, the fitness of a generation, a
+//! recorded chain of trials for figures, and the success assessment on fresh conditions.
+
+use std::sync::atomic::AtomicBool;
+
+use ctrnn::{Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, LANES};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::config::{Nav1dConfig, Objective};
+use super::world::{run_chains, Condition, Environment, Phase, Side};
+use crate::common::{check_inputs, config_from_params, interrupted};
+
+/// The fraction of scored trials a network must get right on fresh conditions to have solved its
+/// objective.
+pub const SUCCESS_RATE: f64 = 0.95;
+
+/// Fresh chains a run uses to check whether its champion has succeeded yet (`dnnevo sweep`'s
+/// "first success" generation). `dnnevo evaluate` uses as many as asked.
+pub const SUCCESS_CHAINS: usize = 40;
+
+/// The one-dimensional navigation task: a validated [`Nav1dConfig`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Nav1dTask {
+    config: Nav1dConfig,
+}
+
+/// One chain of trials in one environment, as it went.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Episode {
+    /// The environment type.
+    pub environment: Environment,
+    /// Each trial's world.
+    pub conditions: Vec<Condition>,
+    /// Whether each trial reached the goal.
+    pub reached: Vec<bool>,
+    /// The classifier's output at the end of each trial's reinforcement period.
+    pub classification: Vec<f64>,
+}
+
+/// A network judged on fresh conditions.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Assessment {
+    /// What was scored.
+    pub objective: Objective,
+    /// Every chain.
+    pub episodes: Vec<Episode>,
+    /// The fraction of scored trials done right: the goal reached (`goal`; trials 2.. with
+    /// `single`) or the environment classified right (`classify`).
+    pub rate: f64,
+    /// Whether `rate >= SUCCESS_RATE`.
+    pub success: bool,
+}
+
+/// One chain of one network, time step by time step (all of length T; `outputs` is T x N).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Record {
+    /// Each trial's world.
+    pub conditions: Vec<Condition>,
+    /// The agent's position after each time step.
+    pub x: Vec<f64>,
+    /// The landmark input during each time step.
+    pub landmark: Vec<f64>,
+    /// The reinforcement input during each time step.
+    pub reinforcement: Vec<f64>,
+    /// Every neuron's firing rate after each time step.
+    pub outputs: Vec<Vec<f64>>,
+    /// The trial each time step belongs to.
+    pub trial: Vec<usize>,
+    /// Whether the agent was moving (false during the reinforcement period).
+    pub moving: Vec<bool>,
+    /// Whether each trial reached the goal.
+    pub reached: Vec<bool>,
+    /// The classifier's output at the end of each trial.
+    pub classification: Vec<f64>,
+    /// The state after the last time step.
+    pub final_state: Vec<f64>,
+}
+
+impl Record {
+    /// This record followed by `next`, whose trials are renumbered to come after this one's.
+    pub fn then(mut self, next: Record) -> Record {
+        let offset = self.conditions.len();
+        self.conditions.extend(next.conditions);
+        self.x.extend(next.x);
+        self.landmark.extend(next.landmark);
+        self.reinforcement.extend(next.reinforcement);
+        self.outputs.extend(next.outputs);
+        self.trial.extend(next.trial.iter().map(|t| t + offset));
+        self.moving.extend(next.moving);
+        self.reached.extend(next.reached);
+        self.classification.extend(next.classification);
+        self.final_state = next.final_state;
+        self
+    }
+}
+
+/// The sides in the order the fixed trial sets list them.
+const SIDES: [Side; 2] = [Side::Left, Side::Right];
+
+fn side(stream: &mut Stream) -> Side {
+    if stream.bernoulli(0.5) {
+        Side::Right
+    } else {
+        Side::Left
+    }
+}
+
+impl Nav1dTask {
+    /// The task for `config`, which is validated.
+    pub fn new(config: Nav1dConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(Nav1dTask { config })
+    }
+
+    /// The task from a JSON object of [`Nav1dConfig`] fields (`null` means all defaults).
+    pub fn from_params(params: &serde_json::Value) -> Result<Self> {
+        Nav1dTask::new(config_from_params("nav1d", params)?)
+    }
+
+    /// The config.
+    pub fn config(&self) -> &Nav1dConfig {
+        &self.config
+    }
+
+    /// Trials per chain of the success check: `trials_per_environment` with `single` or a
+    /// `chained` goal task, else 1.
+    pub fn chain_len(&self) -> usize {
+        match self.config.objective {
+            Objective::Single => self.config.trials_per_environment,
+            Objective::Goal if self.config.chained => self.config.trials_per_environment,
+            _ => 1,
+        }
+    }
+
+    /// The chains every individual of `generation` runs (common random numbers).
+    ///
+    /// - `goal` and `classify`: for each environment in `environments`, a goal-left then a
+    ///   goal-right trial, each a chain of its own; chain `t` draws its jitter from
+    ///   `Stream::new(seed, generation, Purpose::Trial, 0, t)`. A `chained` goal task runs, for
+    ///   each environment, the chains (left, right) and (right, left) instead, each trial's
+    ///   jitter drawn in turn from its chain's stream.
+    /// - `single`: for each environment, `chains_per_environment` chains; each trial of chain `t`
+    ///   draws its goal side (right with probability 1/2), then its jitter, from that stream.
+    pub fn chains(&self, seed: u64, generation: u64) -> Vec<Vec<Condition>> {
+        let c = &self.config;
+        let stream = |t: usize| Stream::new(seed, generation, Purpose::Trial, 0, t as u64);
+        match c.objective {
+            Objective::Goal if c.chained => c
+                .environments
+                .iter()
+                .flat_map(|&env| [(env, SIDES), (env, [SIDES[1], SIDES[0]])])
+                .enumerate()
+                .map(|(t, (env, goals))| {
+                    let mut s = stream(t);
+                    goals
+                        .iter()
+                        .map(|&goal| Condition::drawn(c, env, goal, &mut s))
+                        .collect()
+                })
+                .collect(),
+            Objective::Goal | Objective::Classify => c
+                .environments
+                .iter()
+                .flat_map(|&env| SIDES.map(|goal| (env, goal)))
+                .enumerate()
+                .map(|(t, (env, goal))| vec![Condition::drawn(c, env, goal, &mut stream(t))])
+                .collect(),
+            Objective::Single => c
+                .environments
+                .iter()
+                .flat_map(|&env| std::iter::repeat_n(env, c.chains_per_environment))
+                .enumerate()
+                .map(|(t, env)| {
+                    let mut s = stream(t);
+                    (0..c.trials_per_environment)
+                        .map(|_| {
+                            let goal = side(&mut s);
+                            Condition::drawn(c, env, goal, &mut s)
+                        })
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// `count` fresh chains of `trials` trials for assessments, chain `e` drawn from
+    /// `Stream::new(seed, 0, Purpose::Evaluate, 0, e)`: its environment uniformly from
+    /// `environments`, then for each trial its goal side and jitter.
+    pub fn fresh_chains(&self, count: usize, trials: usize, seed: u64) -> Vec<Vec<Condition>> {
+        let c = &self.config;
+        (0..count)
+            .map(|e| {
+                let mut s = Stream::new(seed, 0, Purpose::Evaluate, 0, e as u64);
+                let env = c.environments[s.below(c.environments.len() as u64) as usize];
+                (0..trials)
+                    .map(|_| {
+                        let goal = side(&mut s);
+                        Condition::drawn(c, env, goal, &mut s)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Trial `t` of a chain, judged: its score and whether it was done right, or `None` for a
+    /// trial the objective does not score (the first trial with `single`).
+    pub fn judge(
+        &self,
+        t: usize,
+        condition: &Condition,
+        reached: bool,
+        classification: f64,
+    ) -> Option<(f64, bool)> {
+        let goal = (f64::from(u8::from(reached)), reached);
+        match self.config.objective {
+            Objective::Goal => Some(goal),
+            Objective::Single => (t > 0).then_some(goal),
+            Objective::Classify => Some(match condition.environment {
+                Environment::Near => (classification, classification >= 0.5),
+                Environment::Far => (1.0 - classification, classification < 0.5),
+            }),
+        }
+    }
+
+    /// The fitness of every network in `generation`: the mean score over the scored trials of
+    /// [`chains`](Self::chains). Blocks of [`LANES`] networks run in parallel. Stops with
+    /// [`Error::Interrupted`] between chains once `cancel` is set.
+    pub fn scores(
+        &self,
+        networks: &[Network],
+        generation: u64,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        self.check(networks)?;
+        if networks.is_empty() {
+            return Ok(vec![]);
+        }
+        let chains = self.chains(seed, generation);
+        let mut population = Population::new(networks)?;
+        let per_block = population
+            .blocks_mut()
+            .par_iter_mut()
+            .enumerate()
+            .map(|(b, block)| {
+                let mut sum = [0.0; LANES];
+                let mut count = 0usize;
+                for chain in &chains {
+                    if interrupted(cancel) {
+                        return Err(Error::Interrupted);
+                    }
+                    let outcome = run_chains(
+                        &self.config,
+                        block,
+                        [chain.as_slice(); LANES],
+                        true,
+                        |_, _, _, _| {},
+                    )
+                    .map_err(|d| d.error(b * LANES))?;
+                    for (t, condition) in chain.iter().enumerate() {
+                        let mut scored = false;
+                        for l in 0..LANES {
+                            let (r, c) = (outcome.reached[t][l], outcome.classification[t][l]);
+                            if let Some((score, _)) = self.judge(t, condition, r, c) {
+                                sum[l] += score;
+                                scored = true;
+                            }
+                        }
+                        count += usize::from(scored);
+                    }
+                }
+                Ok(sum[..block.len()]
+                    .iter()
+                    .map(|s| s / count as f64)
+                    .collect::<Vec<f64>>())
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(per_block.concat())
+    }
+
+    /// Runs `net` through each of `chains` (all of the same length), [`LANES`] chains at a time in
+    /// parallel, each from a reset state.
+    pub fn episodes(&self, net: &Network, chains: &[Vec<Condition>]) -> Result<Vec<Episode>> {
+        self.check(std::slice::from_ref(net))?;
+        let Some(first) = chains.first() else {
+            return Ok(vec![]);
+        };
+        if let Some(e) = chains.iter().position(|c| c.len() != first.len()) {
+            return Err(Error::InvalidArgument(format!(
+                "chain {e} has {} trials and chain 0 has {}; every chain must have as many",
+                chains[e].len(),
+                first.len()
+            )));
+        }
+        let refs = [net; LANES];
+        let groups = chains
+            .par_chunks(LANES)
+            .map(|group| {
+                let mut lanes = Lanes::<LANES>::new(&refs)?;
+                let pick = std::array::from_fn(|l| group[l.min(group.len() - 1)].as_slice());
+                let outcome = run_chains(&self.config, &mut lanes, pick, true, |_, _, _, _| {})
+                    .map_err(|d| d.error(0))?;
+                Ok(group
+                    .iter()
+                    .enumerate()
+                    .map(|(l, chain)| Episode {
+                        environment: chain.first().map_or(Environment::Far, |c| c.environment),
+                        conditions: chain.clone(),
+                        reached: outcome.reached.iter().map(|r| r[l]).collect(),
+                        classification: outcome.classification.iter().map(|c| c[l]).collect(),
+                    })
+                    .collect::<Vec<_>>())
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(groups.concat())
+    }
+
+    /// The fraction of scored trials of `episodes` done right (0 when none is scored).
+    pub fn rate(&self, episodes: &[Episode]) -> f64 {
+        let (mut right, mut scored) = (0usize, 0usize);
+        for ep in episodes {
+            for (t, c) in ep.conditions.iter().enumerate() {
+                if let Some((_, ok)) = self.judge(t, c, ep.reached[t], ep.classification[t]) {
+                    scored += 1;
+                    right += usize::from(ok);
+                }
+            }
+        }
+        if scored == 0 {
+            0.0
+        } else {
+            right as f64 / scored as f64
+        }
+    }
+
+    /// Judges `net` on `chains` fresh chains of [`chain_len`](Self::chain_len) trials from
+    /// [`fresh_chains`](Self::fresh_chains): it succeeds when at least [`SUCCESS_RATE`] of the
+    /// scored trials are done right.
+    pub fn assess(&self, net: &Network, chains: usize, seed: u64) -> Result<Assessment> {
+        if chains == 0 {
+            return Err(Error::InvalidArgument(
+                "chains is 0; assessing needs at least 1".into(),
+            ));
+        }
+        let episodes = self.episodes(net, &self.fresh_chains(chains, self.chain_len(), seed))?;
+        let rate = self.rate(&episodes);
+        Ok(Assessment {
+            objective: self.config.objective,
+            episodes,
+            rate,
+            success: rate >= SUCCESS_RATE,
+        })
+    }
+
+    /// Runs `net` through `chain`, recorded time step by time step. With `reset` the state starts
+    /// at 0; otherwise it continues from `net`'s state. Bit-identical to the evaluation.
+    pub fn record(&self, net: &Network, chain: &[Condition], reset: bool) -> Result<Record> {
+        self.check(std::slice::from_ref(net))?;
+        let h = self.config.half_length;
+        for (t, c) in chain.iter().enumerate() {
+            if !(c.start.is_finite() && c.start.abs() < h && c.landmark.is_finite()) {
+                return Err(Error::InvalidArgument(format!(
+                    "conditions[{t}] has start {} and landmark {}; the start must lie strictly \
+                     inside (-{h}, {h}) and both must be finite",
+                    c.start, c.landmark
+                )));
+            }
+        }
+        let mut lanes = Lanes::<1>::new(&[net])?;
+        let n = net.size();
+        let mut rec = Record {
+            conditions: chain.to_vec(),
+            x: vec![],
+            landmark: vec![],
+            reinforcement: vec![],
+            outputs: vec![],
+            trial: vec![],
+            moving: vec![],
+            reached: vec![],
+            classification: vec![],
+            final_state: vec![0.0; n],
+        };
+        let outcome = run_chains(
+            &self.config,
+            &mut lanes,
+            [chain],
+            reset,
+            |inputs, lanes, before, after| {
+                let (b, a) = (before[0], after[0]);
+                rec.x.push(if a.trial == b.trial { a.x } else { b.x });
+                rec.landmark.push(inputs[0][0]);
+                rec.reinforcement.push(inputs.get(1).map_or(0.0, |r| r[0]));
+                rec.outputs
+                    .push((0..n).map(|i| lanes.output(i)[0]).collect());
+                rec.trial.push(b.trial);
+                rec.moving.push(b.phase == Phase::Move);
+            },
+        )
+        .map_err(|d| d.error(0))?;
+        rec.reached = outcome.reached.iter().map(|r| r[0]).collect();
+        rec.classification = outcome.classification.iter().map(|c| c[0]).collect();
+        lanes.lane_state(0, &mut rec.final_state);
+        Ok(rec)
+    }
+
+    /// Checks that every network has the task's size constraints and sensors.
+    fn check(&self, networks: &[Network]) -> Result<()> {
+        let c = &self.config;
+        let what = if c.reinforcement_input {
+            "landmark, reinforcement"
+        } else {
+            "landmark"
+        };
+        check_inputs(networks, c.n_inputs(), what)?;
+        let mut needed = c.left_motor.max(c.right_motor);
+        if c.objective != Objective::Goal {
+            needed = needed.max(c.classifier);
+        }
+        if let Some(p) = networks.iter().position(|net| net.size() <= needed) {
+            return Err(Error::InvalidArgument(format!(
+                "network {p} has N = {} neurons; this task reads neuron {needed}, so N must be \
+                 at least {}",
+                networks[p].size(),
+                needed + 1
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Task for Nav1dTask {
+    fn layout(&self) -> Layout {
+        Layout {
+            size: self.config.size,
+            n_inputs: self.config.n_inputs(),
+        }
+    }
+
+    /// The fitness of [`Nav1dTask::scores`].
+    fn evaluate(
+        &self,
+        networks: &[Network],
+        generation: u64,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        self.scores(networks, generation, seed, cancel)
+    }
+
+    /// [`Nav1dTask::assess`] with [`SUCCESS_CHAINS`] chains.
+    fn succeeds(&self, net: &Network, seed: u64) -> Result<Option<bool>> {
+        Ok(Some(self.assess(net, SUCCESS_CHAINS, seed)?.success))
+    }
+}

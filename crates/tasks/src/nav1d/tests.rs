@@ -1,0 +1,483 @@
+use ctrnn::genome::{self, Ranges};
+use ctrnn::{Network, Stream, Task};
+
+use super::*;
+
+/// A network with zero weights whose neuron `i` fires at the constant rate `f(-theta[i])`.
+fn constant(theta: &[f64], m: usize) -> Network {
+    let n = theta.len();
+    Network::new(
+        vec![1.0; n],
+        theta.to_vec(),
+        vec![0.0; n * n],
+        vec![0.0; n * m],
+        None,
+    )
+    .unwrap()
+}
+
+/// Right motor on, left off: moves right at `f(8) - f(-8)` per time step.
+fn rightward(m: usize) -> Network {
+    constant(&[8.0, -8.0, 0.0, 0.0, 0.0], m)
+}
+
+fn task(config: Nav1dConfig) -> Nav1dTask {
+    Nav1dTask::new(config).unwrap()
+}
+
+fn goal_task(envs: &[Environment]) -> Nav1dTask {
+    task(Nav1dConfig {
+        environments: envs.to_vec(),
+        ..Nav1dConfig::default()
+    })
+}
+
+fn random_networks(count: usize, size: usize, m: usize, seed: u64) -> Vec<Network> {
+    let layout = genome::Layout { size, n_inputs: m };
+    let ranges = Ranges::default();
+    (0..count)
+        .map(|i| {
+            let mut s = Stream::new(seed, 0, ctrnn::Purpose::Init, i as u64, 0);
+            genome::decode(layout, &genome::random(layout, &ranges, &mut s)).unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn landmark_contact_includes_both_edges() {
+    let config = Nav1dConfig::default();
+    for (env, goal, centre) in [
+        (Environment::Near, Side::Right, 10.0),
+        (Environment::Near, Side::Left, -10.0),
+        (Environment::Far, Side::Right, -10.0),
+        (Environment::Far, Side::Left, 10.0),
+    ] {
+        let c = Condition::exact(&config, env, goal);
+        assert_eq!(c.landmark, centre);
+        for (x, on) in [
+            (centre - 2.0, 1.0),
+            (centre + 2.0, 1.0),
+            (centre, 1.0),
+            (centre - 2.0 - 1e-9, 0.0),
+            (centre + 2.0 + 1e-9, 0.0),
+            (0.0, 0.0),
+        ] {
+            assert_eq!(c.landmark_input(x, 4.0), on, "{env:?} {goal:?} x = {x}");
+        }
+    }
+}
+
+#[test]
+fn velocity_sign_follows_the_stronger_motor() {
+    let t = goal_task(&[Environment::Far]);
+    let chain = [Condition::exact(t.config(), Environment::Far, Side::Right)];
+    let right = t.record(&rightward(2), &chain, true).unwrap();
+    let v = 8f64.exp() / (1.0 + 8f64.exp()) - 1.0 / (1.0 + 8f64.exp());
+    assert!((right.x[0] - v).abs() < 1e-12, "{}", right.x[0]);
+    assert!(right.x.windows(2).take(10).all(|w| w[1] > w[0]));
+    let left = t
+        .record(&constant(&[-8.0, 8.0, 0.0, 0.0, 0.0], 2), &chain, true)
+        .unwrap();
+    assert!((left.x[0] + v).abs() < 1e-12);
+    let still = t.record(&constant(&[0.0; 5], 2), &chain, true).unwrap();
+    assert!(still.x.iter().all(|&x| x == 0.0));
+}
+
+#[test]
+fn a_trial_ends_at_either_end_or_at_the_time_limit() {
+    let t = goal_task(&[Environment::Far]);
+    let right = Condition::exact(t.config(), Environment::Far, Side::Right);
+    let left = Condition::exact(t.config(), Environment::Far, Side::Left);
+    let net = rightward(2);
+    // 20 / 0.99933 = 20.013...: the agent crosses x = 20 on its 21st time step.
+    for (cond, reached) in [(right, true), (left, false)] {
+        let rec = t.record(&net, &[cond], true).unwrap();
+        let moving = rec.moving.iter().filter(|&&m| m).count();
+        assert_eq!(moving, 21);
+        assert!(rec.x[20] >= 20.0 && rec.x[19] < 20.0);
+        assert_eq!(rec.reached, vec![reached]);
+        assert_eq!(rec.x.len(), 21 + 50);
+        // The agent stays where the trial ended.
+        assert!(rec.x[21..].iter().all(|&x| x == rec.x[20]));
+    }
+    // Standing still: the trial runs to max_steps, then the reinforcement period.
+    let short = task(Nav1dConfig {
+        max_steps: 30,
+        ..Nav1dConfig::default()
+    });
+    let rec = short
+        .record(&constant(&[0.0; 5], 2), &[right], true)
+        .unwrap();
+    assert_eq!(rec.x.len(), 30 + 50);
+    assert_eq!(rec.reached, vec![false]);
+}
+
+#[test]
+fn reinforcement_follows_a_reached_goal_for_its_period() {
+    let t = task(Nav1dConfig {
+        reinforcement_steps: 7,
+        ..Nav1dConfig::default()
+    });
+    let net = rightward(2);
+    let right = Condition::exact(t.config(), Environment::Near, Side::Right);
+    let rec = t.record(&net, &[right], true).unwrap();
+    let expected: Vec<f64> = [vec![0.0; 21], vec![1.0; 7]].concat();
+    assert_eq!(rec.reinforcement, expected);
+    // Landmark input while moving over [8, 12]; none during the reinforcement period.
+    let on: Vec<usize> = (0..rec.x.len())
+        .filter(|&k| rec.landmark[k] == 1.0)
+        .collect();
+    assert!(!on.is_empty());
+    for &k in &on {
+        let x_before = if k == 0 { 0.0 } else { rec.x[k - 1] };
+        assert!((8.0..=12.0).contains(&x_before), "step {k}: x = {x_before}");
+    }
+    let left = Condition::exact(t.config(), Environment::Near, Side::Left);
+    let rec = t.record(&net, &[left], true).unwrap();
+    assert!(rec.reinforcement.iter().all(|&r| r == 0.0));
+    assert_eq!(rec.reinforcement.len(), 21 + 7);
+}
+
+#[test]
+fn the_rightward_network_reaches_exactly_the_goal_right_trials() {
+    for reinforcement_input in [false, true] {
+        let m = 1 + usize::from(reinforcement_input);
+        let t = task(Nav1dConfig {
+            reinforcement_input,
+            ..Nav1dConfig::default()
+        });
+        let chains = t.chains(3, 0);
+        assert_eq!(chains.len(), 4);
+        let eps = t.episodes(&rightward(m), &chains).unwrap();
+        for ep in &eps {
+            assert_eq!(ep.reached, vec![ep.conditions[0].goal == Side::Right]);
+        }
+        assert_eq!(t.evaluate(&[rightward(m)], 0, 3, None).unwrap(), vec![0.5]);
+        let far = goal_task(&[Environment::Far]);
+        if m == 2 {
+            assert_eq!(
+                far.evaluate(&[rightward(m)], 0, 3, None).unwrap(),
+                vec![0.5]
+            );
+        }
+    }
+}
+
+#[test]
+fn batched_evaluation_equals_the_record_and_ignores_threads() {
+    for objective in [Objective::Goal, Objective::Classify, Objective::Single] {
+        let t = task(Nav1dConfig {
+            objective,
+            landmark_jitter: 1.0,
+            start_jitter: 0.5,
+            trials_per_environment: 3,
+            ..Nav1dConfig::default()
+        });
+        let nets = random_networks(19, 5, 2, 11);
+        let fitness = t.evaluate(&nets, 4, 9, None).unwrap();
+        let chains = t.chains(9, 4);
+        for (p, net) in nets.iter().enumerate() {
+            let (mut sum, mut count) = (0.0, 0);
+            for chain in &chains {
+                let rec = t.record(net, chain, true).unwrap();
+                for (k, c) in chain.iter().enumerate() {
+                    if let Some((s, _)) = t.judge(k, c, rec.reached[k], rec.classification[k]) {
+                        sum += s;
+                        count += 1;
+                    }
+                }
+            }
+            assert_eq!(
+                fitness[p].to_bits(),
+                (sum / count as f64).to_bits(),
+                "{objective:?} {p}"
+            );
+        }
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let single = one.install(|| t.evaluate(&nets, 4, 9, None).unwrap());
+        assert_eq!(single, fitness);
+    }
+}
+
+#[test]
+fn classifier_score_is_f_on_near_and_one_minus_f_on_far() {
+    let t = task(Nav1dConfig {
+        objective: Objective::Classify,
+        ..Nav1dConfig::default()
+    });
+    // Classifier neuron 2 fires at f(-theta) = c whatever happens; motors off.
+    let theta_c = -1.5f64;
+    let c = 1.0 / (1.0 + theta_c.exp());
+    let net = constant(&[0.0, 0.0, theta_c, 0.0, 0.0], 2);
+    let fitness = t.evaluate(std::slice::from_ref(&net), 0, 0, None).unwrap()[0];
+    assert!((fitness - 0.5 * (c + (1.0 - c))).abs() < 1e-15);
+    let near = Condition::exact(t.config(), Environment::Near, Side::Left);
+    let far = Condition::exact(t.config(), Environment::Far, Side::Left);
+    assert_eq!(t.judge(0, &near, false, 0.8), Some((0.8, true)));
+    assert_eq!(t.judge(0, &far, false, 0.8), Some((1.0 - 0.8, false)));
+    assert_eq!(t.judge(0, &far, true, 0.2), Some((0.8, true)));
+    let a = t.assess(&net, 40, 1).unwrap();
+    // c > 0.5: every near trial right, every far trial wrong.
+    let near_share = a
+        .episodes
+        .iter()
+        .filter(|e| e.environment == Environment::Near)
+        .count() as f64
+        / 40.0;
+    assert_eq!(a.rate, near_share);
+    assert!(!a.success);
+}
+
+#[test]
+fn single_scores_trials_after_the_first_and_keeps_state() {
+    let t = task(Nav1dConfig {
+        objective: Objective::Single,
+        trials_per_environment: 4,
+        ..Nav1dConfig::default()
+    });
+    let chains = t.chains(5, 2);
+    assert_eq!(chains.len(), 4);
+    assert!(chains.iter().all(|c| c.len() == 4));
+    let environments: Vec<Environment> = chains.iter().map(|c| c[0].environment).collect();
+    use Environment::{Far, Near};
+    assert_eq!(environments, vec![Far, Far, Near, Near]);
+    let net = rightward(2);
+    let expected: f64 = chains
+        .iter()
+        .flat_map(|c| c[1..].iter())
+        .filter(|c| c.goal == Side::Right)
+        .count() as f64
+        / 12.0;
+    assert_eq!(t.evaluate(&[net], 2, 5, None).unwrap(), vec![expected]);
+    // A recorded chain without reset continues from the state the network carries.
+    let nets = random_networks(1, 5, 2, 3);
+    let whole = t.record(&nets[0], &chains[0], true).unwrap();
+    let head = t.record(&nets[0], &chains[0][..1], true).unwrap();
+    let mut cont = nets[0].clone();
+    cont.set_state(Some(&head.final_state)).unwrap();
+    let tail = t.record(&cont, &chains[0][1..], false).unwrap();
+    assert_eq!(whole.reached, [head.reached, tail.reached].concat());
+    assert_eq!(whole.final_state, tail.final_state);
+}
+
+#[test]
+fn fresh_chains_are_keyed_by_seed_and_cover_the_environments() {
+    let t = task(Nav1dConfig {
+        landmark_jitter: 0.5,
+        ..Nav1dConfig::default()
+    });
+    let a = t.fresh_chains(200, 3, 1);
+    assert_eq!(a, t.fresh_chains(200, 3, 1));
+    assert_ne!(a, t.fresh_chains(200, 3, 2));
+    let near = a
+        .iter()
+        .filter(|c| c[0].environment == Environment::Near)
+        .count();
+    assert!((70..130).contains(&near), "{near}");
+    for chain in &a {
+        for c in chain {
+            assert_eq!(c.environment, chain[0].environment);
+            let side = if c.landmark > 0.0 {
+                Side::Right
+            } else {
+                Side::Left
+            };
+            let expect = match c.environment {
+                Environment::Near => c.goal,
+                Environment::Far => c.goal.opposite(),
+            };
+            assert_eq!(side, expect);
+            assert!((c.landmark.abs() - 10.0).abs() <= 0.5);
+        }
+    }
+}
+
+#[test]
+fn the_system_picks_a_network_by_the_classification() {
+    let base = Nav1dConfig::default();
+    let classify = Nav1dTask::new(Nav1dConfig {
+        objective: Objective::Classify,
+        ..base.clone()
+    })
+    .unwrap();
+    let goal = Nav1dTask::new(base).unwrap();
+    let leftward = constant(&[-8.0, 8.0, 0.0, 0.0, 0.0], 2);
+    let part = |task: &Nav1dTask, network: &Network| Part {
+        task: task.clone(),
+        network: network.clone(),
+    };
+    // The classifier stands still and says "near" (f(v_C) = f(2) > 0.5): the near network, which
+    // always goes right, drives trials 2.., and the far network (always left) never does.
+    let says_near = constant(&[0.0, 0.0, -2.0, 0.0, 0.0], 2);
+    let system = System::new(
+        part(&classify, &says_near),
+        part(&goal, &leftward),
+        part(&goal, &rightward(2)),
+    )
+    .unwrap();
+    let report = system.assess(30, 4, 8).unwrap();
+    for ep in &report.episodes {
+        assert_eq!(ep.chosen, Environment::Near);
+        assert!(!ep.reached[0]);
+        for (c, &r) in ep.conditions[1..].iter().zip(&ep.reached[1..]) {
+            assert_eq!(r, c.goal == Side::Right);
+        }
+    }
+    let near = report
+        .episodes
+        .iter()
+        .filter(|e| e.environment == Environment::Near)
+        .count();
+    assert_eq!(report.classification_rate, near as f64 / 30.0);
+    let (a, b, chosen) = system.record(&report.episodes[0].conditions).unwrap();
+    assert_eq!(chosen, Environment::Near);
+    assert_eq!(a.reached.len(), 1);
+    assert_eq!(b.reached, report.episodes[0].reached[1..]);
+    // Parts must share a world.
+    let other = Nav1dTask::new(Nav1dConfig {
+        half_length: 30.0,
+        ..Nav1dConfig::default()
+    })
+    .unwrap();
+    let e = System::new(
+        part(&classify, &says_near),
+        part(&other, &leftward),
+        part(&goal, &leftward),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("far network's half_length is 30"), "{e}");
+    // Each part must have its role.
+    let e = System::new(
+        part(&goal, &says_near),
+        part(&goal, &leftward),
+        part(&goal, &leftward),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("classifier network's task has objective \"goal\""),
+        "{e}"
+    );
+    let far_only = Nav1dTask::new(Nav1dConfig {
+        environments: vec![Environment::Far],
+        ..Nav1dConfig::default()
+    })
+    .unwrap();
+    let e = System::new(
+        part(&classify, &says_near),
+        part(&goal, &leftward),
+        part(&far_only, &leftward),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("near network's task"), "{e}");
+}
+
+#[test]
+fn config_errors_name_the_field() {
+    let err = |p: serde_json::Value| Nav1dTask::from_params(&p).unwrap_err().to_string();
+    use serde_json::json;
+    assert!(err(json!({"environments": []})).contains("environments is empty"));
+    assert!(err(json!({"environments": ["far", "far"]})).contains("repeats"));
+    assert!(err(json!({"environments": ["middle"]})).contains("unknown variant `middle`"));
+    assert!(err(json!({"left_motor": 7})).contains("left_motor is 7"));
+    assert!(
+        err(json!({"left_motor": 1})).contains("left_motor is 1, the same neuron as")
+            || err(json!({"left_motor": 1})).contains("right_motor is 1, the same neuron as")
+    );
+    assert!(err(json!({"objective": "classify", "classifier": 1}))
+        .contains("classifier is 1, the same neuron as right_motor"));
+    assert!(
+        err(json!({"objective": "single", "trials_per_environment": 1}))
+            .contains("trials_per_environment is 1")
+    );
+    assert!(err(json!({"half_length": -1.0})).contains("half_length is -1"));
+    assert!(err(json!({"landmark_offset": 19.0})).contains("landmark_offset is 19"));
+    assert!(err(json!({"start": 25.0})).contains("start is 25"));
+    assert!(err(json!({"max_steps": 0})).contains("max_steps is 0"));
+    assert!(err(json!({"landmark_jitter": -1.0})).contains("landmark_jitter is -1"));
+    assert!(
+        err(json!({"integrator": {"method": "euler", "dt": 0.0, "substeps": 1}}))
+            .contains("integrator")
+    );
+    assert!(err(json!({"landmarks": 1})).contains("unknown field `landmarks`"));
+    // A goal task needs no classifier neuron; a 2-neuron network is enough.
+    let t = Nav1dTask::from_params(&json!({"size": 2, "classifier": 9})).unwrap();
+    assert_eq!(t.layout().size, 2);
+}
+
+#[test]
+fn recorded_conditions_are_checked() {
+    let t = goal_task(&[Environment::Far]);
+    let mut c = Condition::exact(t.config(), Environment::Far, Side::Left);
+    c.start = 25.0;
+    let e = t.record(&rightward(2), &[c], true).unwrap_err().to_string();
+    assert!(e.contains("conditions[0] has start 25"), "{e}");
+    let empty = t.record(&rightward(2), &[], true).unwrap();
+    assert!(empty.x.is_empty() && empty.reached.is_empty());
+}
+
+#[test]
+fn wrong_networks_are_errors() {
+    let t = task(Nav1dConfig {
+        objective: Objective::Classify,
+        ..Nav1dConfig::default()
+    });
+    let e = t
+        .evaluate(&[constant(&[0.0; 5], 1)], 0, 0, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("M = 1") && e.contains("landmark, reinforcement"),
+        "{e}"
+    );
+    let e = t
+        .evaluate(&[constant(&[0.0; 2], 2)], 0, 0, None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("N must be at least 3"), "{e}");
+}
+
+#[test]
+fn layout_follows_the_sensors() {
+    let t = task(Nav1dConfig {
+        reinforcement_input: false,
+        size: 6,
+        ..Nav1dConfig::default()
+    });
+    assert_eq!((t.layout().size, t.layout().n_inputs), (6, 1));
+}
+
+#[test]
+fn chained_goal_trials_run_both_orders_without_reset() {
+    let t = task(Nav1dConfig {
+        chained: true,
+        trials_per_environment: 3,
+        ..Nav1dConfig::default()
+    });
+    let chains = t.chains(0, 0);
+    let goals: Vec<Vec<Side>> = chains
+        .iter()
+        .map(|c| c.iter().map(|x| x.goal).collect())
+        .collect();
+    use Side::{Left, Right};
+    assert_eq!(
+        goals,
+        vec![
+            vec![Left, Right],
+            vec![Right, Left],
+            vec![Left, Right],
+            vec![Right, Left]
+        ]
+    );
+    assert_eq!(t.chain_len(), 3);
+    assert_eq!(t.evaluate(&[rightward(2)], 0, 0, None).unwrap(), vec![0.5]);
+    let e = Nav1dTask::from_params(&serde_json::json!({"objective": "classify", "chained": true}))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("chained is true"), "{e}");
+}

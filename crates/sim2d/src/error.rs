@@ -1,0 +1,111 @@
+//! The crate's one error type.
+//!
+//! Every fallible function of `sim2d` returns [`Error`]. A message names the field that was wrong,
+//! its value and what is allowed, for example `sonar.cone_deg is -3; it must be in (0, 180)`.
+
+use std::fmt::Display;
+
+/// Everything that can go wrong in `sim2d`: bad parameters, bad world files, impossible starts.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A parameter or argument is outside its allowed range.
+    #[error("{field} is {value}; it must be {allowed}")]
+    Invalid {
+        /// The field's path, such as `boxes[1].size[0]` or `sonar.cone_deg`.
+        field: String,
+        /// The offending value, as written by `Display`.
+        value: String,
+        /// What is allowed, such as `in (0, 180)`.
+        allowed: String,
+    },
+    /// A world file is not valid TOML or does not have the world's fields.
+    #[error("world file: {0}")]
+    Toml(String),
+    /// Rejection sampling found no start position in the start region that keeps the robot clear
+    /// of every wall and box.
+    #[error(
+        "no start pose: {attempts} random positions in the start region all put a robot of radius \
+         {radius} m closer than {clearance} m to a wall or box; enlarge start or move the boxes"
+    )]
+    NoStartPose {
+        /// How many positions were tried.
+        attempts: u32,
+        /// The robot's radius in metres.
+        radius: f64,
+        /// The clearance that was required, in metres.
+        clearance: f64,
+    },
+}
+
+impl Error {
+    /// An [`Error::Invalid`] for `field` with `value`, which must be `allowed`.
+    pub(crate) fn invalid(field: impl Into<String>, value: impl Display, allowed: &str) -> Self {
+        Error::Invalid {
+            field: field.into(),
+            value: value.to_string(),
+            allowed: allowed.to_string(),
+        }
+    }
+}
+
+/// Checks that `value` is finite and inside the interval `(lo, hi)` with the given closedness;
+/// returns an [`Error::Invalid`] for `field` otherwise.
+pub(crate) fn check_range(
+    field: &str,
+    value: f64,
+    lo: f64,
+    lo_closed: bool,
+    hi: f64,
+    hi_closed: bool,
+) -> Result<(), Error> {
+    let above = if lo_closed { value >= lo } else { value > lo };
+    let below = if hi_closed { value <= hi } else { value < hi };
+    if value.is_finite() && above && below {
+        return Ok(());
+    }
+    let allowed = match (lo == f64::NEG_INFINITY, hi == f64::INFINITY) {
+        (true, true) => "a finite number".to_string(),
+        (false, true) => format!(
+            "a finite number {} {lo}",
+            if lo_closed { ">=" } else { ">" }
+        ),
+        (true, false) => format!(
+            "a finite number {} {hi}",
+            if hi_closed { "<=" } else { "<" }
+        ),
+        (false, false) => format!(
+            "in {}{lo}, {hi}{}",
+            if lo_closed { '[' } else { '(' },
+            if hi_closed { ']' } else { ')' }
+        ),
+    };
+    Err(Error::invalid(field, value, &allowed))
+}
+
+/// Checks that `value` is a finite number.
+pub(crate) fn check_finite(field: &str, value: f64) -> Result<(), Error> {
+    check_range(field, value, f64::NEG_INFINITY, false, f64::INFINITY, false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_name_field_value_and_range() {
+        let e = check_range("sonar.cone_deg", -3.0, 0.0, false, 180.0, false).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "sonar.cone_deg is -3; it must be in (0, 180)"
+        );
+        let e = check_range("robot.radius", 0.0, 0.0, false, f64::INFINITY, false).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "robot.radius is 0; it must be a finite number > 0"
+        );
+        let e = check_finite("x", f64::NAN).unwrap_err();
+        assert_eq!(e.to_string(), "x is NaN; it must be a finite number");
+        assert!(check_range("p", 1.0, 0.0, true, 1.0, true).is_ok());
+    }
+}

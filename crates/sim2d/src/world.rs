@@ -1,0 +1,390 @@
+//! The world's geometry: the room's four walls and its boxes as parry2d shapes, with ray casts
+//! and disc clearance queries.
+//!
+//! Shapes are built once by [`World::new`]; queries allocate nothing. parry2d 0.25 computes in
+//! `f32`, so distances carry an error of about `1e-6` m in a room of a few metres; the public API
+//! is in `f64`.
+
+use std::f64::consts::PI;
+
+use ctrnn::rng::Stream;
+use parry2d::math::{Isometry, Point, Real, Vector};
+use parry2d::query::{PointQuery, Ray, RayCast};
+use parry2d::shape::Cuboid;
+
+use crate::error::{check_range, Error};
+use crate::pose::Pose;
+use crate::world_spec::WorldSpec;
+
+/// How many random positions [`World::random_pose`] tries before giving up.
+pub const START_ATTEMPTS: u32 = 10_000;
+
+/// The thickness of each wall slab outside the room, in metres (any positive value works).
+const WALL_THICKNESS: f64 = 1.0;
+
+/// What a ray hit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Surface {
+    /// One of the room's four walls.
+    Wall,
+    /// The box with this index in [`WorldSpec::boxes`].
+    Box(usize),
+}
+
+/// The nearest intersection of a ray with the world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// The distance from the ray's origin to the hit point, in metres.
+    pub distance: f64,
+    /// The hit point `[x, y]`.
+    pub point: [f64; 2],
+    /// The surface's outward unit normal at the hit point (pointing back into the room).
+    pub normal: [f64; 2],
+    /// What was hit.
+    pub surface: Surface,
+}
+
+/// One convex obstacle: a cuboid placed by an isometry.
+#[derive(Clone, Debug)]
+struct Obstacle {
+    pose: Isometry<Real>,
+    shape: Cuboid,
+    surface: Surface,
+}
+
+/// A room with walls and boxes, ready for ray casts and clearance queries.
+///
+/// # Example
+/// ```
+/// use sim2d::{Surface, World, WorldSpec};
+/// let world = World::new(&WorldSpec::landmark(1)?)?;
+/// // From (1, 2.5) looking +x: the landmark's left face is at x = 2.4.
+/// let hit = world.cast_ray([1.0, 2.5], [1.0, 0.0], 10.0).unwrap();
+/// assert!((hit.distance - 1.4).abs() < 1e-5);
+/// assert_eq!(hit.surface, Surface::Box(0));
+/// // Looking -x, the left wall at x = 0.
+/// let hit = world.cast_ray([1.0, 2.5], [-1.0, 0.0], 10.0).unwrap();
+/// assert_eq!((hit.surface, hit.normal), (Surface::Wall, [1.0, 0.0]));
+/// // A robot of radius 0.265 at (1, 1) is 0.735 m from the nearest wall.
+/// assert!((world.clearance([1.0, 1.0], 0.265) - 0.735).abs() < 1e-5);
+/// # Ok::<(), sim2d::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct World {
+    spec: WorldSpec,
+    /// The four walls first, then the boxes in order.
+    obstacles: Vec<Obstacle>,
+}
+
+fn isometry(center: [f64; 2], angle: f64) -> Isometry<Real> {
+    Isometry::new(
+        Vector::new(center[0] as Real, center[1] as Real),
+        angle as Real,
+    )
+}
+
+fn cuboid(size: [f64; 2]) -> Cuboid {
+    Cuboid::new(Vector::new(0.5 * size[0] as Real, 0.5 * size[1] as Real))
+}
+
+impl World {
+    /// Validates `spec` and builds its shapes: four wall slabs just outside the room (overlapping
+    /// at the corners) and one cuboid per box.
+    pub fn new(spec: &WorldSpec) -> Result<World, Error> {
+        spec.validate()?;
+        let [w, h] = spec.room;
+        let t = WALL_THICKNESS;
+        let walls = [
+            ([0.5 * w, -0.5 * t], [w + 2.0 * t, t]),    // bottom
+            ([w + 0.5 * t, 0.5 * h], [t, h + 2.0 * t]), // right
+            ([0.5 * w, h + 0.5 * t], [w + 2.0 * t, t]), // top
+            ([-0.5 * t, 0.5 * h], [t, h + 2.0 * t]),    // left
+        ];
+        let mut obstacles = Vec::with_capacity(4 + spec.boxes.len());
+        for (center, size) in walls {
+            obstacles.push(Obstacle {
+                pose: isometry(center, 0.0),
+                shape: cuboid(size),
+                surface: Surface::Wall,
+            });
+        }
+        for (i, b) in spec.boxes.iter().enumerate() {
+            obstacles.push(Obstacle {
+                pose: isometry(b.center, b.angle_deg.to_radians()),
+                shape: cuboid(b.size),
+                surface: Surface::Box(i),
+            });
+        }
+        Ok(World {
+            spec: spec.clone(),
+            obstacles,
+        })
+    }
+
+    /// The world's description.
+    pub fn spec(&self) -> &WorldSpec {
+        &self.spec
+    }
+
+    /// The room's `[width, height]` in metres.
+    pub fn room(&self) -> [f64; 2] {
+        self.spec.room
+    }
+
+    /// The nearest hit of the ray from `origin` along `dir` within `max_distance`, over all walls
+    /// and boxes; `None` if nothing is that close.
+    ///
+    /// `dir` need not be a unit vector; a zero or non-finite `dir` hits nothing. An origin inside
+    /// a wall or box hits it at distance 0. Allocates nothing.
+    pub fn cast_ray(&self, origin: [f64; 2], dir: [f64; 2], max_distance: f64) -> Option<Hit> {
+        let norm = dir[0].hypot(dir[1]);
+        if !(norm > 0.0 && norm.is_finite() && max_distance >= 0.0) {
+            return None;
+        }
+        let ray = Ray::new(
+            Point::new(origin[0] as Real, origin[1] as Real),
+            Vector::new((dir[0] / norm) as Real, (dir[1] / norm) as Real),
+        );
+        let mut best_toi = max_distance.min(f32::MAX as f64) as Real;
+        let mut best = None;
+        for ob in &self.obstacles {
+            if let Some(hit) = ob
+                .shape
+                .cast_ray_and_get_normal(&ob.pose, &ray, best_toi, true)
+            {
+                if hit.time_of_impact <= best_toi {
+                    best_toi = hit.time_of_impact;
+                    best = Some((hit, ob.surface));
+                }
+            }
+        }
+        best.map(|(hit, surface)| {
+            let p = ray.point_at(hit.time_of_impact);
+            Hit {
+                distance: hit.time_of_impact as f64,
+                point: [p.x as f64, p.y as f64],
+                normal: [hit.normal.x as f64, hit.normal.y as f64],
+                surface,
+            }
+        })
+    }
+
+    /// The signed clearance of a disc: the distance from the disc's edge to the nearest wall or
+    /// box, negative by the depth of the deepest overlap when it overlaps one.
+    ///
+    /// Allocates nothing.
+    pub fn clearance(&self, center: [f64; 2], radius: f64) -> f64 {
+        let p = Point::new(center[0] as Real, center[1] as Real);
+        let mut nearest = f64::INFINITY;
+        for ob in &self.obstacles {
+            let proj = ob.shape.project_point(&ob.pose, &p, false);
+            let d = (proj.point - p).norm() as f64;
+            let signed = if proj.is_inside { -d } else { d };
+            nearest = nearest.min(signed);
+        }
+        nearest - radius
+    }
+
+    /// Calls `f(signed_distance, outward_normal)` for each wall and box: the signed distance from
+    /// `point` to it (negative inside) and the unit vector along which that distance grows fastest
+    /// (`[0, 0]` when the point is on the boundary). Allocates nothing.
+    pub(crate) fn for_each_distance(&self, point: [f64; 2], mut f: impl FnMut(f64, [f64; 2])) {
+        let p = Point::new(point[0] as Real, point[1] as Real);
+        for ob in &self.obstacles {
+            let proj = ob.shape.project_point(&ob.pose, &p, false);
+            let diff = p - proj.point;
+            let d = diff.norm() as f64;
+            let (signed, sign) = if proj.is_inside { (-d, -1.0) } else { (d, 1.0) };
+            let n = if d > 0.0 {
+                [sign * diff.x as f64 / d, sign * diff.y as f64 / d]
+            } else {
+                [0.0, 0.0]
+            };
+            f(signed, n);
+        }
+    }
+
+    /// Whether a disc overlaps a wall or a box (its clearance is negative).
+    pub fn disc_overlaps(&self, center: [f64; 2], radius: f64) -> bool {
+        self.clearance(center, radius) < 0.0
+    }
+
+    /// A random start pose for a robot of `radius`: a position uniform in the start region, redrawn
+    /// until the robot's clearance is at least `min_clearance` (up to [`START_ATTEMPTS`] draws),
+    /// then a heading uniform in `[-pi, pi)`.
+    ///
+    /// Draws two uniforms per tried position, then one for the heading. Returns
+    /// [`Error::NoStartPose`] if every draw was too close to a wall or box.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::rng::{Purpose, Stream};
+    /// let world = sim2d::World::new(&sim2d::WorldSpec::landmark(2)?)?;
+    /// let mut s = Stream::new(0, 0, Purpose::Trial, 0, 0);
+    /// let pose = world.random_pose(0.265, 0.05, &mut s)?;
+    /// assert!(world.clearance(pose.position(), 0.265) >= 0.05);
+    /// # Ok::<(), sim2d::Error>(())
+    /// ```
+    pub fn random_pose(
+        &self,
+        radius: f64,
+        min_clearance: f64,
+        stream: &mut Stream,
+    ) -> Result<Pose, Error> {
+        check_range("radius", radius, 0.0, false, f64::INFINITY, false)?;
+        check_range(
+            "min_clearance",
+            min_clearance,
+            0.0,
+            true,
+            f64::INFINITY,
+            false,
+        )?;
+        let (lo, hi) = (self.spec.start.min, self.spec.start.max);
+        for _ in 0..START_ATTEMPTS {
+            let x = stream.range(lo[0], hi[0]);
+            let y = stream.range(lo[1], hi[1]);
+            if self.clearance([x, y], radius) >= min_clearance {
+                let heading = stream.range(-PI, PI);
+                return Ok(Pose::new(x, y, heading));
+            }
+        }
+        Err(Error::NoStartPose {
+            attempts: START_ATTEMPTS,
+            radius,
+            clearance: min_clearance,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world_spec::{BoxSpec, StartRegion};
+    use ctrnn::rng::Purpose;
+
+    const TOL: f64 = 2e-5; // f32 arithmetic in parry2d
+
+    fn world(boxes: Vec<BoxSpec>) -> World {
+        World::new(&WorldSpec {
+            room: [10.0, 8.0],
+            boxes,
+            start: StartRegion {
+                min: [0.5, 0.5],
+                max: [9.5, 7.5],
+            },
+        })
+        .unwrap()
+    }
+
+    fn square(center: [f64; 2], side: f64, angle_deg: f64) -> BoxSpec {
+        BoxSpec {
+            center,
+            size: [side, side],
+            angle_deg,
+        }
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < TOL
+    }
+
+    #[test]
+    fn ray_against_axis_aligned_box() {
+        // A 2 x 1 box centred at (5, 4): faces at x = 4 and 6, y = 3.5 and 4.5.
+        let w = world(vec![BoxSpec {
+            center: [5.0, 4.0],
+            size: [2.0, 1.0],
+            angle_deg: 0.0,
+        }]);
+        // From (1, 4.2) along +x: the face x = 4 at distance 3.
+        let h = w.cast_ray([1.0, 4.2], [1.0, 0.0], 100.0).unwrap();
+        assert!(close(h.distance, 3.0), "{h:?}");
+        assert!(close(h.point[0], 4.0) && close(h.point[1], 4.2));
+        assert_eq!(h.normal, [-1.0, 0.0]);
+        assert_eq!(h.surface, Surface::Box(0));
+        // From (5.5, 0.5) along +y: the bottom face y = 3.5 at distance 3.
+        let h = w.cast_ray([5.5, 0.5], [0.0, 2.0], 100.0).unwrap();
+        assert!(close(h.distance, 3.0) && h.normal == [0.0, -1.0], "{h:?}");
+        // From (1, 1) along (3, 2.6): the ray meets x = 4 at y = 3.6, on the left face just above
+        // the corner (4, 3.5), at distance sqrt(9 + 6.76) = 3.96989.
+        let h = w.cast_ray([1.0, 1.0], [3.0, 2.6], 100.0).unwrap();
+        assert!(close(h.distance, (9.0f64 + 6.76).sqrt()), "{h:?}");
+        assert!(close(h.point[0], 4.0) && close(h.point[1], 3.6));
+        // Past the box along y = 4.6 (above its top face): the right wall x = 10 at distance 9.
+        let h = w.cast_ray([1.0, 4.6], [1.0, 0.0], 100.0).unwrap();
+        assert!(close(h.distance, 9.0) && h.surface == Surface::Wall);
+        assert_eq!(h.normal, [-1.0, 0.0]);
+        // A range shorter than the box: nothing.
+        assert!(w.cast_ray([1.0, 4.2], [1.0, 0.0], 2.9).is_none());
+        // A zero direction: nothing.
+        assert!(w.cast_ray([1.0, 4.2], [0.0, 0.0], 9.0).is_none());
+    }
+
+    #[test]
+    fn ray_against_rotated_box() {
+        // A unit-sided square at (5, 4) turned 45 degrees: a diamond whose corners are
+        // 1/sqrt(2) = 0.70711 from the centre along the axes, and whose faces are 0.5 from it.
+        let w = world(vec![square([5.0, 4.0], 1.0, 45.0)]);
+        let half_diag = 0.5 * 2f64.sqrt();
+        // Along +x from (1, 4): the left corner at x = 5 - 0.70711, distance 4 - 0.70711.
+        let h = w.cast_ray([1.0, 4.0], [1.0, 0.0], 100.0).unwrap();
+        assert!(close(h.distance, 4.0 - half_diag), "{h:?}");
+        // Along the face normal (1, 1)/sqrt 2 from (3, 2), aimed at the centre: the lower-left face
+        // is 0.5 before the centre, which is 2 sqrt 2 = 2.82843 away: distance 2.32843, and the
+        // face's normal is (-1, -1)/sqrt 2, so incidence is 0.
+        let h = w.cast_ray([3.0, 2.0], [1.0, 1.0], 100.0).unwrap();
+        assert!(close(h.distance, 2.0 * 2f64.sqrt() - 0.5), "{h:?}");
+        let n = -(0.5f64.sqrt());
+        assert!(close(h.normal[0], n) && close(h.normal[1], n), "{h:?}");
+        // A ray along y = 4.3 from the left meets the upper-left face, the line from the left corner
+        // (4.29289, 4) to the top corner (5, 4.70711), i.e. x - y = 0.29289: x = 4.59289, at
+        // distance 3.59289 from x = 1.
+        let h = w.cast_ray([1.0, 4.3], [1.0, 0.0], 100.0).unwrap();
+        assert!(close(h.distance, 4.3 - half_diag), "{h:?}");
+    }
+
+    #[test]
+    fn walls_bound_the_room_and_rays_from_inside_a_box_stop_at_once() {
+        let w = world(vec![square([5.0, 4.0], 1.0, 0.0)]);
+        let h = w.cast_ray([2.0, 1.0], [0.0, -1.0], 100.0).unwrap();
+        assert!(close(h.distance, 1.0) && h.normal == [0.0, 1.0]);
+        let h = w.cast_ray([2.0, 1.0], [-1.0, 0.0], 100.0).unwrap();
+        assert!(close(h.distance, 2.0) && h.normal == [1.0, 0.0]);
+        let h = w.cast_ray([2.0, 7.0], [0.0, 1.0], 100.0).unwrap();
+        assert!(close(h.distance, 1.0) && h.normal == [0.0, -1.0]);
+        let h = w.cast_ray([5.0, 4.0], [0.0, 1.0], 100.0).unwrap();
+        assert_eq!(h.distance, 0.0);
+    }
+
+    #[test]
+    fn clearance_is_signed() {
+        let w = world(vec![square([5.0, 4.0], 1.0, 0.0)]);
+        assert!(close(w.clearance([1.0, 4.0], 0.25), 0.75)); // left wall
+        assert!(close(w.clearance([3.0, 4.0], 0.25), 1.25)); // box face x = 4.5
+        assert!(close(w.clearance([4.0, 4.0], 0.25), 0.25));
+        assert!(close(w.clearance([4.6, 4.0], 0.25), -0.35)); // 0.1 inside the box
+        assert!(close(w.clearance([0.1, 4.0], 0.25), -0.15)); // into the left wall
+        assert!(w.disc_overlaps([0.1, 4.0], 0.25));
+        assert!(!w.disc_overlaps([1.0, 4.0], 0.25));
+        // Towards the box's corner (4.5, 3.5) from (4, 3): sqrt(0.5) = 0.70711.
+        assert!(close(w.clearance([4.0, 3.0], 0.0), 0.5f64.sqrt()));
+    }
+
+    #[test]
+    fn random_pose_is_clear_reproducible_and_fails_cleanly() {
+        let w = World::new(&WorldSpec::landmark(1).unwrap()).unwrap();
+        for t in 0..100 {
+            let mut s = Stream::new(3, 0, Purpose::Trial, 0, t);
+            let p = w.random_pose(0.265, 0.05, &mut s).unwrap();
+            assert!(w.clearance(p.position(), 0.265) >= 0.05);
+            assert!((-PI..PI).contains(&p.heading));
+            let mut s2 = Stream::new(3, 0, Purpose::Trial, 0, t);
+            assert_eq!(w.random_pose(0.265, 0.05, &mut s2).unwrap(), p);
+        }
+        let mut s = Stream::new(3, 0, Purpose::Trial, 0, 0);
+        let e = w.random_pose(3.0, 0.0, &mut s).unwrap_err();
+        assert!(matches!(e, Error::NoStartPose { .. }));
+        assert!(w.random_pose(-1.0, 0.0, &mut s).is_err());
+    }
+}

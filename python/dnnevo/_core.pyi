@@ -18,6 +18,8 @@ __all__ = [
     "encode",
     "evaluate",
     "run_population",
+    "landmark_assess",
+    "landmark_record",
     "nav1d_assess",
     "nav1d_chains",
     "nav1d_exact",
@@ -28,6 +30,8 @@ __all__ = [
     "sequence_assess",
     "sequence_timings",
     "sequence_trial",
+    "sim2d_cast_rays",
+    "sim2d_landmark_world",
     "task_layout",
     "task_names",
     "task_success",
@@ -205,3 +209,13 @@ def nav1d_system_record(
     conditions: str,
     persist_state: bool = True,
 ) -> str: ...
+def landmark_record(
+    params: str, net: Network, landmark: int, seed: int, trial: int, robot_like: bool = False
+) -> str: ...
+def landmark_assess(
+    params: str, net: Network, per_landmark: int, seed: int, robot_like: bool = False
+) -> str: ...
+def sim2d_cast_rays(
+    world: str, origins: npt.ArrayLike, directions: npt.ArrayLike, max_distance: float
+) -> npt.NDArray[np.float64]: ...
+def sim2d_landmark_world(n: int) -> str: ...

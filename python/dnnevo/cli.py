@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 import dnnevo
-from dnnevo import _cli_nav1d, presets
+from dnnevo import _cli_landmark, _cli_nav1d, presets
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import DnnevoError
+from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.rundir import RunDir, write_atomic
 
 EXAMPLES = """examples:
@@ -31,6 +31,7 @@ EXAMPLES = """examples:
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
   dnnevo run nav1d-classifier --out runs/cls       the paper's navigation classifier (6 s)
   dnnevo nav1d-system --classifier runs/cls --far runs/far --near runs/near
+  dnnevo run landmark --out runs/lm && dnnevo evaluate runs/lm --trials 100 --robot-like
 """
 
 
@@ -126,6 +127,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="fresh trials per target (sequence), fresh chains of trials (nav1d), "
                         "or evaluations for other tasks (default 100)")
     p.add_argument("--seed", type=_nonnegative, default=None, help="seed of the fresh conditions")
+    p.add_argument("--robot-like", action="store_true",
+                   help="landmark runs: sonar noise, specular misses and a jittered room")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        epilog="example: dnnevo plot runs/demo")
@@ -230,8 +233,12 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     if config.task == "sequence":
         return _evaluate_sequence(args, config, champion, seed)
+    if args.robot_like and config.task != "landmark":
+        raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
     if config.task == "nav1d":
         return _cli_nav1d.evaluate(args, config, champion, seed)
+    if config.task == "landmark":
+        return _cli_landmark.evaluate(args, config, champion, seed)
     fitness = np.array([
         dnnevo.evaluate(config.task, [champion], generation=k, seed=seed, config=config)[0]
         for k in range(args.trials)
@@ -284,6 +291,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         written += _plot_sequence(run, config, args.seed)
     if config.task == "nav1d":
         written += _cli_nav1d.plot(run, config, args.seed)
+    if config.task == "landmark":
+        written += _cli_landmark.plot(run, config, args.seed)
     print(f"wrote {', '.join(str(run.path / w) for w in written)}")
     return 0
 

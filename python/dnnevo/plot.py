@@ -14,10 +14,11 @@ import numpy.typing as npt
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
+    from dnnevo.landmark import Record as LandmarkRecord
     from dnnevo.nav1d import Record as Nav1dRecord
     from dnnevo.sequence import TrialRecord
 
-__all__ = ["plot_fitness", "plot_nav1d_path", "plot_nav1d_traces", "plot_sequence_trial", "plot_traces"]
+__all__ = ["plot_fitness", "plot_landmark_world", "plot_nav1d_path", "plot_nav1d_traces", "plot_sequence_trial", "plot_traces"]
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -176,3 +177,33 @@ def plot_nav1d_traces(
     return plot_traces({"landmark": record.landmark, "reinforcement": record.reinforcement},
                        record.outputs, ax, labels=labels, highlight=classifier if classifier < n else None,
                        title=title)
+
+
+def plot_landmark_world(
+    record: LandmarkRecord, ax: Axes | None = None, *, title: str | None = None
+) -> Axes:
+    """A top-down view of a landmark trial: the room's walls, the boxes, the robot's path (start
+    marked) and where the sonar's echoes landed."""
+    from matplotlib.patches import Rectangle
+
+    ax = _axes(ax)
+    w, h = record.world["room"]
+    ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2.5, color="0.2"))
+    for box in record.world["boxes"]:
+        (cx, cy), (sx, sy) = box["center"], box["size"]
+        ax.add_patch(Rectangle((cx - sx / 2, cy - sy / 2), sx, sy, angle=box.get("angle_deg", 0.0),
+                               rotation_point="center", color="tab:brown", alpha=0.8))
+    ax.plot(record.poses[:, 0], record.poses[:, 1], color="tab:blue", lw=1.2, label="robot path")
+    ax.plot(*record.poses[0, :2], marker="o", color="tab:blue", ls="none", label="start")
+    hit = ~np.isnan(record.echoes[:, 0])
+    ax.scatter(record.echoes[hit, 0], record.echoes[hit, 1], s=4, color="tab:red", alpha=0.5,
+               label="sonar echoes")
+    ax.set_xlim(-0.3, w + 0.3)
+    ax.set_ylim(-0.3, h + 0.3)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.legend(loc="upper right", fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return ax

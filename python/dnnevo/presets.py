@@ -110,6 +110,15 @@ PRESETS: dict[str, Preset] = {
                trials_per_environment=5, chains_per_environment=2, max_steps=300),
         _QUICK,
     ),
+    # The paper solved it by generation 15; 100 generations (4 s) leave room for slower seeds.
+    "landmark": Preset(
+        "paper §3: tell two landmarks apart from a wall-following robot's sonar; "
+        "8 neurons, 100 x 100, 6 trials",
+        EvolutionConfig(task="landmark", population=100, generations=100, crossover_rate=0.5,
+                        mutation_rate=0.025, size=8, n_inputs=1,
+                        task_params={"trials_per_landmark": 3}),
+        {"population": 30, "generations": 5},
+    ),
     "sequence-3bit": Preset(
         "paper §5.4: (011)*, (101)*, (110)*; 10 neurons, 1000 x 700, perf_base 2/3",
         _sequence(["011", "101", "110"], 10, 700, 0.002, 2 / 3),

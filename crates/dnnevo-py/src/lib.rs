@@ -8,6 +8,7 @@ mod detach;
 mod errors;
 mod evolution;
 mod json;
+mod landmark;
 mod nav1d;
 mod network;
 mod sequence;
@@ -20,6 +21,10 @@ mod _core {
     #[pymodule_export]
     use super::evolution::{
         decode, encode, evaluate, task_layout, task_names, task_success, PyEvolution,
+    };
+    #[pymodule_export]
+    use super::landmark::{
+        landmark_assess, landmark_record, sim2d_cast_rays, sim2d_landmark_world,
     };
     #[pymodule_export]
     use super::nav1d::{

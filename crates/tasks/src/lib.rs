@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 mod common;
+pub mod landmark;
 pub mod nav1d;
 pub mod registry;
 pub mod sequence;

@@ -4,16 +4,17 @@
 //! # Example
 //! ```
 //! let e = tasks::build("maze", &serde_json::json!({})).err().unwrap().to_string();
-//! assert!(e.contains("unknown task \"maze\"; known tasks: sequence, nav1d"), "{e}");
+//! assert!(e.contains("unknown task \"maze\"; known tasks: sequence, nav1d, landmark"), "{e}");
 //! ```
 
 use ctrnn::{Error, Result, Task};
 
+use crate::landmark::LandmarkTask;
 use crate::nav1d::Nav1dTask;
 use crate::sequence::SequenceTask;
 
 /// The names [`build`] knows, in the order they are listed in messages.
-const NAMES: &[&str] = &["sequence", "nav1d"];
+const NAMES: &[&str] = &["sequence", "nav1d", "landmark"];
 
 /// The names of the known tasks.
 pub fn names() -> &'static [&'static str] {
@@ -24,7 +25,8 @@ pub fn names() -> &'static [&'static str] {
 /// defaults).
 ///
 /// - `"sequence"`: a [`SequenceConfig`](crate::sequence::SequenceConfig);
-/// - `"nav1d"`: a [`Nav1dConfig`](crate::nav1d::Nav1dConfig).
+/// - `"nav1d"`: a [`Nav1dConfig`](crate::nav1d::Nav1dConfig);
+/// - `"landmark"`: a [`LandmarkConfig`](crate::landmark::LandmarkConfig).
 ///
 /// Unknown names, unknown or mistyped parameters and out-of-range values are [`Error::Config`]
 /// errors that say what was wrong and what is allowed.
@@ -43,6 +45,7 @@ pub fn build(name: &str, params: &serde_json::Value) -> Result<Box<dyn Task>> {
     match name {
         "sequence" => Ok(Box::new(SequenceTask::from_params(params)?)),
         "nav1d" => Ok(Box::new(Nav1dTask::from_params(params)?)),
+        "landmark" => Ok(Box::new(LandmarkTask::from_params(params)?)),
         _ => Err(Error::Config(format!(
             "unknown task {name:?}; known tasks: {}",
             NAMES.join(", ")
@@ -87,7 +90,7 @@ mod tests {
         assert!(matches!(e, Error::Config(_)));
         assert_eq!(
             e.to_string(),
-            "invalid config: unknown task \"x\"; known tasks: sequence, nav1d"
+            "invalid config: unknown task \"x\"; known tasks: sequence, nav1d, landmark"
         );
     }
 }

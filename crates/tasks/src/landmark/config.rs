@@ -1,0 +1,170 @@
+//! The settings of the landmark-recognition experiment: the network, the two worlds, the robot
+//! trial, and the "robot-like" conditions of the stand-in for the paper's real-robot test.
+
+use ctrnn::{Error, Integrator, Method, Result};
+use serde::{Deserialize, Serialize};
+use sim2d::{SimSpec, WorldSpec};
+
+/// Conditions that make a simulated trial more like the real robot's: sonar noise, specular
+/// misses and a jittered room. Each trial draws its own jitter.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RobotLike {
+    /// Gaussian range noise of the network's sonar, in metres. Default 0.03.
+    pub noise_sd: f64,
+    /// Rays hitting a surface at more than this angle of incidence, in degrees, are lost (a
+    /// specular miss). Default 60.
+    pub specular_max_incidence_deg: f64,
+    /// Each box moves by up to this much in x and y, in metres. Default 0.15.
+    pub box_shift: f64,
+    /// The room's width and height each scale by up to this fraction. Default 0.05.
+    pub room_scale: f64,
+}
+
+impl Default for RobotLike {
+    fn default() -> Self {
+        RobotLike {
+            noise_sd: 0.03,
+            specular_max_incidence_deg: 60.0,
+            box_shift: 0.15,
+            room_scale: 0.05,
+        }
+    }
+}
+
+/// The landmark-recognition settings (paper §3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LandmarkConfig {
+    /// Neurons per network N. Default 8.
+    pub size: usize,
+    /// The classifier neuron: `f < 0.5` at the end of a trial means landmark 1. Default 0.
+    pub classifier: usize,
+    /// Trials per landmark in one evaluation. Default 3 (the paper's 6 trials in all).
+    pub trials_per_landmark: usize,
+    /// Simulated seconds per trial. Default 45.
+    pub trial_seconds: f64,
+    /// The sonar input is `min(1, d0 / range)`. Default 0.5 m.
+    pub d0: f64,
+    /// The world of landmark 1. Default the shipped `landmark1.toml` (two crates pushed together).
+    pub landmark1: WorldSpec,
+    /// The world of landmark 2. Default the shipped `landmark2.toml` (two crates 0.6 m apart).
+    pub landmark2: WorldSpec,
+    /// The robot trial: time step, robot, wall follower and the network's sonar (`sonars[0]`, the
+    /// left one, is the input). Default [`SimSpec::default`] (0.1 s steps).
+    pub sim: SimSpec,
+    /// Train (and check success) under robot-like conditions instead of the ideal world.
+    /// Default false.
+    pub train_robot_like: bool,
+    /// What "robot-like" means. Default [`RobotLike::default`].
+    pub robot_like: RobotLike,
+    /// How the network is integrated over one robot step; `dt * substeps` is one unit of network
+    /// time, so by default one robot step of 0.1 s is one network time step. Default 10 Euler
+    /// steps of 0.1.
+    pub integrator: Integrator,
+}
+
+impl Default for LandmarkConfig {
+    fn default() -> Self {
+        LandmarkConfig {
+            size: 8,
+            classifier: 0,
+            trials_per_landmark: 3,
+            trial_seconds: 45.0,
+            d0: sim2d::DEFAULT_D0,
+            landmark1: WorldSpec::landmark(1).expect("the shipped world is valid"),
+            landmark2: WorldSpec::landmark(2).expect("the shipped world is valid"),
+            sim: SimSpec::default(),
+            train_robot_like: false,
+            robot_like: RobotLike::default(),
+            integrator: Integrator {
+                method: Method::Euler,
+                dt: 0.1,
+                substeps: 10,
+            },
+        }
+    }
+}
+
+/// A `sim2d` error as a config error.
+pub(crate) fn config_error(e: sim2d::Error) -> Error {
+    Error::Config(e.to_string())
+}
+
+impl LandmarkConfig {
+    /// Checks every field; the error names the field and says what is allowed.
+    ///
+    /// # Example
+    /// ```
+    /// use tasks::landmark::LandmarkConfig;
+    /// let bad = LandmarkConfig { classifier: 8, ..LandmarkConfig::default() };
+    /// assert!(bad.validate().unwrap_err().to_string().contains("classifier is 8"));
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        let config = |msg: String| Err(Error::Config(msg));
+        for (name, value) in [
+            ("size", self.size),
+            ("trials_per_landmark", self.trials_per_landmark),
+        ] {
+            if value == 0 {
+                return config(format!("{name} is 0; it must be >= 1"));
+            }
+        }
+        if self.classifier >= self.size {
+            return config(format!(
+                "classifier is {}; it must be a neuron index below size ({})",
+                self.classifier, self.size
+            ));
+        }
+        for (name, value) in [("trial_seconds", self.trial_seconds), ("d0", self.d0)] {
+            if !(value.is_finite() && value > 0.0) {
+                return config(format!("{name} is {value}; it must be a number > 0"));
+            }
+        }
+        self.landmark1
+            .validate()
+            .map_err(|e| Error::Config(format!("landmark1: {e}")))?;
+        self.landmark2
+            .validate()
+            .map_err(|e| Error::Config(format!("landmark2: {e}")))?;
+        self.sim
+            .validate()
+            .map_err(|e| Error::Config(format!("sim: {e}")))?;
+        if self.sim.sonars.is_empty() {
+            return config("sim.sonars is empty; the network reads sonars[0]".into());
+        }
+        let r = &self.robot_like;
+        for (name, value, hi) in [
+            ("robot_like.noise_sd", r.noise_sd, f64::INFINITY),
+            (
+                "robot_like.specular_max_incidence_deg",
+                r.specular_max_incidence_deg,
+                90.0,
+            ),
+            ("robot_like.box_shift", r.box_shift, f64::INFINITY),
+            ("robot_like.room_scale", r.room_scale, 0.5),
+        ] {
+            if !(value.is_finite() && (0.0..=hi).contains(&value)) {
+                return config(format!("{name} is {value}; it must be in [0, {hi}]"));
+            }
+        }
+        self.integrator.validate().map_err(|e| match e {
+            Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
+            other => other,
+        })
+    }
+
+    /// Robot steps per trial: `trial_seconds / sim.dt`, rounded.
+    pub fn steps(&self) -> usize {
+        (self.trial_seconds / self.sim.dt).round() as usize
+    }
+
+    /// The world of landmark `n` (1 or 2).
+    pub fn world(&self, n: u8) -> &WorldSpec {
+        if n == 1 {
+            &self.landmark1
+        } else {
+            &self.landmark2
+        }
+    }
+}

@@ -1,0 +1,350 @@
+//! The landmark-recognition task: robot trials in the two worlds, the fitness of a generation,
+//! a recorded trial for figures, and the (robot-like) assessment with its confusion matrix.
+
+use std::sync::atomic::AtomicBool;
+
+use ctrnn::{Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, LANES};
+use rayon::prelude::*;
+use serde::Serialize;
+use sim2d::{Echo, Sim, World, WorldSpec};
+
+use super::config::{config_error, LandmarkConfig};
+use crate::common::{check_inputs, config_from_params, interrupted, Diverged};
+
+/// The fraction of fresh trials a network must classify right to have solved the task.
+pub const SUCCESS_RATE: f64 = 0.95;
+
+/// Fresh trials per landmark a run uses to check whether its champion has succeeded yet.
+pub const SUCCESS_TRIALS: usize = 20;
+
+/// The landmark-recognition task: a validated [`LandmarkConfig`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LandmarkTask {
+    config: LandmarkConfig,
+}
+
+/// What the robot sensed in one trial. The wall follower drives the robot, not the network, so
+/// this does not depend on the network and is computed once per trial for a whole generation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sensing {
+    /// The landmark, 1 or 2.
+    pub landmark: u8,
+    /// The world of the trial (jittered under robot-like conditions).
+    pub world: WorldSpec,
+    /// The network's input at each step, `min(1, d0 / range)`.
+    pub input: Vec<f64>,
+    /// The sonar's range at each step, in metres.
+    pub range: Vec<f64>,
+    /// The robot's pose `[x, y, heading]` at each step, before it moves.
+    pub poses: Vec<[f64; 3]>,
+    /// Where the echo came from at each step (`None`: nothing within range).
+    pub echoes: Vec<Option<[f64; 2]>>,
+}
+
+/// A network's run through one trial.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Record {
+    /// The trial.
+    pub sensing: Sensing,
+    /// Every neuron's firing rate after each step (T x N).
+    pub outputs: Vec<Vec<f64>>,
+    /// The classifier's output at the end: `< 0.5` means landmark 1.
+    pub classification: f64,
+}
+
+/// A network judged on fresh trials.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Assessment {
+    /// Whether the trials were robot-like.
+    pub robot_like: bool,
+    /// `confusion[true landmark - 1][answer - 1]`: counts of trials.
+    pub confusion: [[usize; 2]; 2],
+    /// Each trial's landmark and final classifier output.
+    pub trials: Vec<(u8, f64)>,
+    /// The fraction classified right.
+    pub rate: f64,
+    /// Whether `rate >= SUCCESS_RATE`.
+    pub success: bool,
+}
+
+/// The answer a final output gives: landmark 1 below 0.5, else 2.
+pub fn answer(output: f64) -> u8 {
+    if output < 0.5 {
+        1
+    } else {
+        2
+    }
+}
+
+/// A trial's score: `1 - f` on landmark 1, `f` on landmark 2.
+pub fn score(landmark: u8, output: f64) -> f64 {
+    if landmark == 1 {
+        1.0 - output
+    } else {
+        output
+    }
+}
+
+impl LandmarkTask {
+    /// The task for `config`, which is validated.
+    pub fn new(config: LandmarkConfig) -> Result<Self> {
+        config.validate()?;
+        Ok(LandmarkTask { config })
+    }
+
+    /// The task from a JSON object of [`LandmarkConfig`] fields (`null` means all defaults).
+    pub fn from_params(params: &serde_json::Value) -> Result<Self> {
+        LandmarkTask::new(config_from_params("landmark", params)?)
+    }
+
+    /// The config.
+    pub fn config(&self) -> &LandmarkConfig {
+        &self.config
+    }
+
+    /// Runs the robot through one trial with landmark `landmark`, drawing (in this order) the
+    /// world's jitter if `robot_like`, the start pose, then the sonar noise from `stream`.
+    pub fn sense(&self, landmark: u8, mut stream: Stream, robot_like: bool) -> Result<Sensing> {
+        if landmark != 1 && landmark != 2 {
+            return Err(Error::InvalidArgument(format!(
+                "landmark is {landmark}; it must be 1 or 2"
+            )));
+        }
+        let c = &self.config;
+        let rl = &c.robot_like;
+        let spec = c.world(landmark);
+        let world_spec = if robot_like {
+            spec.jittered(&mut stream, rl.box_shift, rl.room_scale)
+                .map_err(config_error)?
+        } else {
+            spec.clone()
+        };
+        let world = World::new(&world_spec).map_err(config_error)?;
+        let mut sim_spec = c.sim.clone();
+        if robot_like {
+            sim_spec.sonars[0].noise_sd = rl.noise_sd;
+            sim_spec.sonars[0].specular_max_incidence_deg = Some(rl.specular_max_incidence_deg);
+        }
+        let mut sim = Sim::random_start(&world, &sim_spec, &mut stream).map_err(config_error)?;
+        let steps = c.steps();
+        let mut echoes = vec![Echo::default(); sim_spec.sonars.len()];
+        let mut sensing = Sensing {
+            landmark,
+            world: world_spec.clone(),
+            input: Vec::with_capacity(steps),
+            range: Vec::with_capacity(steps),
+            poses: Vec::with_capacity(steps),
+            echoes: Vec::with_capacity(steps),
+        };
+        for _ in 0..steps {
+            let p = sim.pose();
+            sim.step(&mut stream, &mut echoes).map_err(config_error)?;
+            sensing.poses.push([p.x, p.y, p.heading]);
+            sensing.range.push(echoes[0].range);
+            sensing.echoes.push(echoes[0].point);
+            sensing.input.push(sim2d::input(echoes[0].range, c.d0));
+        }
+        Ok(sensing)
+    }
+
+    /// The trials every individual of `generation` runs: `trials_per_landmark` with landmark 1,
+    /// then as many with landmark 2; trial `t` draws from
+    /// `Stream::new(seed, generation, Purpose::Trial, 0, t)`, robot-like if `train_robot_like`.
+    pub fn trials(&self, seed: u64, generation: u64) -> Result<Vec<Sensing>> {
+        let k = self.config.trials_per_landmark;
+        (0..2 * k)
+            .into_par_iter()
+            .map(|t| {
+                let stream = Stream::new(seed, generation, Purpose::Trial, 0, t as u64);
+                let landmark = if t < k { 1 } else { 2 };
+                self.sense(landmark, stream, self.config.train_robot_like)
+            })
+            .collect()
+    }
+
+    /// `per_landmark` fresh trials per landmark (landmark 1 first), trial `t` drawn from
+    /// `Stream::new(seed, 0, Purpose::Evaluate, 0, t)`.
+    pub fn fresh_trials(
+        &self,
+        per_landmark: usize,
+        seed: u64,
+        robot_like: bool,
+    ) -> Result<Vec<Sensing>> {
+        (0..2 * per_landmark)
+            .into_par_iter()
+            .map(|t| {
+                let stream = Stream::new(seed, 0, Purpose::Evaluate, 0, t as u64);
+                let landmark = if t < per_landmark { 1 } else { 2 };
+                self.sense(landmark, stream, robot_like)
+            })
+            .collect()
+    }
+
+    /// Feeds `input` to every lane from a reset state; `observe` sees the network after each
+    /// step. Returns the classifier's final output on every lane.
+    fn run_lanes<const L: usize>(
+        &self,
+        lanes: &mut Lanes<L>,
+        input: &[f64],
+        mut observe: impl FnMut(&Lanes<L>),
+    ) -> std::result::Result<[f64; L], Diverged> {
+        lanes.reset();
+        for &x in input {
+            lanes.step_row(&[[x; L]], &self.config.integrator);
+            observe(lanes);
+        }
+        Diverged::find(lanes)?;
+        Ok(lanes.output(self.config.classifier))
+    }
+
+    /// Each network's final classifier output on each trial: `out[p][t]`.
+    pub fn outputs(
+        &self,
+        networks: &[Network],
+        trials: &[Sensing],
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<Vec<f64>>> {
+        self.check(networks)?;
+        if networks.is_empty() {
+            return Ok(vec![]);
+        }
+        let mut population = Population::new(networks)?;
+        let per_block = population
+            .blocks_mut()
+            .par_iter_mut()
+            .enumerate()
+            .map(|(b, block)| {
+                let mut out = vec![vec![0.0; trials.len()]; block.len()];
+                for (t, trial) in trials.iter().enumerate() {
+                    if interrupted(cancel) {
+                        return Err(Error::Interrupted);
+                    }
+                    let f = self
+                        .run_lanes(block, &trial.input, |_| {})
+                        .map_err(|d| d.error(b * LANES))?;
+                    for (l, row) in out.iter_mut().enumerate() {
+                        row[t] = f[l];
+                    }
+                }
+                Ok(out)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(per_block.concat())
+    }
+
+    /// The fitness of every network in `generation`: the mean trial score over
+    /// [`trials`](Self::trials).
+    pub fn scores(
+        &self,
+        networks: &[Network],
+        generation: u64,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        let trials = self.trials(seed, generation)?;
+        let outputs = self.outputs(networks, &trials, cancel)?;
+        Ok(outputs
+            .iter()
+            .map(|f| {
+                let total: f64 = trials
+                    .iter()
+                    .zip(f)
+                    .map(|(s, &o)| score(s.landmark, o))
+                    .sum();
+                total / trials.len() as f64
+            })
+            .collect())
+    }
+
+    /// Runs `net` through one trial, recorded step by step. Bit-identical to the evaluation.
+    pub fn record(&self, net: &Network, sensing: Sensing) -> Result<Record> {
+        self.check(std::slice::from_ref(net))?;
+        let mut lanes = Lanes::<1>::new(&[net])?;
+        let n = net.size();
+        let mut outputs = Vec::with_capacity(sensing.input.len());
+        let f = self
+            .run_lanes(&mut lanes, &sensing.input, |lanes| {
+                outputs.push((0..n).map(|i| lanes.output(i)[0]).collect());
+            })
+            .map_err(|d| d.error(0))?;
+        Ok(Record {
+            sensing,
+            outputs,
+            classification: f[0],
+        })
+    }
+
+    /// Judges `net` on `per_landmark` fresh trials per landmark ([`fresh_trials`](Self::fresh_trials)),
+    /// robot-like or not: it succeeds when at least [`SUCCESS_RATE`] of them are classified right.
+    pub fn assess(
+        &self,
+        net: &Network,
+        per_landmark: usize,
+        seed: u64,
+        robot_like: bool,
+    ) -> Result<Assessment> {
+        if per_landmark == 0 {
+            return Err(Error::InvalidArgument(
+                "trials per landmark is 0; assessing needs at least 1".into(),
+            ));
+        }
+        let trials = self.fresh_trials(per_landmark, seed, robot_like)?;
+        let outputs = self.outputs(std::slice::from_ref(net), &trials, None)?;
+        let mut confusion = [[0usize; 2]; 2];
+        let mut list = vec![];
+        for (s, &f) in trials.iter().zip(&outputs[0]) {
+            confusion[usize::from(s.landmark - 1)][usize::from(answer(f) - 1)] += 1;
+            list.push((s.landmark, f));
+        }
+        let rate = (confusion[0][0] + confusion[1][1]) as f64 / trials.len() as f64;
+        Ok(Assessment {
+            robot_like,
+            confusion,
+            trials: list,
+            rate,
+            success: rate >= SUCCESS_RATE,
+        })
+    }
+
+    fn check(&self, networks: &[Network]) -> Result<()> {
+        check_inputs(networks, 1, "the left sonar")?;
+        let c = self.config.classifier;
+        if let Some(p) = networks.iter().position(|net| net.size() <= c) {
+            return Err(Error::InvalidArgument(format!(
+                "network {p} has N = {}; the classifier is neuron {c}, so N must be at least {}",
+                networks[p].size(),
+                c + 1
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Task for LandmarkTask {
+    fn layout(&self) -> Layout {
+        Layout {
+            size: self.config.size,
+            n_inputs: 1,
+        }
+    }
+
+    /// The fitness of [`LandmarkTask::scores`].
+    fn evaluate(
+        &self,
+        networks: &[Network],
+        generation: u64,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        self.scores(networks, generation, seed, cancel)
+    }
+
+    /// [`LandmarkTask::assess`] with [`SUCCESS_TRIALS`] trials per landmark, in the training
+    /// conditions.
+    fn succeeds(&self, net: &Network, seed: u64) -> Result<Option<bool>> {
+        let robot_like = self.config.train_robot_like;
+        Ok(Some(
+            self.assess(net, SUCCESS_TRIALS, seed, robot_like)?.success,
+        ))
+    }
+}

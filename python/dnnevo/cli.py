@@ -347,6 +347,10 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     try:
         return COMMANDS[args.command](args)
+    except BrokenPipeError:
+        # The reader (e.g. `| head`) stopped reading; that is not an error of ours.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except (DnnevoError, OSError) as e:
         if args.debug:
             raise

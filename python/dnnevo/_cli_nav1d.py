@@ -133,7 +133,7 @@ def system(args: argparse.Namespace) -> int:
     parts = [nav1d.load_part(p, role) for p, role in
              [(args.classifier, "--classifier"), (args.far, "--far"), (args.near, "--near")]]
     persist = not args.reset_each_trial
-    report = nav1d.system_assess(*parts, environments=args.environments, trials=args.trials,
+    report = nav1d.system_assess(parts[0], parts[1], parts[2], environments=args.environments, trials=args.trials,
                                  seed=args.seed, persist_state=persist)
     state = "persisting" if persist else "reset each trial"
     print(f"integrated system on {args.environments} fresh environments x {args.trials} trials "
@@ -147,7 +147,8 @@ def system(args: argparse.Namespace) -> int:
         write_atomic(args.out / "report.json", json.dumps(report, indent=1))
         records = []
         for c in nav1d.cases(parts[0].config):
-            first, rest, _ = nav1d.system_record(*parts, [c] * args.trials, persist_state=persist)
+            first, rest, _ = nav1d.system_record(parts[0], parts[1], parts[2], [c] * args.trials,
+                                                 persist_state=persist)
             records.append(_join(first, rest))
         _fig2(records, parts[0].config.task_json(), "integrated system, one environment per case "
               f"({args.trials} trials, goal on the same side)", args.out / "fig2-system.png")

@@ -26,8 +26,8 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
+from dnnevo._checks import nonnegative, task_params
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError, InvalidArgumentError
 
 __all__ = ["Record", "assess", "cast_rays", "default_world", "record"]
 
@@ -48,15 +48,7 @@ class Record:
 
 
 def _params(config: EvolutionConfig) -> str:
-    if config.task != "landmark":
-        raise ConfigError(f"config.task is {config.task!r}; expected 'landmark'")
-    return json.dumps(config.task_json())
-
-
-def _count(name: str, value: int) -> int:
-    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-        raise InvalidArgumentError(f"{name} is {value!r}; it must be an integer >= 0")
-    return value
+    return task_params(config, "landmark")
 
 
 def record(
@@ -64,8 +56,8 @@ def record(
     robot_like: bool = False,
 ) -> Record:
     """Runs ``net`` through fresh trial ``trial`` of ``seed`` with ``landmark`` (1 or 2)."""
-    d = json.loads(_core.landmark_record(_params(config), net, _count("landmark", landmark),
-                                         _count("seed", seed), _count("trial", trial), robot_like))
+    d = json.loads(_core.landmark_record(_params(config), net, nonnegative("landmark", landmark),
+                                         nonnegative("seed", seed), nonnegative("trial", trial), robot_like))
     s = d["sensing"]
     echoes = np.array([[np.nan, np.nan] if p is None else p for p in s["echoes"]], dtype=float)
     return Record(
@@ -86,14 +78,14 @@ def assess(
 ) -> dict[str, Any]:
     """Judges ``net`` on ``per_landmark`` fresh trials of each landmark: ``{"confusion"
     (rows: true landmark 1, 2; columns: answer 1, 2), "rate", "success", "trials"}``."""
-    return json.loads(_core.landmark_assess(_params(config), net, _count("per_landmark", per_landmark),
-                                            _count("seed", seed), robot_like))
+    return json.loads(_core.landmark_assess(_params(config), net, nonnegative("per_landmark", per_landmark),
+                                            nonnegative("seed", seed), robot_like))
 
 
 def default_world(n: int) -> dict[str, Any]:
     """The shipped world of landmark ``n`` (1 or 2) as a dict (room, boxes, start region); pass
     a changed copy as ``task_params["landmark1"]`` or ``["landmark2"]``."""
-    result: dict[str, Any] = json.loads(_core.sim2d_landmark_world(_count("n", n)))
+    result: dict[str, Any] = json.loads(_core.sim2d_landmark_world(nonnegative("n", n)))
     return result
 
 

@@ -29,8 +29,9 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
+from dnnevo._checks import nonnegative, task_params
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError, InvalidArgumentError
+from dnnevo.errors import ConfigError
 
 __all__ = [
     "Condition",
@@ -87,15 +88,7 @@ class Part:
 
 
 def _params(config: EvolutionConfig) -> str:
-    if config.task != "nav1d":
-        raise ConfigError(f"config.task is {config.task!r}; expected 'nav1d'")
-    return json.dumps(config.task_json())
-
-
-def _count(name: str, value: int) -> int:
-    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-        raise InvalidArgumentError(f"{name} is {value!r}; it must be an integer >= 0")
-    return value
+    return task_params(config, "nav1d")
 
 
 def _conditions(items: list[dict[str, Any]]) -> list[Condition]:
@@ -116,15 +109,15 @@ def cases(config: EvolutionConfig) -> list[Condition]:
 def chains(config: EvolutionConfig, seed: int, generation: int) -> list[list[Condition]]:
     """The chains of trials every individual of ``generation`` ran."""
     return [_conditions(c) for c in json.loads(
-        _core.nav1d_chains(_params(config), _count("seed", seed), _count("generation", generation)))]
+        _core.nav1d_chains(_params(config), nonnegative("seed", seed), nonnegative("generation", generation)))]
 
 
 def fresh_chains(config: EvolutionConfig, count: int, trials: int, seed: int) -> list[list[Condition]]:
     """``count`` fresh chains of ``trials`` trials, each in a random environment of the config's
     ``environments``, each trial with a random goal side."""
     return [_conditions(c) for c in json.loads(
-        _core.nav1d_fresh_chains(_params(config), _count("count", count), _count("trials", trials),
-                                 _count("seed", seed)))]
+        _core.nav1d_fresh_chains(_params(config), nonnegative("count", count), nonnegative("trials", trials),
+                                 nonnegative("seed", seed)))]
 
 
 def _record(d: dict[str, Any]) -> Record:
@@ -152,7 +145,7 @@ def record(
 
 def assess(config: EvolutionConfig, net: _core.Network, count: int, seed: int) -> dict[str, Any]:
     """Judges ``net`` on ``count`` fresh chains: ``{"rate", "success", "episodes", ...}``."""
-    return json.loads(_core.nav1d_assess(_params(config), net, _count("count", count), _count("seed", seed)))
+    return json.loads(_core.nav1d_assess(_params(config), net, nonnegative("count", count), nonnegative("seed", seed)))
 
 
 def goal_rates(episodes: Sequence[dict[str, Any]]) -> dict[str, npt.NDArray[np.float64]]:
@@ -194,8 +187,8 @@ def system_assess(
     "classification_rate", "episodes"}``; see :func:`goal_rates` for the breakdown."""
     c, f, n = _parts(classifier, far, near)
     return json.loads(_core.nav1d_system_assess(
-        c, f, n, _count("environments", environments), _count("trials", trials),
-        _count("seed", seed), persist_state))
+        c, f, n, nonnegative("environments", environments), nonnegative("trials", trials),
+        nonnegative("seed", seed), persist_state))
 
 
 def system_record(

@@ -74,7 +74,7 @@ def plot_sequence_trial(
     starts = np.flatnonzero(np.diff(np.concatenate([[0.0], trigger])) > 0)
     bits = np.concatenate([r.targets for r in records])
     for s, bit in zip(starts, bits, strict=False):
-        ax.text(s + 5, 1.05, str(bit), ha="center", fontsize=8)
+        ax.text(float(s) + 5, 1.05, str(bit), ha="center", fontsize=8)
     if follow is not None:
         ax.axvline(len(record.output), color="k", lw=0.8, ls="--")
     ax.set_ylim(-0.05, 1.15)

@@ -17,6 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
+from dnnevo._checks import task_params
 from dnnevo.config import EvolutionConfig
 
 __all__ = ["TrialRecord", "assess", "run_trial", "switch_trial", "timings"]
@@ -41,9 +42,7 @@ class TrialRecord:
 
 
 def _params(config: EvolutionConfig) -> str:
-    if config.task != "sequence":
-        raise ValueError(f"config.task is {config.task!r}; expected 'sequence'")
-    return json.dumps(config.task_json())
+    return task_params(config, "sequence")
 
 
 def timings(config: EvolutionConfig, seed: int, generation: int, trial: int) -> list[tuple[int, int]]:

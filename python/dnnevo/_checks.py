@@ -9,9 +9,10 @@ from dnnevo.errors import ConfigError, InvalidArgumentError
 
 
 def nonnegative(name: str, value: int) -> int:
-    """``value`` if it is an integer >= 0, else an :class:`InvalidArgumentError` naming it."""
-    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-        raise InvalidArgumentError(f"{name} is {value!r}; it must be an integer >= 0")
+    """``value`` if it is an integer in [0, 2**64), else an :class:`InvalidArgumentError` naming
+    it."""
+    if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value < 2**64:
+        raise InvalidArgumentError(f"{name} is {value!r}; it must be an integer in [0, 2**64)")
     return value
 
 

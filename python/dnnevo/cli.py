@@ -231,10 +231,10 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
     champion = dnnevo.Network.load(run.best)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
-    if config.task == "sequence":
-        return _evaluate_sequence(args, config, champion, seed)
     if args.robot_like and config.task != "landmark":
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
+    if config.task == "sequence":
+        return _evaluate_sequence(args, config, champion, seed)
     if config.task == "nav1d":
         return _cli_nav1d.evaluate(args, config, champion, seed)
     if config.task == "landmark":

@@ -28,6 +28,7 @@ import numpy.typing as npt
 from dnnevo import _core
 from dnnevo._checks import nonnegative, task_params
 from dnnevo.config import EvolutionConfig
+from dnnevo.errors import InvalidArgumentError
 
 __all__ = ["Record", "assess", "cast_rays", "default_world", "record"]
 
@@ -51,11 +52,18 @@ def _params(config: EvolutionConfig) -> str:
     return task_params(config, "landmark")
 
 
+def _landmark(n: int) -> int:
+    if n not in (1, 2) or isinstance(n, bool):
+        raise InvalidArgumentError(f"landmark is {n!r}; it must be 1 or 2")
+    return n
+
+
 def record(
     config: EvolutionConfig, net: _core.Network, landmark: int, *, seed: int = 0, trial: int = 0,
     robot_like: bool = False,
 ) -> Record:
     """Runs ``net`` through fresh trial ``trial`` of ``seed`` with ``landmark`` (1 or 2)."""
+    _landmark(landmark)
     d = json.loads(_core.landmark_record(_params(config), net, nonnegative("landmark", landmark),
                                          nonnegative("seed", seed), nonnegative("trial", trial), robot_like))
     s = d["sensing"]
@@ -85,7 +93,7 @@ def assess(
 def default_world(n: int) -> dict[str, Any]:
     """The shipped world of landmark ``n`` (1 or 2) as a dict (room, boxes, start region); pass
     a changed copy as ``task_params["landmark1"]`` or ``["landmark2"]``."""
-    result: dict[str, Any] = json.loads(_core.sim2d_landmark_world(nonnegative("n", n)))
+    result: dict[str, Any] = json.loads(_core.sim2d_landmark_world(_landmark(n)))
     return result
 
 
@@ -96,4 +104,7 @@ def cast_rays(
     nearest wall or box of ``world``, or ``max_distance`` when nothing is nearer."""
     o = np.ascontiguousarray(origins, dtype=float)
     d = np.ascontiguousarray(directions, dtype=float)
+    if o.ndim != 2 or o.shape[1:] != (2,) or o.shape != d.shape:
+        raise InvalidArgumentError(
+            f"origins has shape {o.shape} and directions {d.shape}; both must be (K, 2)")
     return _core.sim2d_cast_rays(json.dumps(world), o, d, float(max_distance))

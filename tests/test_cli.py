@@ -90,3 +90,19 @@ def test_console_script_is_installed() -> None:
     r = subprocess.run([str(Path(sys.executable).parent / "dnnevo"), "--version"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and r.stdout.startswith("dnnevo ")
+
+
+def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
+    import tomllib
+
+    small = ["--quick", "--set", "generations=1", "--set", "population=10"]
+    for name in ("a", "b"):
+        r = dnnevo("run", "sequence-1bit", *small, "--out", str(tmp_path / name))
+        assert r.returncode == 0, r.stderr
+    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "c"),
+               "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
+    assert r.returncode == 0, r.stderr
+    run = tomllib.loads((tmp_path / "c" / "config.toml").read_text())["run"]
+    assert run["seeded_from"] == [str(tmp_path / "a"), str(tmp_path / "b")]
+    plain = tomllib.loads((tmp_path / "a" / "config.toml").read_text())["run"]
+    assert "seeded_from" not in plain

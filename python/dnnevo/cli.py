@@ -143,8 +143,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
     config = presets.get(args.preset, quick=args.quick, overrides=args.set)
     out = args.out or Path("runs") / f"{args.preset}{'-quick' if args.quick else ''}-seed{args.seed}"
     seeds = _seed_networks(args.seed_from, config.size)
+    info = {"seeded_from": [str(p) for p in args.seed_from]} if args.seed_from else None
     result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,
-                           seeds=seeds, force=args.force)
+                           seeds=seeds, force=args.force, run_info=info)
     return _report(result)
 
 

@@ -14,7 +14,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -118,6 +118,7 @@ def evolve(
     threads: int | None = None,
     seeds: Sequence[_core.Network] | None = None,
     force: bool = False,
+    run_info: Mapping[str, Any] | None = None,
 ) -> EvolutionResult:
     """Evolves networks for ``task`` and returns the champion and the history.
 
@@ -126,6 +127,8 @@ def evolve(
     writes a run folder (see :mod:`dnnevo.rundir`); an existing non-empty folder is refused unless
     ``force``. ``callback(stats, ga)`` runs after every generation; returning True stops the run.
     ``seeds`` are networks placed first in the initial population (e.g. from :func:`compose`).
+    ``run_info`` adds entries to the ``[run]`` table of ``config.toml``, e.g. where the seeds
+    came from.
     """
     if callable(task):
         name = getattr(task, "__qualname__", type(task).__qualname__)
@@ -137,7 +140,8 @@ def evolve(
     run = RunDir(out) if out is not None else None
     if run is not None:
         run.create(force=force)
-        run.config.write_text(config.to_toml(run=_run_table(seed)), encoding="utf-8")
+        table = {**_run_table(seed), **(run_info or {})}
+        run.config.write_text(config.to_toml(run=table), encoding="utf-8")
     ga = GeneticAlgorithm(config, seed=seed, seeds=seeds)
     return _loop(ga, task, [], run, progress=progress, callback=callback, threads=threads)
 

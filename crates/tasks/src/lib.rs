@@ -22,6 +22,6 @@ pub mod sequence;
 
 pub use registry::{build, names};
 pub use sequence::{
-    performance, Assessment, PerfBase, Scores, SequenceConfig, SequenceTask, TargetReport,
+    performance, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask, TargetReport,
     TrialRecord,
 };

@@ -36,7 +36,9 @@
 //!
 //! Note that clamping per trial rewards a constant output: on B = {0*, 1*} with base 0.5, a
 //! network whose output is always 0 scores 1 on the 0* trials and 0 on the 1* trials, so its
-//! fitness is 0.5. Only an output stuck at 0.5 (or a random one) scores about 0.
+//! fitness is 0.5. Only an output stuck at 0.5 (or a random one) scores about 0. With
+//! `clamp = "evaluation"` the clamp is applied once, to the mean over the trials of
+//! `(mean_k R_k - base) / (1 - base)`, and every constant output scores 0.
 //!
 //! # Success rule
 //! A network has learnt a target when, over fresh random timings (drawn with
@@ -140,6 +142,19 @@ impl<'de> Deserialize<'de> for PerfBase {
     }
 }
 
+/// Where the performance score `(mean R - base) / (1 - base)` is clamped at 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Clamp {
+    /// Per trial, then averaged: READING.md's formula. An output stuck at 0 scores 1 on every
+    /// 0* trial and 0 on every 1* trial, so 0.5 on B = {0*, 1*}.
+    #[default]
+    Trial,
+    /// Once, on the mean of the trials' unclamped scores, so that failing one target cancels
+    /// succeeding at another: any constant output scores 0 on B = {0*, 1*}.
+    Evaluation,
+}
+
 /// The sequence-learning experiment's settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -165,6 +180,8 @@ pub struct SequenceConfig {
     pub gap: (usize, usize),
     /// Base of the performance score: a number in [0, 1) or `"generation-mean"`. Default 0.5.
     pub perf_base: PerfBase,
+    /// Where the performance score is clamped at 0. Default `"trial"`.
+    pub clamp: Clamp,
     /// How one time step is integrated; `dt * substeps` is the length of a time step in units of
     /// simulated time. Default 10 Euler steps of dt = 0.1.
     pub integrator: Integrator,
@@ -185,6 +202,7 @@ impl Default for SequenceConfig {
             delay: (10, 40),
             gap: (10, 40),
             perf_base: PerfBase::default(),
+            clamp: Clamp::Trial,
             integrator: Integrator {
                 method: Method::Euler,
                 dt: 0.1,
@@ -648,7 +666,12 @@ impl SequenceTask {
         };
         let fitness = mean_r
             .chunks(n_trials)
-            .map(|trials| trials.iter().map(|&m| score(m, base)).sum::<f64>() / n_trials as f64)
+            .map(|trials| match config.clamp {
+                Clamp::Trial => {
+                    trials.iter().map(|&m| score(m, base)).sum::<f64>() / n_trials as f64
+                }
+                Clamp::Evaluation => score(mean(trials), base),
+            })
             .collect();
         Ok(Scores {
             trials: n_trials,
@@ -1034,6 +1057,12 @@ mod tests {
         // Always 0: perfect on the two 0* trials, nothing on the two 1* trials. Always 1: the
         // reverse. Always 0.5: R = 0.5 everywhere, nothing above the base.
         assert_eq!(f, vec![0.5, 0.5, 0.0]);
+        // Clamped once per evaluation, no constant output earns anything.
+        let t = task(SequenceConfig {
+            clamp: Clamp::Evaluation,
+            ..SequenceConfig::default()
+        });
+        assert_eq!(t.evaluate(&nets, 0, 3, None).unwrap(), vec![0.0, 0.0, 0.0]);
     }
 
     #[test]

@@ -569,6 +569,11 @@ def test_quick_run_plot(run):
     for picture in ("fitness.png", "fig1-traces.png", "world.png"):
         assert_png(run / picture)
         assert picture in r.stdout
+    assert not (run / "trial-landmark2.gif").exists()
+    r = run_cli("plot", run, "--animate")
+    assert r.returncode == 0, r.stderr
+    gif = (run / "trial-landmark2.gif").read_bytes()
+    assert gif[:6] in (b"GIF87a", b"GIF89a") and len(gif) > 10_000
 
 
 # -- errors ------------------------------------------------------------------------------------

@@ -26,9 +26,10 @@ def evaluate(args: argparse.Namespace, config: EvolutionConfig, champion: Any, s
     return 0 if report["success"] else 1
 
 
-def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
+def plot(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = False) -> list[str]:
     """``dnnevo plot`` for a ``landmark`` run: Fig. 1 (sonar input and every neuron over a
-    landmark-1 and a landmark-2 trial) and a top-down view of both trials."""
+    landmark-1 and a landmark-2 trial), a top-down view of both trials and, with ``animate``, a
+    GIF of the landmark-2 trial."""
     import matplotlib.pyplot as plt
 
     from dnnevo import _core
@@ -51,4 +52,45 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
         plot_landmark_world(rec, ax, title=f"landmark {rec.landmark}: path and sonar echoes")
     fig.savefig(run.path / "world.png", dpi=120)
     plt.close(fig)
-    return ["fig1-traces.png", "world.png"]
+    written = ["fig1-traces.png", "world.png"]
+    if animate:
+        _animate(records[1], classifier, run.path / "trial-landmark2.gif")
+        written.append("trial-landmark2.gif")
+    return written
+
+
+FRAME_STEPS = 10
+"""Robot steps per GIF frame (1 s of simulated time at the default 0.1 s step)."""
+
+
+def _animate(rec: landmark.Record, classifier: int, path: Any) -> None:
+    """A GIF of one trial: the robot, its sonar echo and the classifier's output so far."""
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    from dnnevo.plot import plot_landmark_world
+
+    fig, (top, trace) = plt.subplots(2, 1, figsize=(6, 6.5), height_ratios=[3, 1],
+                                     layout="constrained")
+    plot_landmark_world(rec, top, title=f"landmark {rec.landmark}")
+    (robot,) = top.plot([], [], "o", ms=12, color="tab:blue", alpha=0.6)
+    (beam,) = top.plot([], [], "-", color="tab:red", lw=1)
+    out = rec.outputs[:, classifier]
+    (line,) = trace.plot([], [], color="tab:red")
+    trace.axhline(0.5, color="0.3", lw=0.7, ls=":")
+    trace.set_xlim(0, len(out))
+    trace.set_ylim(-0.05, 1.05)
+    trace.set_xlabel("time step")
+    trace.set_ylabel("classifier")
+
+    def draw(frame: int) -> None:
+        k = min(frame * FRAME_STEPS, len(out) - 1)
+        x, y = rec.poses[k, :2]
+        robot.set_data([x], [y])
+        ex, ey = rec.echoes[k]
+        beam.set_data([x, ex], [y, ey])
+        line.set_data(range(k + 1), out[: k + 1])
+
+    frames = len(out) // FRAME_STEPS
+    FuncAnimation(fig, draw, frames=frames).save(path, writer=PillowWriter(fps=10))
+    plt.close(fig)

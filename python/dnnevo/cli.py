@@ -134,6 +134,8 @@ def build_parser() -> argparse.ArgumentParser:
                        epilog="example: dnnevo plot runs/demo")
     p.add_argument("dir", type=Path)
     p.add_argument("--seed", type=_nonnegative, default=0, help="seed of the trials shown")
+    p.add_argument("--animate", action="store_true",
+                   help="landmark runs: also write a GIF of a trial (slower)")
 
     _cli_nav1d.add_system_parser(sub)
     return parser
@@ -293,7 +295,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if config.task == "nav1d":
         written += _cli_nav1d.plot(run, config, args.seed)
     if config.task == "landmark":
-        written += _cli_landmark.plot(run, config, args.seed)
+        written += _cli_landmark.plot(run, config, args.seed, animate=args.animate)
     print(f"wrote {', '.join(str(run.path / w) for w in written)}")
     return 0
 

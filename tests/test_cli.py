@@ -104,5 +104,29 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     run = tomllib.loads((tmp_path / "c" / "config.toml").read_text())["run"]
     assert run["seeded_from"] == [str(tmp_path / "a"), str(tmp_path / "b")]
+    assert run["seeded_with"] == "champions"
     plain = tomllib.loads((tmp_path / "a" / "config.toml").read_text())["run"]
     assert "seeded_from" not in plain
+    # Whole populations, member by member: the composite of the two runs' first members is the
+    # new run's first genome.
+    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "d"), "--seed-populations",
+               "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
+    assert r.returncode == 0, r.stderr
+    assert tomllib.loads((tmp_path / "d" / "config.toml").read_text())["run"]["seeded_with"] == "populations"
+    import dnnevo as dn
+    from dnnevo.rundir import RunDir
+
+    def population(run: Path) -> list[dn.Network]:
+        state = RunDir(run).read_checkpoint()[0]
+        return dn.GeneticAlgorithm.from_state_dict(state).ask().networks
+
+    from dnnevo.cli import _seed_networks
+
+    a, b = population(tmp_path / "a"), population(tmp_path / "b")
+    seeds = _seed_networks([tmp_path / "a", tmp_path / "b"], 10, populations=True)
+    assert len(seeds) == len(a) == 10
+    for k in (0, 3, 9):
+        expected = dn.compose(a[k], b[k])
+        assert (seeds[k].weights == expected.weights).all() and (seeds[k].tau == expected.tau).all()
+    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "e"), "--seed-populations")
+    assert r.returncode == 2 and "--seed-populations needs" in r.stderr

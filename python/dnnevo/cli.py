@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import functools
 import io
 import os
 import sys
@@ -101,6 +102,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed-from", action="append", default=[], type=Path, metavar="RUN",
                    help="seed the initial population with RUN's champion (repeatable); "
                         "champions whose sizes add up to the preset's size are composed")
+    p.add_argument("--seed-populations", action="store_true",
+                   help="with --seed-from: use each RUN's whole last population, not its champion; "
+                        "the i-th members of the runs are composed into the i-th seed")
     run_options(p)
 
     p = sub.add_parser("resume", help="continue a stopped run", epilog="example: dnnevo resume runs/demo")
@@ -144,23 +148,30 @@ def build_parser() -> argparse.ArgumentParser:
 def _cmd_run(args: argparse.Namespace) -> int:
     config = presets.get(args.preset, quick=args.quick, overrides=args.set)
     out = args.out or Path("runs") / f"{args.preset}{'-quick' if args.quick else ''}-seed{args.seed}"
-    seeds = _seed_networks(args.seed_from, config.size)
-    info = {"seeded_from": [str(p) for p in args.seed_from]} if args.seed_from else None
+    if args.seed_populations and not args.seed_from:
+        raise ConfigError("--seed-populations needs at least one --seed-from RUN")
+    seeds = _seed_networks(args.seed_from, config.size, populations=args.seed_populations)
+    info: dict[str, object] | None = None
+    if args.seed_from:
+        info = {"seeded_from": [str(p) for p in args.seed_from],
+                "seeded_with": "populations" if args.seed_populations else "champions"}
     result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,
                            seeds=seeds, force=args.force, run_info=info)
     return _report(result)
 
 
-def _seed_networks(runs: list[Path], size: int) -> list[dnnevo.Network]:
-    """The champions of ``runs``; when their sizes add up to ``size`` they are composed in order
-    (the first run's output neuron stays the output), as in the paper's incremental route."""
-    nets = [dnnevo.Network.load(RunDir(r).best) for r in runs]
-    if len(nets) > 1 and sum(n.size for n in nets) == size:
-        composite = nets[0]
-        for other in nets[1:]:
-            composite = dnnevo.compose(composite, other)
-        return [composite]
-    return nets
+def _seed_networks(runs: list[Path], size: int, *, populations: bool = False) -> list[dnnevo.Network]:
+    """The champions of ``runs`` (or, with ``populations``, each run's last population, member by
+    member); when their sizes add up to ``size`` they are composed in order (the first run's
+    output neuron stays the output), as in the paper's incremental route."""
+    if populations:
+        groups = [dnnevo.GeneticAlgorithm.from_state_dict(RunDir(r).read_checkpoint()[0]).ask().networks
+                  for r in runs]
+    else:
+        groups = [[dnnevo.Network.load(RunDir(r).best)] for r in runs]
+    if len(groups) > 1 and sum(g[0].size for g in groups) == size:
+        return [functools.reduce(dnnevo.compose, members) for members in zip(*groups)]
+    return [net for group in groups for net in group]
 
 
 def _report(result: dnnevo.EvolutionResult) -> int:

@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import importlib.util
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import Phase, given, settings
 from hypothesis import strategies as st
+
+from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 import dnnevo
 from dnnevo import nav1d, presets
@@ -375,22 +375,6 @@ def reference_system(parts, conditions, persist):
 # -- the command line, end to end --------------------------------------------------------------
 
 
-def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "dnnevo", *map(str, args)], capture_output=True,
-                          text=True, timeout=300)
-
-
-def assert_png(path: Path) -> None:
-    data = path.read_bytes()
-    assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 1000, path
-
-
-def assert_one_line_error(r: subprocess.CompletedProcess[str], *fragments: str) -> None:
-    assert r.returncode == 2, (r.stdout, r.stderr)
-    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
-    assert "Traceback" not in r.stderr
-    for fragment in fragments:
-        assert fragment in r.stderr
 
 
 @pytest.fixture(scope="module")

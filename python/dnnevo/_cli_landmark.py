@@ -22,7 +22,7 @@ def evaluate(args: argparse.Namespace, config: EvolutionConfig, champion: Any, s
     print(f"{'landmark 1':>12} {a:>7} {b:>7} {a / max(a + b, 1):>7.1%}")
     print(f"{'landmark 2':>12} {c:>7} {d:>7} {d / max(c + d, 1):>7.1%}")
     verdict = "SUCCESS" if report["success"] else "failure"
-    print(f"overall: {report['rate']:.1%} right (success needs >= 95%): {verdict}")
+    print(f"overall: {report['rate']:.1%} right (success needs >= {report['required']:.0%}): {verdict}")
     return 0 if report["success"] else 1
 
 

@@ -56,7 +56,7 @@ def evaluate(args: argparse.Namespace, config: EvolutionConfig, champion: Any, s
         for line in _rate_table(episodes, 1 if objective == "single" else 0):
             print(line)
     verdict = "SUCCESS" if report["success"] else "failure"
-    print(f"overall: {report['rate']:.1%} of scored trials right (success needs >= 95%): {verdict}")
+    print(f"overall: {report['rate']:.1%} of scored trials right (success needs >= {report['required']:.0%}): {verdict}")
     return 0 if report["success"] else 1
 
 

@@ -67,7 +67,10 @@ pub fn nav1d_assess(
     Ok(to_json(&report))
 }
 
-fn system(parts: [(&str, &PyNetwork); 3], persist_state: bool) -> PyResult<System> {
+/// A subnetwork as Python passes it: its task's JSON parameters and the network.
+type PyPart<'py> = (String, PyRef<'py, PyNetwork>);
+
+fn system(parts: [&PyPart<'_>; 3], persist_state: bool) -> PyResult<System> {
     let [c, f, n] = parts.map(|(params, net)| {
         task(params).map(|task| Part {
             task,
@@ -85,22 +88,15 @@ fn system(parts: [(&str, &PyNetwork); 3], persist_state: bool) -> PyResult<Syste
 #[allow(clippy::too_many_arguments)]
 pub fn nav1d_system_assess(
     py: Python<'_>,
-    classifier: (String, PyRef<'_, PyNetwork>),
-    far: (String, PyRef<'_, PyNetwork>),
-    near: (String, PyRef<'_, PyNetwork>),
+    classifier: PyPart<'_>,
+    far: PyPart<'_>,
+    near: PyPart<'_>,
     environments: usize,
     trials: usize,
     seed: u64,
     persist_state: bool,
 ) -> PyResult<String> {
-    let system = system(
-        [
-            (&classifier.0, &classifier.1),
-            (&far.0, &far.1),
-            (&near.0, &near.1),
-        ],
-        persist_state,
-    )?;
+    let system = system([&classifier, &far, &near], persist_state)?;
     let report = py
         .detach(|| system.assess(environments, trials, seed))
         .py_err()?;
@@ -112,20 +108,13 @@ pub fn nav1d_system_assess(
 #[pyfunction]
 #[pyo3(signature = (classifier, far, near, conditions, persist_state=true))]
 pub fn nav1d_system_record(
-    classifier: (String, PyRef<'_, PyNetwork>),
-    far: (String, PyRef<'_, PyNetwork>),
-    near: (String, PyRef<'_, PyNetwork>),
+    classifier: PyPart<'_>,
+    far: PyPart<'_>,
+    near: PyPart<'_>,
     conditions: &str,
     persist_state: bool,
 ) -> PyResult<String> {
-    let system = system(
-        [
-            (&classifier.0, &classifier.1),
-            (&far.0, &far.1),
-            (&near.0, &near.1),
-        ],
-        persist_state,
-    )?;
+    let system = system([&classifier, &far, &near], persist_state)?;
     let (a, b, chosen) = system.record(&chain(conditions)?).py_err()?;
     Ok(to_json(
         &serde_json::json!({"first": a, "rest": b, "chosen": chosen}),

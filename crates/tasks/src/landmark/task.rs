@@ -63,7 +63,9 @@ pub struct Assessment {
     pub trials: Vec<(u8, f64)>,
     /// The fraction classified right.
     pub rate: f64,
-    /// Whether `rate >= SUCCESS_RATE`.
+    /// The rate success needs, [`SUCCESS_RATE`].
+    pub required: f64,
+    /// Whether `rate >= required`.
     pub success: bool,
 }
 
@@ -302,6 +304,7 @@ impl LandmarkTask {
             confusion,
             trials: list,
             rate,
+            required: SUCCESS_RATE,
             success: rate >= SUCCESS_RATE,
         })
     }

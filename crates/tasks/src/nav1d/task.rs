@@ -48,7 +48,9 @@ pub struct Assessment {
     /// The fraction of scored trials done right: the goal reached (`goal`; trials 2.. with
     /// `single`) or the environment classified right (`classify`).
     pub rate: f64,
-    /// Whether `rate >= SUCCESS_RATE`.
+    /// The rate success needs, [`SUCCESS_RATE`].
+    pub required: f64,
+    /// Whether `rate >= required`.
     pub success: bool,
 }
 
@@ -349,6 +351,7 @@ impl Nav1dTask {
             objective: self.config.objective,
             episodes,
             rate,
+            required: SUCCESS_RATE,
             success: rate >= SUCCESS_RATE,
         })
     }

@@ -1,10 +1,12 @@
 //! Forward Euler and classical RK4 for one network or a block of networks stepped together.
 //!
 //! The kernel works on [`Lanes`]: `L` networks of the same shape, stored parameter by parameter
-//! with the networks side by side (`weights[i * N + j][lane]`), so that one step is straight-line
-//! arithmetic over `[f64; L]` rows that the compiler vectorises across networks. A single network
-//! is `Lanes<1>` and a population block is `Lanes<LANES>`: both run the same code in the same
-//! order, which is why the two paths agree bit for bit.
+//! with the networks side by side (`theta[i][lane]`), so that one step is straight-line
+//! arithmetic over rows of `L` values, one per network. A single network is `Lanes<1>` and a
+//! population block is `Lanes<LANES>`. The kernel is written once over the crate's lane vectors:
+//! where the build's target CPU has AVX-512F a block keeps each row in 512-bit registers (8 lanes
+//! each), elsewhere it runs lane by lane. Every path performs the same operations in the same
+//! order, which is why single networks and populations agree bit for bit.
 //!
 //! One Euler step of size `dt`, with `h = dt / tau`:
 //! `v += h * (-v + W f(v - theta) + S I)`. Each row of inputs is held for `substeps` steps.
@@ -14,11 +16,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::math::sigmoid;
+use crate::math::{sigmoid, sigmoid_lanes};
 use crate::network::Network;
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+use crate::vector::Avx512;
+use crate::vector::{Group, Portable, Vector};
 
-/// How many networks a population block steps together (one AVX-512 register of f64).
-pub const LANES: usize = 8;
+/// How many networks a population block steps together: two AVX-512 registers of f64, so that
+/// every row of the kernel has two independent dependency chains in flight.
+pub const LANES: usize = 16;
 
 /// Rows between two looks at the cancel flag.
 const CANCEL_CHECK_ROWS: usize = 64;
@@ -123,7 +129,8 @@ struct Scratch<const L: usize> {
     ext: Vec<[f64; L]>,
     /// Firing rates.
     out: Vec<[f64; L]>,
-    k: [Vec<[f64; L]>; 4],
+    /// RK4's first three slopes (the fourth is used as soon as it is known).
+    k: [Vec<[f64; L]>; 3],
     probe: Vec<[f64; L]>,
 }
 
@@ -151,9 +158,14 @@ impl<const L: usize> Lanes<L> {
             }
         }
         let gather = |get: fn(&Network) -> &[f64], count: usize| -> Vec<[f64; L]> {
-            (0..count)
-                .map(|q| std::array::from_fn(|l| get(nets.get(l).unwrap_or(first))[q]))
-                .collect()
+            let mut rows = vec![[0.0; L]; count];
+            for l in 0..L {
+                let values = get(nets.get(l).unwrap_or(first));
+                for (row, &x) in rows.iter_mut().zip(values) {
+                    row[l] = x;
+                }
+            }
+            rows
         };
         let zeros = |count: usize| vec![[0.0; L]; count];
         Ok(Lanes {
@@ -162,7 +174,7 @@ impl<const L: usize> Lanes<L> {
             len: nets.len(),
             tau: gather(Network::tau, n),
             theta: gather(Network::theta, n),
-            weights: gather(Network::weights, n * n),
+            weights: by_row_groups(gather(Network::weights, n * n), n),
             sensor_weights: gather(Network::sensor_weights, n * m),
             state: gather(Network::state, n),
             scratch: Scratch {
@@ -172,7 +184,7 @@ impl<const L: usize> Lanes<L> {
                 h6: zeros(n),
                 ext: zeros(n),
                 out: zeros(n),
-                k: [zeros(n), zeros(n), zeros(n), zeros(n)],
+                k: [zeros(n), zeros(n), zeros(n)],
                 probe: zeros(n),
             },
         })
@@ -220,11 +232,17 @@ impl<const L: usize> Lanes<L> {
         }
     }
 
+    /// Makes the step sizes match `dt`.
+    #[inline(always)]
     fn prepare(&mut self, dt: f64) {
-        let s = &mut self.scratch;
-        if s.dt.to_bits() == dt.to_bits() {
-            return;
+        if self.scratch.dt.to_bits() != dt.to_bits() {
+            self.set_step_sizes(dt);
         }
+    }
+
+    #[cold]
+    fn set_step_sizes(&mut self, dt: f64) {
+        let s = &mut self.scratch;
         s.dt = dt;
         for i in 0..self.size {
             for l in 0..L {
@@ -238,68 +256,57 @@ impl<const L: usize> Lanes<L> {
 
     /// Holds `inputs` (one `[f64; L]` per sensor) for `integ.substeps` steps of `integ.dt`.
     /// `integ` must be valid.
+    #[inline(always)]
     pub fn step_row(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
         debug_assert_eq!(inputs.len(), self.n_inputs);
         self.prepare(integ.dt);
-        let (n, m) = (self.size, self.n_inputs);
-        for i in 0..n {
-            let mut acc = [0.0; L];
-            for k in 0..m {
-                let s = &self.sensor_weights[i * m + k];
-                for l in 0..L {
-                    acc[l] = s[l].mul_add(inputs[k][l], acc[l]);
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+        if L == 8 {
+            return self.step_row_with::<Avx512>(inputs, integ);
+        }
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+        if L == 16 {
+            return self.step_row_with::<Group<Avx512, 2>>(inputs, integ);
+        }
+        self.step_row_with::<Portable<L>>(inputs, integ);
+    }
+
+    /// [`step_row`](Self::step_row) on the lane vector `V`, whose rows are `[f64; L]`.
+    #[inline(always)]
+    fn step_row_with<V: Vector>(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
+        fn rows<V: Vector, const L: usize>(x: &[[f64; L]]) -> &[V::Row] {
+            V::rows(x.as_flattened())
+        }
+        let rows = rows::<V, L>;
+        let s = &mut self.scratch;
+        let ext = V::rows_mut(s.ext.as_flattened_mut());
+        sensor_drive::<V>(rows(&self.sensor_weights), rows(inputs), ext);
+        let net = Net::<V> {
+            theta: rows(&self.theta),
+            weights: rows(&self.weights),
+            ext: &*ext,
+        };
+        let state = V::rows_mut(self.state.as_flattened_mut());
+        let out = V::rows_mut(s.out.as_flattened_mut());
+        match integ.method {
+            Method::Euler => {
+                let h = rows(&s.h);
+                for _ in 0..integ.substeps {
+                    euler_step(&net, state, out, h);
                 }
             }
-            self.scratch.ext[i] = acc;
-        }
-        for _ in 0..integ.substeps {
-            match integ.method {
-                Method::Euler => self.euler_step(),
-                Method::Rk4 => self.rk4_step(),
-            }
-        }
-    }
-
-    fn euler_step(&mut self) {
-        let Lanes {
-            theta,
-            weights,
-            state,
-            scratch: s,
-            ..
-        } = self;
-        let net = Weights { theta, weights };
-        let [d, ..] = &mut s.k;
-        derivative(&net, state, d, &mut s.out, &s.ext);
-        for (v, (h, d)) in state.iter_mut().zip(s.h.iter().zip(d.iter())) {
-            for l in 0..L {
-                v[l] = h[l].mul_add(d[l], v[l]);
-            }
-        }
-    }
-
-    fn rk4_step(&mut self) {
-        let Lanes {
-            theta,
-            weights,
-            state,
-            scratch: s,
-            ..
-        } = self;
-        let net = Weights { theta, weights };
-        let [k1, k2, k3, k4] = &mut s.k;
-        let probe = &mut s.probe;
-        derivative(&net, state, k1, &mut s.out, &s.ext);
-        offset(probe, state, &s.h2, k1);
-        derivative(&net, probe, k2, &mut s.out, &s.ext);
-        offset(probe, state, &s.h2, k2);
-        derivative(&net, probe, k3, &mut s.out, &s.ext);
-        offset(probe, state, &s.h, k3);
-        derivative(&net, probe, k4, &mut s.out, &s.ext);
-        for i in 0..state.len() {
-            for l in 0..L {
-                let sum = k1[i][l] + 2.0 * k2[i][l] + 2.0 * k3[i][l] + k4[i][l];
-                state[i][l] = s.h6[i][l].mul_add(sum, state[i][l]);
+            Method::Rk4 => {
+                let [k1, k2, k3] = &mut s.k;
+                let mut rk4 = Rk4::<V> {
+                    h2: rows(&s.h2),
+                    h: rows(&s.h),
+                    h6: rows(&s.h6),
+                    k: [k1, k2, k3].map(|k| V::rows_mut(k.as_flattened_mut())),
+                    probe: V::rows_mut(s.probe.as_flattened_mut()),
+                };
+                for _ in 0..integ.substeps {
+                    rk4_step(&net, state, out, &mut rk4);
+                }
             }
         }
     }
@@ -342,73 +349,172 @@ impl<const L: usize> Lanes<L> {
     }
 }
 
-/// The parameters the derivative reads, borrowed apart from the state and the scratch arrays.
-struct Weights<'a, const L: usize> {
-    theta: &'a [[f64; L]],
-    weights: &'a [[f64; L]],
+/// What a step reads besides the state: the parameters and this row's sensor drive.
+struct Net<'a, V: Vector> {
+    theta: &'a [V::Row],
+    weights: &'a [V::Row],
+    /// `S I` for the current input row.
+    ext: &'a [V::Row],
 }
 
-/// `d = -v + W f(v - theta) + ext`, lane by lane.
+/// `ext = S I`, each sum over the sensors in order.
 #[inline(always)]
-fn derivative<const L: usize>(
-    net: &Weights<'_, L>,
-    v: &[[f64; L]],
-    d: &mut [[f64; L]],
-    out: &mut [[f64; L]],
-    ext: &[[f64; L]],
-) {
-    let n = v.len();
-    for j in 0..n {
-        for l in 0..L {
-            out[j][l] = sigmoid(v[j][l] - net.theta[j][l]);
+fn sensor_drive<V: Vector>(sensor_weights: &[V::Row], inputs: &[V::Row], ext: &mut [V::Row]) {
+    if inputs.is_empty() {
+        ext.iter_mut().for_each(|e| V::splat(0.0).store(e));
+        return;
+    }
+    for (e, weights) in ext
+        .iter_mut()
+        .zip(sensor_weights.chunks_exact(inputs.len()))
+    {
+        let mut acc = V::splat(0.0);
+        for (s, x) in weights.iter().zip(inputs) {
+            acc = V::load(s).mul_add(V::load(x), acc);
+        }
+        acc.store(e);
+    }
+}
+
+/// Firing rates `out = f(v - theta)`, [`RATE_GROUP`] neurons at a time (see [`Group`]).
+#[inline(always)]
+fn rates<V: Vector>(theta: &[V::Row], v: &[V::Row], out: &mut [V::Row]) {
+    let mut groups = out.chunks_exact_mut(RATE_GROUP);
+    let mut at = 0;
+    for o in &mut groups {
+        let x = Group::<V, RATE_GROUP>(std::array::from_fn(|g| {
+            V::load(&v[at + g]) - V::load(&theta[at + g])
+        }));
+        for (o, y) in o.iter_mut().zip(sigmoid_lanes(x).0) {
+            y.store(o);
+        }
+        at += RATE_GROUP;
+    }
+    for (o, (x, t)) in groups
+        .into_remainder()
+        .iter_mut()
+        .zip(v[at..].iter().zip(&theta[at..]))
+    {
+        sigmoid_lanes(V::load(x) - V::load(t)).store(o);
+    }
+}
+
+/// Neurons whose firing rates are computed together in [`rates`].
+const RATE_GROUP: usize = 4;
+
+/// Rows of `W f` computed together in [`drive`].
+const ROWS: usize = 4;
+
+/// Reorders row-major `N x N` weights so that [`drive`] reads them as one stream: each group of
+/// [`ROWS`] rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the rows left
+/// over, row by row. Row `i`'s weights start at `i * N` either way.
+fn by_row_groups<T: Copy>(row_major: Vec<T>, n: usize) -> Vec<T> {
+    let full = n - n % ROWS;
+    let mut out = Vec::with_capacity(row_major.len());
+    for i in (0..full).step_by(ROWS) {
+        for j in 0..n {
+            out.extend((i..i + ROWS).map(|r| row_major[r * n + j]));
         }
     }
-    // Rows go ROWS at a time: independent sums keep the adders busy, and each sum still adds
-    // its terms in the order j = 0, 1, ..., so the result does not depend on the blocking.
+    out.extend_from_slice(&row_major[full * n..]);
+    out
+}
+
+/// For every neuron `i`, `finish(i, ext_i + sum_j w_ij out_j)`, the sum taken in the order
+/// `j = 0, 1, ...`. Rows go [`ROWS`] at a time: independent sums keep the multiply-add units
+/// busy, and the result does not depend on the blocking.
+#[inline(always)]
+fn drive<V: Vector>(net: &Net<'_, V>, out: &[V::Row], mut finish: impl FnMut(usize, V)) {
+    let n = out.len();
     let mut i = 0;
     while i + ROWS <= n {
-        let mut acc: [[f64; L]; ROWS] = std::array::from_fn(|r| ext[i + r]);
-        for j in 0..n {
-            let o = &out[j];
-            for (r, a) in acc.iter_mut().enumerate() {
-                let w = &net.weights[(i + r) * n + j];
-                for l in 0..L {
-                    a[l] = w[l].mul_add(o[l], a[l]);
-                }
+        let (columns, _) = net.weights[i * n..(i + ROWS) * n].as_chunks::<ROWS>();
+        let mut acc: [V; ROWS] = std::array::from_fn(|r| V::load(&net.ext[i + r]));
+        for (w, o) in columns.iter().zip(out) {
+            let o = V::load(o);
+            for (a, w) in acc.iter_mut().zip(w) {
+                *a = V::load(w).mul_add(o, *a);
             }
         }
-        for (r, a) in acc.iter().enumerate() {
-            for l in 0..L {
-                d[i + r][l] = a[l] - v[i + r][l];
-            }
+        for (r, a) in acc.into_iter().enumerate() {
+            finish(i + r, a);
         }
         i += ROWS;
     }
     for i in i..n {
-        let mut acc = ext[i];
-        let w = &net.weights[i * n..(i + 1) * n];
-        for j in 0..n {
-            for l in 0..L {
-                acc[l] = w[j][l].mul_add(out[j][l], acc[l]);
-            }
+        let mut acc = V::load(&net.ext[i]);
+        for (w, o) in net.weights[i * n..][..n].iter().zip(out) {
+            acc = V::load(w).mul_add(V::load(o), acc);
         }
-        for l in 0..L {
-            d[i][l] = acc[l] - v[i][l];
-        }
+        finish(i, acc);
     }
 }
 
-/// Rows of `W f` computed together in [`derivative`].
-const ROWS: usize = 4;
-
-/// `probe = v + h * k`, lane by lane.
+/// One Euler step: `v += h * (ext + W f(v - theta) - v)`.
 #[inline(always)]
-fn offset<const L: usize>(probe: &mut [[f64; L]], v: &[[f64; L]], h: &[[f64; L]], k: &[[f64; L]]) {
-    for i in 0..v.len() {
-        for l in 0..L {
-            probe[i][l] = h[i][l].mul_add(k[i][l], v[i][l]);
-        }
+fn euler_step<V: Vector>(net: &Net<'_, V>, v: &mut [V::Row], out: &mut [V::Row], h: &[V::Row]) {
+    rates::<V>(net.theta, v, out);
+    drive(net, out, |i, acc| {
+        let x = V::load(&v[i]);
+        V::load(&h[i]).mul_add(acc - x, x).store(&mut v[i]);
+    });
+}
+
+/// RK4's step sizes and work rows.
+struct Rk4<'a, V: Vector> {
+    /// `dt/tau`, its half and its sixth.
+    h: &'a [V::Row],
+    h2: &'a [V::Row],
+    h6: &'a [V::Row],
+    /// The first three slopes.
+    k: [&'a mut [V::Row]; 3],
+    /// The point where the next slope is taken.
+    probe: &'a mut [V::Row],
+}
+
+/// One classical RK4 step.
+#[inline(always)]
+fn rk4_step<V: Vector>(
+    net: &Net<'_, V>,
+    v: &mut [V::Row],
+    out: &mut [V::Row],
+    rk: &mut Rk4<'_, V>,
+) {
+    let Rk4 {
+        h,
+        h2,
+        h6,
+        k: [k1, k2, k3],
+        probe,
+    } = rk;
+    // Slope 1 at v; the next probe is v + h/2 k1.
+    rates::<V>(net.theta, v, out);
+    drive(net, out, |i, acc| {
+        let x = V::load(&v[i]);
+        let d = acc - x;
+        d.store(&mut k1[i]);
+        V::load(&h2[i]).mul_add(d, x).store(&mut probe[i]);
+    });
+    // Slopes 2 and 3 at the probe; the probes after them are v + h/2 k2 and v + h k3.
+    for (k, h) in [(&mut **k2, *h2), (&mut **k3, *h)] {
+        rates::<V>(net.theta, probe, out);
+        drive(net, out, |i, acc| {
+            let d = acc - V::load(&probe[i]);
+            d.store(&mut k[i]);
+            V::load(&h[i])
+                .mul_add(d, V::load(&v[i]))
+                .store(&mut probe[i]);
+        });
     }
+    // Slope 4 at the last probe, then v += h/6 (k1 + 2 k2 + 2 k3 + k4).
+    rates::<V>(net.theta, probe, out);
+    drive(net, out, |i, acc| {
+        let k4 = acc - V::load(&probe[i]);
+        let two = V::splat(2.0);
+        let sum = V::load(&k1[i]) + two * V::load(&k2[i]) + two * V::load(&k3[i]) + k4;
+        let x = V::load(&v[i]);
+        V::load(&h6[i]).mul_add(sum, x).store(&mut v[i]);
+    });
 }
 
 impl Network {
@@ -591,6 +697,94 @@ mod tests {
         };
         let e = net.run(&[0.0], 1, &huge).unwrap_err().to_string();
         assert!(e.contains("diverged"), "{e}");
+    }
+
+    #[test]
+    fn weights_are_stored_by_row_groups() {
+        // 6 x 6: one group of ROWS = 4 rows read column by column, then rows 4 and 5 as they are.
+        let n = 6;
+        let w: Vec<usize> = (0..n * n).collect();
+        let stored = by_row_groups(w, n);
+        let group: Vec<usize> = (0..n)
+            .flat_map(|j| (0..ROWS).map(move |r| r * n + j))
+            .collect();
+        assert_eq!(stored[..ROWS * n], group[..]);
+        assert_eq!(
+            stored[ROWS * n..],
+            (ROWS * n..n * n).collect::<Vec<_>>()[..]
+        );
+        // Fewer rows than a group: unchanged.
+        assert_eq!(by_row_groups(vec![1, 2, 3, 4], 2), vec![1, 2, 3, 4]);
+    }
+
+    /// Random networks of one shape, from a fixed seed.
+    fn random_networks(count: usize, n: usize, m: usize, seed: u64) -> Vec<Network> {
+        use crate::rng::{Purpose, Stream};
+        let mut rng = Stream::new(seed, 0, Purpose::Init, 0, 0);
+        let mut draw = |count: usize, lo: f64, hi: f64| -> Vec<f64> {
+            (0..count).map(|_| rng.range(lo, hi)).collect()
+        };
+        (0..count)
+            .map(|_| {
+                let (tau, theta) = (draw(n, 0.5, 10.0), draw(n, -16.0, 16.0));
+                let (w, s, v) = (
+                    draw(n * n, -16.0, 16.0),
+                    draw(n * m, -16.0, 16.0),
+                    draw(n, -5.0, 5.0),
+                );
+                Network::new(tau, theta, w, s, Some(v)).unwrap()
+            })
+            .collect()
+    }
+
+    /// Steps one block with vector backend `V` and with the portable backend: same bits.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    fn backends_agree<V: Vector<Row = R>, R, const L: usize>() {
+        for (n, m) in [
+            (1, 0),
+            (3, 1),
+            (4, 2),
+            (5, 2),
+            (7, 3),
+            (10, 2),
+            (13, 1),
+            (30, 2),
+        ] {
+            let nets = random_networks(L, n, m, (n * 10 + m) as u64);
+            let refs: Vec<&Network> = nets.iter().collect();
+            for method in [Method::Euler, Method::Rk4] {
+                let integ = Integrator {
+                    method,
+                    dt: 0.05,
+                    substeps: 3,
+                };
+                let mut fast = Lanes::<L>::new(&refs).unwrap();
+                let mut portable = fast.clone();
+                for t in 0..20 {
+                    let inputs: Vec<[f64; L]> = (0..m)
+                        .map(|k| std::array::from_fn(|l| ((t * 7 + k * 3 + l) % 5) as f64 - 2.0))
+                        .collect();
+                    fast.prepare(integ.dt);
+                    fast.step_row_with::<V>(&inputs, &integ);
+                    portable.prepare(integ.dt);
+                    portable.step_row_with::<Portable<L>>(&inputs, &integ);
+                }
+                for i in 0..n {
+                    let (a, b) = (fast.state(i), portable.state(i));
+                    assert!(
+                        a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                        "N = {n}, M = {m}, {method:?}, neuron {i}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    fn avx512_blocks_match_the_portable_kernel_bit_for_bit() {
+        backends_agree::<Avx512, [f64; 8], 8>();
+        backends_agree::<Group<Avx512, 2>, [[f64; 8]; 2], 16>();
     }
 
     #[test]

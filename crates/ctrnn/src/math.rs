@@ -5,13 +5,17 @@
 //! the exact value, the same bits on every platform, and cheap enough that an integration step is
 //! limited by arithmetic, not by calls.
 //!
+//! Both are written once, over the crate's lane vectors, and run on one network or on a block of
+//! networks with the same operations in the same order; [`exp`] and [`sigmoid`] are the
+//! one-value versions.
+//!
 //! Multiply-adds are written as [`f64::mul_add`], which is always fused (one rounding): a single
 //! FMA instruction on CPUs that have one (every x86-64 since 2013 and every 64-bit ARM), and the
 //! same bits, slowly, in software elsewhere. Every code path in dnnevo (single network, population,
 //! tasks) uses [`sigmoid`], which is what makes them agree bit for bit.
 
-/// Shifts a float so that its last mantissa bits hold `round(x)` (valid for |x| < 2^51).
-const ROUND_SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5 * 2^52
+use crate::vector::{Arith, Portable, ROUND_SHIFT};
+
 const INV_LN2: f64 = std::f64::consts::LOG2_E;
 /// ln 2 split into a part with trailing zero bits (exact when multiplied by k) and the rest.
 const LN2_HI: f64 = f64::from_bits(0x3FE6_2E42_FEE0_0000);
@@ -46,26 +50,7 @@ const TAYLOR: [f64; 12] = [
 /// ```
 #[inline(always)]
 pub fn exp(x: f64) -> f64 {
-    let x = x.clamp(EXP_MIN, EXP_MAX);
-    // k = round(x / ln2), computed without a float-to-int conversion.
-    let shifted = x.mul_add(INV_LN2, ROUND_SHIFT);
-    let k = shifted - ROUND_SHIFT;
-    let r = (-k).mul_add(LN2_LO, (-k).mul_add(LN2_HI, x));
-    // Estrin's scheme: the same polynomial as Horner's, with a dependency chain a third as long.
-    let c = &TAYLOR;
-    let r2 = r * r;
-    let r4 = r2 * r2;
-    let r8 = r4 * r4;
-    let pair = |hi: f64, lo: f64| hi.mul_add(r, lo);
-    let s0 = pair(c[8], c[9]).mul_add(r2, pair(c[10], c[11]));
-    let s1 = pair(c[4], c[5]).mul_add(r2, pair(c[6], c[7]));
-    let s2 = pair(c[0], c[1]).mul_add(r2, pair(c[2], c[3]));
-    let p = s2.mul_add(r8, s1.mul_add(r4, s0));
-    let er = 1.0 + r2.mul_add(p, r);
-    // 2^k: the low bits of `shifted` hold k as a two's-complement integer.
-    let k_int = shifted.to_bits().wrapping_sub(ROUND_SHIFT.to_bits());
-    let scale = f64::from_bits(k_int.wrapping_add(1023) << 52);
-    er * scale
+    exp_lanes(Portable([x])).0[0]
 }
 
 /// The logistic firing rate `1 / (1 + e^(-x))`.
@@ -76,7 +61,36 @@ pub fn exp(x: f64) -> f64 {
 /// ```
 #[inline(always)]
 pub fn sigmoid(x: f64) -> f64 {
-    1.0 / (1.0 + exp(-x))
+    sigmoid_lanes(Portable([x])).0[0]
+}
+
+/// [`exp`] in every lane.
+#[inline(always)]
+pub(crate) fn exp_lanes<V: Arith>(x: V) -> V {
+    let x = x.clamp(EXP_MIN, EXP_MAX);
+    // k = round(x / ln2), computed without a float-to-int conversion.
+    let shifted = x.mul_add(V::splat(INV_LN2), V::splat(ROUND_SHIFT));
+    let k = shifted - V::splat(ROUND_SHIFT);
+    let r = (-k).mul_add(V::splat(LN2_LO), (-k).mul_add(V::splat(LN2_HI), x));
+    // Estrin's scheme: the same polynomial as Horner's, with a dependency chain a third as long.
+    let c = TAYLOR.map(V::splat);
+    let r2 = r * r;
+    let r4 = r2 * r2;
+    let r8 = r4 * r4;
+    let pair = |hi: V, lo: V| hi.mul_add(r, lo);
+    let s0 = pair(c[8], c[9]).mul_add(r2, pair(c[10], c[11]));
+    let s1 = pair(c[4], c[5]).mul_add(r2, pair(c[6], c[7]));
+    let s2 = pair(c[0], c[1]).mul_add(r2, pair(c[2], c[3]));
+    let p = s2.mul_add(r8, s1.mul_add(r4, s0));
+    let er = V::splat(1.0) + r2.mul_add(p, r);
+    er.mul_pow2(k)
+}
+
+/// [`sigmoid`] in every lane.
+#[inline(always)]
+pub(crate) fn sigmoid_lanes<V: Arith>(x: V) -> V {
+    let one = V::splat(1.0);
+    one / (one + exp_lanes(-x))
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 //! are independent, so the result does not depend on the number of threads, and each network's
 //! result is bit-identical to [`Network::run`] on that network alone.
 
+use std::borrow::Borrow;
 use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
@@ -35,31 +36,29 @@ pub struct Population {
 }
 
 impl Population {
-    /// Packs `networks` (at least one, all with the same N and M).
-    pub fn new(networks: &[Network]) -> Result<Self> {
-        let first = networks.first().ok_or_else(|| {
+    /// Packs `networks` (at least one, all with the same N and M), given as networks or as
+    /// references to them.
+    pub fn new<N: Borrow<Network>>(networks: &[N]) -> Result<Self> {
+        let refs: Vec<&Network> = networks.iter().map(Borrow::borrow).collect();
+        let first = refs.first().ok_or_else(|| {
             Error::InvalidArgument("a population needs at least 1 network".into())
         })?;
         let (n, m) = (first.size(), first.n_inputs());
-        if let Some(p) = networks
-            .iter()
-            .position(|x| (x.size(), x.n_inputs()) != (n, m))
-        {
+        if let Some(p) = refs.iter().position(|x| (x.size(), x.n_inputs()) != (n, m)) {
             return Err(Error::InvalidArgument(format!(
                 "network {p} has N = {}, M = {}; every network of a population must have N = {n}, M = {m}",
-                networks[p].size(),
-                networks[p].n_inputs()
+                refs[p].size(),
+                refs[p].n_inputs()
             )));
         }
-        let refs: Vec<&Network> = networks.iter().collect();
         let blocks = refs
             .chunks(LANES)
             .map(Block::new)
             .collect::<Result<Vec<_>>>()?;
         Ok(Population {
-            size: first.size(),
-            n_inputs: first.n_inputs(),
-            len: networks.len(),
+            size: n,
+            n_inputs: m,
+            len: refs.len(),
             blocks,
         })
     }
@@ -112,37 +111,50 @@ impl Population {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<f64>> {
         integ.validate()?;
-        let (n, m, p_len) = (self.size, self.n_inputs, self.len);
+        let (m, p_len) = (self.n_inputs, self.len);
         match inputs {
             Inputs::Shared(x) => check_inputs(x, steps * m, "T x M")?,
             Inputs::PerNetwork(x) => check_inputs(x, p_len * steps * m, "P x T x M")?,
         }
-        let row_of = |b: usize| {
-            move |t: usize, row: &mut [[f64; LANES]]| match inputs {
-                Inputs::Shared(x) => {
-                    for k in 0..m {
-                        row[k] = [x[t * m + k]; LANES];
+        match inputs {
+            Inputs::Shared(x) => self.run_filled(steps, integ, record, cancel, |_, t, row| {
+                for (r, &v) in row.iter_mut().zip(&x[t * m..(t + 1) * m]) {
+                    *r = [v; LANES];
+                }
+            }),
+            Inputs::PerNetwork(x) => self.run_filled(steps, integ, record, cancel, |b, t, row| {
+                for l in 0..LANES {
+                    // Padding lanes repeat the block's first network.
+                    let p = b * LANES + if b * LANES + l < p_len { l } else { 0 };
+                    let at = (p * steps + t) * m;
+                    for (r, &v) in row.iter_mut().zip(&x[at..at + m]) {
+                        r[l] = v;
                     }
                 }
-                Inputs::PerNetwork(x) => {
-                    for l in 0..LANES {
-                        // Padding lanes repeat the block's first network.
-                        let p = (b * LANES + if b * LANES + l < p_len { l } else { 0 }) * steps;
-                        for k in 0..m {
-                            row[k][l] = x[(p + t) * m + k];
-                        }
-                    }
-                }
-            }
-        };
+            }),
+        }
+    }
+
+    /// [`run`](Self::run) with `fill(b, t, row)` writing block `b`'s inputs of row `t`.
+    fn run_filled(
+        &mut self,
+        steps: usize,
+        integ: &Integrator,
+        record: bool,
+        cancel: Option<&AtomicBool>,
+        fill: impl Fn(usize, usize, &mut [[f64; LANES]]) + Sync,
+    ) -> Result<Vec<f64>> {
+        let n = self.size;
+        let fill = &fill;
         if record {
-            let mut out = vec![0.0; p_len * steps * n];
+            let mut out = vec![0.0; self.len * steps * n];
             self.blocks
                 .par_iter_mut()
                 .zip(out.par_chunks_mut(LANES * steps * n))
                 .enumerate()
                 .try_for_each(|(b, (block, chunk))| {
-                    block.run_rows(steps, integ, cancel, row_of(b), |t, block| {
+                    let row = |t, row: &mut [[f64; LANES]]| fill(b, t, row);
+                    block.run_rows(steps, integ, cancel, row, |t, block| {
                         for l in 0..block.len() {
                             let at = (l * steps + t) * n;
                             block.lane_state(l, &mut chunk[at..at + n]);
@@ -155,7 +167,8 @@ impl Population {
                 .par_iter_mut()
                 .enumerate()
                 .try_for_each(|(b, block)| {
-                    block.run_rows(steps, integ, cancel, row_of(b), |_, _| {})
+                    let row = |t, row: &mut [[f64; LANES]]| fill(b, t, row);
+                    block.run_rows(steps, integ, cancel, row, |_, _| {})
                 })?;
             Ok(self.states())
         }
@@ -234,7 +247,7 @@ mod tests {
         nets.push(b);
         let e = Population::new(&nets).unwrap_err().to_string();
         assert!(e.contains("network 10 has N = 2"), "{e}");
-        assert!(Population::new(&[]).is_err());
+        assert!(Population::new::<Network>(&[]).is_err());
     }
 
     #[test]

@@ -481,6 +481,25 @@ pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
     if let Ok(d) = obj.cast::<PyDict>() {
         return stacked(d);
     }
+    Ok(network_objects(obj)?
+        .iter()
+        .map(|net| net.inner.clone())
+        .collect())
+}
+
+/// Packs a population for the integrator straight from its Python form (as [`networks_from`]),
+/// without copying each `Network` first.
+fn population_from(obj: &Bound<'_, PyAny>) -> PyResult<Population> {
+    if let Ok(d) = obj.cast::<PyDict>() {
+        return Population::new(&stacked(d)?).py_err();
+    }
+    let objects = network_objects(obj)?;
+    let refs: Vec<&ctrnn::Network> = objects.iter().map(|net| &net.inner).collect();
+    Population::new(&refs).py_err()
+}
+
+/// Borrows every item of a non-empty sequence of Networks.
+fn network_objects<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Vec<PyRef<'py, PyNetwork>>> {
     let mut nets = Vec::new();
     for (p, item) in obj
         .try_iter()
@@ -497,7 +516,7 @@ pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
                     .unwrap_or_default()
             ))
         })?;
-        nets.push(net.borrow().inner.clone());
+        nets.push(net.borrow());
     }
     if nets.is_empty() {
         return Err(arg_err(
@@ -581,8 +600,7 @@ pub fn run_population<'py>(
     record: bool,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let integ = integrator(dt, substeps, method)?;
-    let nets = networks_from(networks)?;
-    let mut pop = Population::new(&nets).py_err()?;
+    let mut pop = population_from(networks)?;
     let (p_len, n, m) = (pop.len(), pop.size(), pop.n_inputs());
     let x = dense(inputs, "inputs", arg_err)?;
     let (steps, shared) = match x.shape.as_slice() {

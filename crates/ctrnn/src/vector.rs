@@ -1,0 +1,237 @@
+//! Rows of values computed on together, one value per network of a block.
+//!
+//! The integrator and the sigmoid are written once, generically over [`Vector`]. Each backend
+//! maps the same sequence of IEEE operations (add, subtract, multiply, divide, fused multiply-add,
+//! exact scaling by a power of two) onto its own instructions, so every backend gives the same
+//! bits:
+//! - [`Portable<L>`]: `L` plain `f64`s, lane by lane. Used for single networks (`L = 1`) and
+//!   wherever no explicit backend applies.
+//! - `Avx512` (x86-64 builds whose target CPU has AVX-512F): 8 lanes in one 512-bit register.
+//!   LLVM does not find this layout on its own: it vectorises the sigmoid loop across neurons,
+//!   with gathers and scatters, instead of across networks.
+//!
+//! Which backend a build uses is fixed at compile time by its target features (see
+//! `.cargo/config.toml`); results do not depend on it.
+
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+mod avx512;
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+pub(crate) use avx512::Avx512;
+
+/// Lane-by-lane arithmetic that rounds as IEEE 754 binary64 does, so that a backend can only
+/// change speed, never a result.
+pub(crate) trait Arith:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// Every lane `x`.
+    fn splat(x: f64) -> Self;
+    /// `self * a + b` with one rounding.
+    fn mul_add(self, a: Self, b: Self) -> Self;
+    /// Each lane clamped to `[lo, hi]`; NaN stays NaN, as with [`f64::clamp`].
+    fn clamp(self, lo: f64, hi: f64) -> Self;
+    /// `self * 2^k` for lanes of `k` that hold integers in [-1022, 1023] and products that are
+    /// normal numbers, where the product is exact.
+    fn mul_pow2(self, k: Self) -> Self;
+}
+
+/// A row of values as the integrator stores it, one per network of a block.
+pub(crate) trait Vector: Arith {
+    /// How values are stored: `[f64; lanes]`.
+    type Row: Copy;
+
+    /// Reads a stored row.
+    fn load(row: &Self::Row) -> Self;
+    /// Writes into a stored row.
+    fn store(self, row: &mut Self::Row);
+    /// Views `lanes * k` values as `k` rows.
+    fn rows(flat: &[f64]) -> &[Self::Row];
+    /// Views `lanes * k` values as `k` mutable rows.
+    fn rows_mut(flat: &mut [f64]) -> &mut [Self::Row];
+}
+
+/// `G` vectors computed on together, operation by operation. A long dependency chain such as
+/// the sigmoid then runs `G` times in parallel instead of one after another, which keeps more
+/// of the CPU's execution units busy than its out-of-order window would on its own.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Group<V, const G: usize>(pub [V; G]);
+
+macro_rules! group_op {
+    ($trait:ident, $method:ident) => {
+        impl<V: Arith, const G: usize> $trait for Group<V, G> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, o: Self) -> Self {
+                Group(std::array::from_fn(|g| self.0[g].$method(o.0[g])))
+            }
+        }
+    };
+}
+group_op!(Add, add);
+group_op!(Sub, sub);
+group_op!(Mul, mul);
+group_op!(Div, div);
+
+impl<V: Arith, const G: usize> Neg for Group<V, G> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Group(self.0.map(|x| -x))
+    }
+}
+
+impl<V: Arith, const G: usize> Arith for Group<V, G> {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        Group([V::splat(x); G])
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        Group(std::array::from_fn(|g| self.0[g].mul_add(a.0[g], b.0[g])))
+    }
+    #[inline(always)]
+    fn clamp(self, lo: f64, hi: f64) -> Self {
+        Group(self.0.map(|x| x.clamp(lo, hi)))
+    }
+    #[inline(always)]
+    fn mul_pow2(self, k: Self) -> Self {
+        Group(std::array::from_fn(|g| self.0[g].mul_pow2(k.0[g])))
+    }
+}
+
+impl<V: Vector, const G: usize> Vector for Group<V, G> {
+    type Row = [V::Row; G];
+
+    #[inline(always)]
+    fn load(row: &Self::Row) -> Self {
+        Group(std::array::from_fn(|g| V::load(&row[g])))
+    }
+    #[inline(always)]
+    fn store(self, row: &mut Self::Row) {
+        for (v, r) in self.0.into_iter().zip(row) {
+            v.store(r);
+        }
+    }
+    #[inline(always)]
+    fn rows(flat: &[f64]) -> &[Self::Row] {
+        V::rows(flat).as_chunks().0
+    }
+    #[inline(always)]
+    fn rows_mut(flat: &mut [f64]) -> &mut [Self::Row] {
+        V::rows_mut(flat).as_chunks_mut().0
+    }
+}
+
+/// Shifts a float so that its last mantissa bits hold an integer (valid for |k| < 2^51).
+pub(crate) const ROUND_SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5 * 2^52
+
+/// `2^k` for an integer-valued `k` in [-1022, 1023], built from its bits.
+#[inline(always)]
+fn pow2(k: f64) -> f64 {
+    let k_int = (k + ROUND_SHIFT)
+        .to_bits()
+        .wrapping_sub(ROUND_SHIFT.to_bits());
+    f64::from_bits(k_int.wrapping_add(1023) << 52)
+}
+
+/// `L` plain `f64`s, computed on one by one (the compiler may still vectorise them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Portable<const L: usize>(pub [f64; L]);
+
+macro_rules! portable_op {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl<const L: usize> $trait for Portable<L> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, o: Self) -> Self {
+                Portable(std::array::from_fn(|l| self.0[l] $op o.0[l]))
+            }
+        }
+    };
+}
+portable_op!(Add, add, +);
+portable_op!(Sub, sub, -);
+portable_op!(Mul, mul, *);
+portable_op!(Div, div, /);
+
+impl<const L: usize> Neg for Portable<L> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Portable(self.0.map(|x| -x))
+    }
+}
+
+impl<const L: usize> Arith for Portable<L> {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        Portable([x; L])
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        Portable(std::array::from_fn(|l| self.0[l].mul_add(a.0[l], b.0[l])))
+    }
+    #[inline(always)]
+    fn clamp(self, lo: f64, hi: f64) -> Self {
+        Portable(self.0.map(|x| x.clamp(lo, hi)))
+    }
+    #[inline(always)]
+    fn mul_pow2(self, k: Self) -> Self {
+        Portable(std::array::from_fn(|l| self.0[l] * pow2(k.0[l])))
+    }
+}
+
+impl<const L: usize> Vector for Portable<L> {
+    type Row = [f64; L];
+
+    #[inline(always)]
+    fn load(row: &[f64; L]) -> Self {
+        Portable(*row)
+    }
+    #[inline(always)]
+    fn store(self, row: &mut [f64; L]) {
+        *row = self.0;
+    }
+    #[inline(always)]
+    fn rows(flat: &[f64]) -> &[[f64; L]] {
+        let (rows, rest) = flat.as_chunks();
+        debug_assert!(rest.is_empty());
+        rows
+    }
+    #[inline(always)]
+    fn rows_mut(flat: &mut [f64]) -> &mut [[f64; L]] {
+        let (rows, rest) = flat.as_chunks_mut();
+        debug_assert!(rest.is_empty());
+        rows
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pow2_is_exact_over_the_normal_range() {
+        for k in -1022..=1023 {
+            assert_eq!(pow2(k as f64), 2f64.powi(k), "k = {k}");
+        }
+    }
+
+    #[test]
+    fn portable_rows_view_flat_storage() {
+        let mut flat = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        assert_eq!(
+            Portable::<3>::rows(&flat),
+            &[[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
+        );
+        let row = &mut Portable::<2>::rows_mut(&mut flat)[1];
+        (Portable::load(row) * Portable::splat(2.0)).store(row);
+        assert_eq!(flat, [1.0, 2.0, 6.0, 8.0, 5.0, 6.0]);
+    }
+}

@@ -65,10 +65,19 @@ def timed(fn):
     return time.perf_counter() - start, result
 
 
+# Warm-up before timing: calls until this much time has passed (at least one call). A cold start
+# (clocks ramping up, idle worker threads, the allocator's first pages) makes the first few
+# calls of a few-millisecond workload up to twice as slow as the rest.
+WARMUP_SECONDS = 0.25
+
+
 def median_time(fn, repeats: int):
-    """(median seconds of `repeats` timed calls `fn(i)`, i = 0 .. repeats-1, after a warm-up
-    call `fn(0)`; the last call's result)."""
+    """(median seconds of `repeats` timed calls `fn(i)`, i = 0 .. repeats-1, after warm-up
+    calls `fn(0)` for at least WARMUP_SECONDS; the last call's result)."""
+    start = time.perf_counter()
     result = fn(0)  # warm-up
+    while time.perf_counter() - start < WARMUP_SECONDS:
+        result = fn(0)
     times = []
     for i in range(repeats):
         t, result = timed(lambda: fn(i))

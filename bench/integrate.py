@@ -7,8 +7,8 @@ Workload (per network size N in {5, 10, 30}):
 
 dnnevo is timed with run_population(..., record=False) on all cores; NumPy with the same
 equations, batched over the population with einsum, on one core (NumPy's einsum does not thread).
-Each figure is the median of timed runs after one warm-up run (--repeats for dnnevo, at most 3 for
-NumPy), in network-steps per second (P x steps / seconds). NumPy may be timed over fewer steps
+Each figure is the median of timed runs (--repeats for dnnevo, at most 3 for NumPy) after a
+quarter-second warm-up, in network-steps per second (P x steps / seconds). NumPy may be timed over fewer steps
 (--numpy-steps) to save time: the figure is a per-step throughput. The final states of both codes
 after the full T steps are compared network by network (rtol = atol = 1e-9). A few random networks
 are chaotic and amplify rounding differences over 1000 steps; a mismatch is reported as such

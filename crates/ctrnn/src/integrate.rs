@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::math::{sigmoid, sigmoid_lanes};
 use crate::network::Network;
+use crate::rows::Rows;
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
 use crate::vector::Avx512;
 use crate::vector::{Group, Portable, Vector};
@@ -103,17 +104,33 @@ impl Integrator {
     }
 }
 
+/// Calls `self.method::<V>(args)` with `V` the lane vector type for `L` lanes: AVX-512 registers
+/// where the build's target CPU has them and `L` is 8 or 16, plain lanes otherwise.
+macro_rules! with_backend {
+    ($self:ident . $method:ident ( $($arg:expr),* )) => {{
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+        if L == 8 {
+            return $self.$method::<Avx512>($($arg),*);
+        }
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+        if L == 16 {
+            return $self.$method::<Group<Avx512, 2>>($($arg),*);
+        }
+        $self.$method::<Portable<L>>($($arg),*)
+    }};
+}
+
 /// `L` networks of the same shape, laid out for stepping together.
 #[derive(Clone, Debug)]
 pub struct Lanes<const L: usize> {
     size: usize,
     n_inputs: usize,
     len: usize,
-    tau: Vec<[f64; L]>,
-    theta: Vec<[f64; L]>,
-    weights: Vec<[f64; L]>,
-    sensor_weights: Vec<[f64; L]>,
-    state: Vec<[f64; L]>,
+    tau: Rows<L>,
+    theta: Rows<L>,
+    weights: Rows<L>,
+    sensor_weights: Rows<L>,
+    state: Rows<L>,
     scratch: Scratch<L>,
 }
 
@@ -122,16 +139,16 @@ pub struct Lanes<const L: usize> {
 struct Scratch<const L: usize> {
     dt: f64,
     /// dt / tau, and its half and sixth for RK4.
-    h: Vec<[f64; L]>,
-    h2: Vec<[f64; L]>,
-    h6: Vec<[f64; L]>,
+    h: Rows<L>,
+    h2: Rows<L>,
+    h6: Rows<L>,
     /// Sensor drive S I of the current row.
-    ext: Vec<[f64; L]>,
+    ext: Rows<L>,
     /// Firing rates.
-    out: Vec<[f64; L]>,
+    out: Rows<L>,
     /// RK4's first three slopes (the fourth is used as soon as it is known).
-    k: [Vec<[f64; L]>; 3],
-    probe: Vec<[f64; L]>,
+    k: [Rows<L>; 3],
+    probe: Rows<L>,
 }
 
 impl<const L: usize> Lanes<L> {
@@ -157,26 +174,22 @@ impl<const L: usize> Lanes<L> {
                 )));
             }
         }
-        let gather = |get: fn(&Network) -> &[f64], count: usize| -> Vec<[f64; L]> {
-            let mut rows = vec![[0.0; L]; count];
-            for l in 0..L {
-                let values = get(nets.get(l).unwrap_or(first));
-                for (row, &x) in rows.iter_mut().zip(values) {
-                    row[l] = x;
-                }
-            }
-            rows
+        // Row r of an array holds value order[r] of every network; padding lanes repeat the first.
+        let gather = |get: fn(&Network) -> &[f64], order: &mut dyn Iterator<Item = usize>| {
+            let sources: [&[f64]; L] = std::array::from_fn(|l| get(nets.get(l).unwrap_or(first)));
+            let len = get(first).len();
+            Rows::from_rows(len, order.map(|q| std::array::from_fn(|l| sources[l][q])))
         };
-        let zeros = |count: usize| vec![[0.0; L]; count];
+        let zeros = Rows::zeros;
         Ok(Lanes {
             size: n,
             n_inputs: m,
             len: nets.len(),
-            tau: gather(Network::tau, n),
-            theta: gather(Network::theta, n),
-            weights: by_row_groups(gather(Network::weights, n * n), n),
-            sensor_weights: gather(Network::sensor_weights, n * m),
-            state: gather(Network::state, n),
+            tau: gather(Network::tau, &mut (0..n)),
+            theta: gather(Network::theta, &mut (0..n)),
+            weights: gather(Network::weights, &mut weight_order(n)),
+            sensor_weights: gather(Network::sensor_weights, &mut (0..n * m)),
+            state: gather(Network::state, &mut (0..n)),
             scratch: Scratch {
                 dt: f64::NAN,
                 h: zeros(n),
@@ -227,9 +240,7 @@ impl<const L: usize> Lanes<L> {
     }
     /// Copies the state of lane `l` into `into` (length N).
     pub fn lane_state(&self, l: usize, into: &mut [f64]) {
-        for (dst, row) in into.iter_mut().zip(&self.state) {
-            *dst = row[l];
-        }
+        copy_lane(&self.state, l, into);
     }
 
     /// Makes the step sizes match `dt`.
@@ -260,77 +271,88 @@ impl<const L: usize> Lanes<L> {
     pub fn step_row(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
         debug_assert_eq!(inputs.len(), self.n_inputs);
         self.prepare(integ.dt);
-        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-        if L == 8 {
-            return self.step_row_with::<Avx512>(inputs, integ);
-        }
-        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-        if L == 16 {
-            return self.step_row_with::<Group<Avx512, 2>>(inputs, integ);
-        }
-        self.step_row_with::<Portable<L>>(inputs, integ);
+        with_backend!(self.step_row_with(inputs, integ))
     }
 
-    /// [`step_row`](Self::step_row) on the lane vector `V`, whose rows are `[f64; L]`.
     #[inline(always)]
     fn step_row_with<V: Vector>(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
-        fn rows<V: Vector, const L: usize>(x: &[[f64; L]]) -> &[V::Row] {
-            V::rows(x.as_flattened())
-        }
-        let rows = rows::<V, L>;
-        let s = &mut self.scratch;
-        let ext = V::rows_mut(s.ext.as_flattened_mut());
-        sensor_drive::<V>(rows(&self.sensor_weights), rows(inputs), ext);
-        let net = Net::<V> {
-            theta: rows(&self.theta),
-            weights: rows(&self.weights),
-            ext: &*ext,
-        };
-        let state = V::rows_mut(self.state.as_flattened_mut());
-        let out = V::rows_mut(s.out.as_flattened_mut());
-        match integ.method {
-            Method::Euler => {
-                let h = rows(&s.h);
-                for _ in 0..integ.substeps {
-                    euler_step(&net, state, out, h);
-                }
-            }
-            Method::Rk4 => {
-                let [k1, k2, k3] = &mut s.k;
-                let mut rk4 = Rk4::<V> {
-                    h2: rows(&s.h2),
-                    h: rows(&s.h),
-                    h6: rows(&s.h6),
-                    k: [k1, k2, k3].map(|k| V::rows_mut(k.as_flattened_mut())),
-                    probe: V::rows_mut(s.probe.as_flattened_mut()),
-                };
-                for _ in 0..integ.substeps {
-                    rk4_step(&net, state, out, &mut rk4);
-                }
-            }
-        }
+        let (mut work, state) = self.work::<V>();
+        work.step(
+            V::rows_mut(state.as_flattened_mut()),
+            V::rows(inputs.as_flattened()),
+            integ,
+        );
     }
 
     /// Runs `steps` input rows. `row(t, inputs)` fills the sensors of row `t`; after each row
-    /// `record(t, self)` may read the state. Stops with [`Error::Interrupted`] when `cancel` is set.
+    /// `record(t, state)` may read the state (one `[f64; L]` per neuron). Stops with
+    /// [`Error::Interrupted`] when `cancel` is set.
     pub fn run_rows(
         &mut self,
         steps: usize,
         integ: &Integrator,
         cancel: Option<&AtomicBool>,
-        mut row: impl FnMut(usize, &mut [[f64; L]]),
-        mut record: impl FnMut(usize, &Self),
+        row: impl FnMut(usize, &mut [[f64; L]]),
+        record: impl FnMut(usize, &[[f64; L]]),
     ) -> Result<()> {
-        let mut inputs = vec![[0.0; L]; self.n_inputs];
+        self.prepare(integ.dt);
+        with_backend!(self.run_rows_with(steps, integ, cancel, row, record))?;
+        self.check_finite()
+    }
+
+    #[inline(always)]
+    fn run_rows_with<V: Vector>(
+        &mut self,
+        steps: usize,
+        integ: &Integrator,
+        cancel: Option<&AtomicBool>,
+        mut row: impl FnMut(usize, &mut [[f64; L]]),
+        mut record: impl FnMut(usize, &[[f64; L]]),
+    ) -> Result<()> {
+        let mut inputs = Rows::<L>::zeros(self.n_inputs);
+        // The row views are taken once: taken row by row, they cost 10% at N = 5.
+        let inputs: &mut [[f64; L]] = &mut inputs;
+        let (mut work, state) = self.work::<V>();
         for t in 0..steps {
             if t % CANCEL_CHECK_ROWS == 0 && cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
                 return Err(Error::Interrupted);
             }
-            row(t, &mut inputs);
-            self.step_row(&inputs, integ);
-            record(t, self);
+            row(t, inputs);
+            let v = V::rows_mut(state.as_flattened_mut());
+            work.step(v, V::rows(inputs.as_flattened()), integ);
+            record(t, state);
         }
-        self.check_finite()
+        Ok(())
+    }
+
+    /// Every array a step uses but the state, viewed as rows of `V`; and the state.
+    #[inline(always)]
+    fn work<V: Vector>(&mut self) -> (Work<'_, V>, &mut [[f64; L]]) {
+        fn rows<V: Vector, const L: usize>(x: &[[f64; L]]) -> &[V::Row] {
+            V::rows(x.as_flattened())
+        }
+        fn rows_mut<V: Vector, const L: usize>(x: &mut [[f64; L]]) -> &mut [V::Row] {
+            V::rows_mut(x.as_flattened_mut())
+        }
+        let s = &mut self.scratch;
+        let [k1, k2, k3] = &mut s.k;
+        let work = Work {
+            theta: rows::<V, L>(&self.theta),
+            weights: rows::<V, L>(&self.weights),
+            sensor_weights: rows::<V, L>(&self.sensor_weights),
+            h: rows::<V, L>(&s.h),
+            h2: rows::<V, L>(&s.h2),
+            h6: rows::<V, L>(&s.h6),
+            ext: rows_mut::<V, L>(&mut s.ext),
+            out: rows_mut::<V, L>(&mut s.out),
+            k: [
+                rows_mut::<V, L>(k1),
+                rows_mut::<V, L>(k2),
+                rows_mut::<V, L>(k3),
+            ],
+            probe: rows_mut::<V, L>(&mut s.probe),
+        };
+        (work, &mut self.state)
     }
 
     /// An Euler step with `dt / tau > 2` oscillates with growing amplitude; say so rather than
@@ -349,12 +371,95 @@ impl<const L: usize> Lanes<L> {
     }
 }
 
-/// What a step reads besides the state: the parameters and this row's sensor drive.
-struct Net<'a, V: Vector> {
+/// The arrays of one step, viewed as rows of the lane vector `V`: the parameters, the step sizes
+/// and the work rows (everything but the state).
+struct Work<'a, V: Vector> {
     theta: &'a [V::Row],
     weights: &'a [V::Row],
+    sensor_weights: &'a [V::Row],
+    /// `dt/tau`, its half and its sixth.
+    h: &'a [V::Row],
+    h2: &'a [V::Row],
+    h6: &'a [V::Row],
     /// `S I` for the current input row.
-    ext: &'a [V::Row],
+    ext: &'a mut [V::Row],
+    /// Firing rates.
+    out: &'a mut [V::Row],
+    /// RK4's first three slopes (the fourth is used as soon as it is known).
+    k: [&'a mut [V::Row]; 3],
+    /// The point where RK4's next slope is taken.
+    probe: &'a mut [V::Row],
+}
+
+impl<V: Vector> Work<'_, V> {
+    /// Holds `inputs` for `integ.substeps` steps of the state `v`.
+    #[inline(always)]
+    fn step(&mut self, v: &mut [V::Row], inputs: &[V::Row], integ: &Integrator) {
+        sensor_drive::<V>(self.sensor_weights, inputs, self.ext);
+        for _ in 0..integ.substeps {
+            match integ.method {
+                Method::Euler => self.euler_step(v),
+                Method::Rk4 => self.rk4_step(v),
+            }
+        }
+    }
+
+    /// One Euler step: `v += h * (ext + W f(v - theta) - v)`.
+    #[inline(always)]
+    fn euler_step(&mut self, v: &mut [V::Row]) {
+        let h = self.h;
+        rates::<V>(self.theta, v, self.out);
+        drive::<V>(self.weights, self.ext, self.out, |i, acc| {
+            let x = V::load(&v[i]);
+            V::load(&h[i]).mul_add(acc - x, x).store(&mut v[i]);
+        });
+    }
+
+    /// One classical RK4 step.
+    #[inline(always)]
+    fn rk4_step(&mut self, v: &mut [V::Row]) {
+        let Work {
+            theta,
+            weights,
+            h,
+            h2,
+            h6,
+            ext,
+            out,
+            k: [k1, k2, k3],
+            probe,
+            ..
+        } = self;
+        let (weights, ext) = (*weights, &**ext);
+        // Slope 1 at v; the next probe is v + h/2 k1.
+        rates::<V>(theta, v, out);
+        drive::<V>(weights, ext, out, |i, acc| {
+            let x = V::load(&v[i]);
+            let d = acc - x;
+            d.store(&mut k1[i]);
+            V::load(&h2[i]).mul_add(d, x).store(&mut probe[i]);
+        });
+        // Slopes 2 and 3 at the probe; the probes after them are v + h/2 k2 and v + h k3.
+        for (k, h) in [(&mut **k2, *h2), (&mut **k3, *h)] {
+            rates::<V>(theta, probe, out);
+            drive::<V>(weights, ext, out, |i, acc| {
+                let d = acc - V::load(&probe[i]);
+                d.store(&mut k[i]);
+                V::load(&h[i])
+                    .mul_add(d, V::load(&v[i]))
+                    .store(&mut probe[i]);
+            });
+        }
+        // Slope 4 at the last probe, then v += h/6 (k1 + 2 k2 + 2 k3 + k4).
+        rates::<V>(theta, probe, out);
+        drive::<V>(weights, ext, out, |i, acc| {
+            let k4 = acc - V::load(&probe[i]);
+            let two = V::splat(2.0);
+            let sum = V::load(&k1[i]) + two * V::load(&k2[i]) + two * V::load(&k3[i]) + k4;
+            let x = V::load(&v[i]);
+            V::load(&h6[i]).mul_add(sum, x).store(&mut v[i]);
+        });
+    }
 }
 
 /// `ext = S I`, each sum over the sensors in order.
@@ -405,31 +510,32 @@ const RATE_GROUP: usize = 4;
 /// Rows of `W f` computed together in [`drive`].
 const ROWS: usize = 4;
 
-/// Reorders row-major `N x N` weights so that [`drive`] reads them as one stream: each group of
-/// [`ROWS`] rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the rows left
-/// over, row by row. Row `i`'s weights start at `i * N` either way.
-fn by_row_groups<T: Copy>(row_major: Vec<T>, n: usize) -> Vec<T> {
+/// The order in which [`drive`] reads the row-major `N x N` weights, as one stream: each group
+/// of [`ROWS`] rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the rows
+/// left over, row by row. Row `i`'s weights start at `i * N` either way.
+fn weight_order(n: usize) -> impl Iterator<Item = usize> {
     let full = n - n % ROWS;
-    let mut out = Vec::with_capacity(row_major.len());
-    for i in (0..full).step_by(ROWS) {
-        for j in 0..n {
-            out.extend((i..i + ROWS).map(|r| row_major[r * n + j]));
-        }
-    }
-    out.extend_from_slice(&row_major[full * n..]);
-    out
+    let groups = (0..full)
+        .step_by(ROWS)
+        .flat_map(move |i| (0..n).flat_map(move |j| (i..i + ROWS).map(move |r| r * n + j)));
+    groups.chain(full * n..n * n)
 }
 
 /// For every neuron `i`, `finish(i, ext_i + sum_j w_ij out_j)`, the sum taken in the order
 /// `j = 0, 1, ...`. Rows go [`ROWS`] at a time: independent sums keep the multiply-add units
 /// busy, and the result does not depend on the blocking.
 #[inline(always)]
-fn drive<V: Vector>(net: &Net<'_, V>, out: &[V::Row], mut finish: impl FnMut(usize, V)) {
+fn drive<V: Vector>(
+    weights: &[V::Row],
+    ext: &[V::Row],
+    out: &[V::Row],
+    mut finish: impl FnMut(usize, V),
+) {
     let n = out.len();
     let mut i = 0;
     while i + ROWS <= n {
-        let (columns, _) = net.weights[i * n..(i + ROWS) * n].as_chunks::<ROWS>();
-        let mut acc: [V; ROWS] = std::array::from_fn(|r| V::load(&net.ext[i + r]));
+        let (columns, _) = weights[i * n..(i + ROWS) * n].as_chunks::<ROWS>();
+        let mut acc: [V; ROWS] = std::array::from_fn(|r| V::load(&ext[i + r]));
         for (w, o) in columns.iter().zip(out) {
             let o = V::load(o);
             for (a, w) in acc.iter_mut().zip(w) {
@@ -442,79 +548,12 @@ fn drive<V: Vector>(net: &Net<'_, V>, out: &[V::Row], mut finish: impl FnMut(usi
         i += ROWS;
     }
     for i in i..n {
-        let mut acc = V::load(&net.ext[i]);
-        for (w, o) in net.weights[i * n..][..n].iter().zip(out) {
+        let mut acc = V::load(&ext[i]);
+        for (w, o) in weights[i * n..][..n].iter().zip(out) {
             acc = V::load(w).mul_add(V::load(o), acc);
         }
         finish(i, acc);
     }
-}
-
-/// One Euler step: `v += h * (ext + W f(v - theta) - v)`.
-#[inline(always)]
-fn euler_step<V: Vector>(net: &Net<'_, V>, v: &mut [V::Row], out: &mut [V::Row], h: &[V::Row]) {
-    rates::<V>(net.theta, v, out);
-    drive(net, out, |i, acc| {
-        let x = V::load(&v[i]);
-        V::load(&h[i]).mul_add(acc - x, x).store(&mut v[i]);
-    });
-}
-
-/// RK4's step sizes and work rows.
-struct Rk4<'a, V: Vector> {
-    /// `dt/tau`, its half and its sixth.
-    h: &'a [V::Row],
-    h2: &'a [V::Row],
-    h6: &'a [V::Row],
-    /// The first three slopes.
-    k: [&'a mut [V::Row]; 3],
-    /// The point where the next slope is taken.
-    probe: &'a mut [V::Row],
-}
-
-/// One classical RK4 step.
-#[inline(always)]
-fn rk4_step<V: Vector>(
-    net: &Net<'_, V>,
-    v: &mut [V::Row],
-    out: &mut [V::Row],
-    rk: &mut Rk4<'_, V>,
-) {
-    let Rk4 {
-        h,
-        h2,
-        h6,
-        k: [k1, k2, k3],
-        probe,
-    } = rk;
-    // Slope 1 at v; the next probe is v + h/2 k1.
-    rates::<V>(net.theta, v, out);
-    drive(net, out, |i, acc| {
-        let x = V::load(&v[i]);
-        let d = acc - x;
-        d.store(&mut k1[i]);
-        V::load(&h2[i]).mul_add(d, x).store(&mut probe[i]);
-    });
-    // Slopes 2 and 3 at the probe; the probes after them are v + h/2 k2 and v + h k3.
-    for (k, h) in [(&mut **k2, *h2), (&mut **k3, *h)] {
-        rates::<V>(net.theta, probe, out);
-        drive(net, out, |i, acc| {
-            let d = acc - V::load(&probe[i]);
-            d.store(&mut k[i]);
-            V::load(&h[i])
-                .mul_add(d, V::load(&v[i]))
-                .store(&mut probe[i]);
-        });
-    }
-    // Slope 4 at the last probe, then v += h/6 (k1 + 2 k2 + 2 k3 + k4).
-    rates::<V>(net.theta, probe, out);
-    drive(net, out, |i, acc| {
-        let k4 = acc - V::load(&probe[i]);
-        let two = V::splat(2.0);
-        let sum = V::load(&k1[i]) + two * V::load(&k2[i]) + two * V::load(&k3[i]) + k4;
-        let x = V::load(&v[i]);
-        V::load(&h6[i]).mul_add(sum, x).store(&mut v[i]);
-    });
 }
 
 impl Network {
@@ -556,10 +595,17 @@ impl Network {
                     row[k][0] = inputs[t * m + k];
                 }
             },
-            |t, lanes| lanes.lane_state(0, &mut states[t * n..(t + 1) * n]),
+            |t, state| copy_lane(state, 0, &mut states[t * n..(t + 1) * n]),
         )?;
         lanes.lane_state(0, self.state_mut());
         Ok(states)
+    }
+}
+
+/// Copies lane `l` of `rows` (one value per row) into `into`.
+pub fn copy_lane<const L: usize>(rows: &[[f64; L]], l: usize, into: &mut [f64]) {
+    for (dst, row) in into.iter_mut().zip(rows) {
+        *dst = row[l];
     }
 }
 
@@ -701,20 +747,16 @@ mod tests {
 
     #[test]
     fn weights_are_stored_by_row_groups() {
-        // 6 x 6: one group of ROWS = 4 rows read column by column, then rows 4 and 5 as they are.
-        let n = 6;
-        let w: Vec<usize> = (0..n * n).collect();
-        let stored = by_row_groups(w, n);
-        let group: Vec<usize> = (0..n)
-            .flat_map(|j| (0..ROWS).map(move |r| r * n + j))
-            .collect();
-        assert_eq!(stored[..ROWS * n], group[..]);
+        // 6 x 6 with ROWS = 4: rows 0-3 column by column, then rows 4 and 5 as they are.
+        let order: Vec<usize> = weight_order(6).collect();
+        assert_eq!(order[..8], [0, 6, 12, 18, 1, 7, 13, 19]);
+        assert_eq!(order[20..24], [5, 11, 17, 23]);
+        assert_eq!(order[24..], (24..36).collect::<Vec<_>>()[..]);
+        // Fewer rows than a group: row-major.
         assert_eq!(
-            stored[ROWS * n..],
-            (ROWS * n..n * n).collect::<Vec<_>>()[..]
+            weight_order(3).collect::<Vec<_>>(),
+            (0..9).collect::<Vec<_>>()
         );
-        // Fewer rows than a group: unchanged.
-        assert_eq!(by_row_groups(vec![1, 2, 3, 4], 2), vec![1, 2, 3, 4]);
     }
 
     /// Random networks of one shape, from a fixed seed.

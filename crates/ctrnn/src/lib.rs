@@ -24,6 +24,7 @@ pub mod math;
 pub mod network;
 pub mod population;
 pub mod rng;
+mod rows;
 mod vector;
 
 pub use error::{Error, Result};

@@ -11,7 +11,7 @@ use std::sync::atomic::AtomicBool;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrate::{check_inputs, Integrator, Lanes, LANES};
+use crate::integrate::{check_inputs, copy_lane, Integrator, Lanes, LANES};
 use crate::network::Network;
 
 /// A block of [`LANES`] networks stepped together.
@@ -154,10 +154,11 @@ impl Population {
                 .enumerate()
                 .try_for_each(|(b, (block, chunk))| {
                     let row = |t, row: &mut [[f64; LANES]]| fill(b, t, row);
-                    block.run_rows(steps, integ, cancel, row, |t, block| {
-                        for l in 0..block.len() {
+                    let real = block.len();
+                    block.run_rows(steps, integ, cancel, row, |t, state| {
+                        for l in 0..real {
                             let at = (l * steps + t) * n;
-                            block.lane_state(l, &mut chunk[at..at + n]);
+                            copy_lane(state, l, &mut chunk[at..at + n]);
                         }
                     })
                 })?;

@@ -15,6 +15,13 @@ mod sequence;
 
 use pyo3::prelude::*;
 
+/// The extension's own Rust allocations (Python's are untouched) go to mimalloc. It keeps freed
+/// memory for reuse, where glibc returns it to the OS between calls: packing a population of
+/// large networks then page-faulted every fresh page again on every call (3-5x the packing time).
+/// `local_dynamic_tls` makes it safe in a library that Python loads with `dlopen`.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// The native core of dnnevo.
 #[pymodule]
 mod _core {

@@ -8,13 +8,14 @@ Workload (per network size N in {5, 10, 30}):
 dnnevo is timed with run_population(..., record=False) on all cores; NumPy with the same
 equations, batched over the population with einsum, on one core (NumPy's einsum does not thread).
 Each figure is the median of timed runs (--repeats for dnnevo, at most 3 for NumPy) after a
-quarter-second warm-up, in network-steps per second (P x steps / seconds). NumPy may be timed over fewer steps
-(--numpy-steps) to save time: the figure is a per-step throughput. The final states of both codes
+quarter-second warm-up, in network-steps per second (P x steps / seconds). A dnnevo run lasts
+milliseconds, so many repeats keep a burst of load from other jobs out of the median. NumPy may
+be timed over fewer steps (--numpy-steps) to save time: the figure is a per-step throughput. The final states of both codes
 after the full T steps are compared network by network (rtol = atol = 1e-9). A few random networks
 are chaotic and amplify rounding differences over 1000 steps; a mismatch is reported as such
 (not as a disagreement) when NumPy with a different summation order misses by as much.
 
-    python bench/integrate.py [--repeats 7] [--quick] [--numpy-steps 200]
+    python bench/integrate.py [--repeats 21] [--quick] [--numpy-steps 200]
 
 Exits with 1 if the two codes disagree; a ratio below its target is reported, not an error.
 """
@@ -150,8 +151,8 @@ def bench_size(n: int, args) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--repeats", type=int, default=7,
-                    help="timed dnnevo runs per size; the median is reported (default 7)")
+    ap.add_argument("--repeats", type=int, default=21,
+                    help="timed dnnevo runs per size; the median is reported (default 21)")
     ap.add_argument("--quick", action="store_true",
                     help="a smoke run: fewer networks, steps and repeats (figures are rougher)")
     ap.add_argument("--numpy-steps", type=int, default=None,

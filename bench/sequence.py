@@ -6,7 +6,7 @@ Workload (preset sequence-1bit, paper §5.2):
   4 trials (2 per target of B = {0*, 1*}) of 10 triggers, trigger and reinforcement 10 time steps,
   delay and gap uniform in [10, 40], 10 forward-Euler steps of dt = 0.1 per time step.
 
-Figures, in seconds per generation (median of timed runs after one warm-up, over generations
+Figures, in seconds per generation (median of timed runs after a quarter-second warm-up, over generations
 0, 1, 2, ... so the timings vary as in a run):
   dnnevo evaluate   dnnevo.evaluate("sequence", genomes, generation=g, seed=0, config=cfg), all cores
                     (and with threads=1, for a per-core comparison)

@@ -29,7 +29,7 @@ Workload:
               real robot could do the same in 6 x 135 s. The cost of one more network per trial
               (the network run alone) is (generation - one network's evaluate) / (99 x 6).
 record's net is the first network of that population. Every figure is the median of timed
-runs after one warm-up run.
+runs after a quarter-second warm-up.
 
     python bench/sim2d.py [--repeats 15] [--rays 200000] [--quick]
 

@@ -509,6 +509,7 @@ const RATE_GROUP: usize = 4;
 
 /// Rows of `W f` computed together in [`drive`].
 const ROWS: usize = 4;
+const PREFETCH_COLUMNS: usize = 4;
 
 /// The order in which [`drive`] reads the row-major `N x N` weights, as one stream: each group
 /// of [`ROWS`] rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the rows
@@ -536,7 +537,10 @@ fn drive<V: Vector>(
     while i + ROWS <= n {
         let (columns, _) = weights[i * n..(i + ROWS) * n].as_chunks::<ROWS>();
         let mut acc: [V; ROWS] = std::array::from_fn(|r| V::load(&ext[i + r]));
-        for (w, o) in columns.iter().zip(out) {
+        for (j, (w, o)) in columns.iter().zip(out).enumerate() {
+            if let Some(ahead) = columns.get(j + PREFETCH_COLUMNS) {
+                ahead.iter().for_each(V::prefetch);
+            }
             let o = V::load(o);
             for (a, w) in acc.iter_mut().zip(w) {
                 *a = V::load(w).mul_add(o, *a);

@@ -54,6 +54,9 @@ pub(crate) trait Vector: Arith {
     fn rows(flat: &[f64]) -> &[Self::Row];
     /// Views `lanes * k` values as `k` mutable rows.
     fn rows_mut(flat: &mut [f64]) -> &mut [Self::Row];
+    /// Asks for a row to be brought into the L1 cache (a hint; may do nothing).
+    #[inline(always)]
+    fn prefetch(_row: &Self::Row) {}
 }
 
 /// `G` vectors computed on together, operation by operation. A long dependency chain such as
@@ -125,6 +128,10 @@ impl<V: Vector, const G: usize> Vector for Group<V, G> {
     #[inline(always)]
     fn rows_mut(flat: &mut [f64]) -> &mut [Self::Row] {
         V::rows_mut(flat).as_chunks_mut().0
+    }
+    #[inline(always)]
+    fn prefetch(row: &Self::Row) {
+        row.iter().for_each(V::prefetch);
     }
 }
 

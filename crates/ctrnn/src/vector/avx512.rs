@@ -73,6 +73,11 @@ impl Vector for Avx512 {
         debug_assert!(rest.is_empty());
         rows
     }
+    #[inline(always)]
+    fn prefetch(row: &[f64; 8]) {
+        // SAFETY: a prefetch is a hint and never faults; the address is that of `row`.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(row.as_ptr().cast()) }
+    }
 }
 
 impl Arith for Avx512 {

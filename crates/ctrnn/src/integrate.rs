@@ -481,9 +481,19 @@ fn sensor_drive<V: Vector>(sensor_weights: &[V::Row], inputs: &[V::Row], ext: &m
     }
 }
 
-/// Firing rates `out = f(v - theta)`, [`RATE_GROUP`] neurons at a time (see [`Group`]).
+/// Firing rates `out = f(v - theta)`: [`RATE_GROUP`] neurons at a time where `V` allows it (see
+/// [`Group`]), else one by one.
 #[inline(always)]
 fn rates<V: Vector>(theta: &[V::Row], v: &[V::Row], out: &mut [V::Row]) {
+    let one = |o: &mut V::Row, x: &V::Row, t: &V::Row| {
+        sigmoid_lanes(V::load(x) - V::load(t)).store(o);
+    };
+    if !V::INTERLEAVE {
+        for (o, (x, t)) in out.iter_mut().zip(v.iter().zip(theta)) {
+            one(o, x, t);
+        }
+        return;
+    }
     let mut groups = out.chunks_exact_mut(RATE_GROUP);
     let mut at = 0;
     for o in &mut groups {
@@ -500,7 +510,7 @@ fn rates<V: Vector>(theta: &[V::Row], v: &[V::Row], out: &mut [V::Row]) {
         .iter_mut()
         .zip(v[at..].iter().zip(&theta[at..]))
     {
-        sigmoid_lanes(V::load(x) - V::load(t)).store(o);
+        one(o, x, t);
     }
 }
 

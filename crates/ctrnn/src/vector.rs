@@ -45,6 +45,11 @@ pub(crate) trait Arith:
 pub(crate) trait Vector: Arith {
     /// How values are stored: `[f64; lanes]`.
     type Row: Copy;
+    /// Whether a [`Group`] of a few of these still fits in registers, so that running long
+    /// dependency chains side by side pays. True for the explicit register backends; plain
+    /// lanes are left to the compiler (grouping 16-lane portable rows four at a time made an AVX2
+    /// build 4x slower, and made single networks no faster).
+    const INTERLEAVE: bool;
 
     /// Reads a stored row.
     fn load(row: &Self::Row) -> Self;
@@ -110,6 +115,7 @@ impl<V: Arith, const G: usize> Arith for Group<V, G> {
 
 impl<V: Vector, const G: usize> Vector for Group<V, G> {
     type Row = [V::Row; G];
+    const INTERLEAVE: bool = V::INTERLEAVE;
 
     #[inline(always)]
     fn load(row: &Self::Row) -> Self {
@@ -196,6 +202,7 @@ impl<const L: usize> Arith for Portable<L> {
 
 impl<const L: usize> Vector for Portable<L> {
     type Row = [f64; L];
+    const INTERLEAVE: bool = false;
 
     #[inline(always)]
     fn load(row: &[f64; L]) -> Self {

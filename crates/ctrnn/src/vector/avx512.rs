@@ -50,6 +50,7 @@ impl Neg for Avx512 {
 
 impl Vector for Avx512 {
     type Row = [f64; 8];
+    const INTERLEAVE: bool = true;
 
     #[inline(always)]
     fn load(row: &[f64; 8]) -> Self {

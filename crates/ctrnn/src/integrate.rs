@@ -774,6 +774,7 @@ mod tests {
     }
 
     /// Random networks of one shape, from a fixed seed.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
     fn random_networks(count: usize, n: usize, m: usize, seed: u64) -> Vec<Network> {
         use crate::rng::{Purpose, Stream};
         let mut rng = Stream::new(seed, 0, Purpose::Init, 0, 0);

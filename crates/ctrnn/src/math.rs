@@ -14,7 +14,7 @@
 //! same bits, slowly, in software elsewhere. Every code path in dnnevo (single network, population,
 //! tasks) uses [`sigmoid`], which is what makes them agree bit for bit.
 
-use crate::vector::{Arith, Portable, ROUND_SHIFT};
+use crate::vector::{Arith, ROUND_SHIFT};
 
 const INV_LN2: f64 = std::f64::consts::LOG2_E;
 /// ln 2 split into a part with trailing zero bits (exact when multiplied by k) and the rest.
@@ -50,7 +50,7 @@ const TAYLOR: [f64; 12] = [
 /// ```
 #[inline(always)]
 pub fn exp(x: f64) -> f64 {
-    exp_lanes(Portable([x])).0[0]
+    exp_lanes(x)
 }
 
 /// The logistic firing rate `1 / (1 + e^(-x))`.
@@ -61,7 +61,7 @@ pub fn exp(x: f64) -> f64 {
 /// ```
 #[inline(always)]
 pub fn sigmoid(x: f64) -> f64 {
-    sigmoid_lanes(Portable([x])).0[0]
+    sigmoid_lanes(x)
 }
 
 /// [`exp`] in every lane.

@@ -153,78 +153,51 @@ fn pow2(k: f64) -> f64 {
     f64::from_bits(k_int.wrapping_add(1023) << 52)
 }
 
-/// `L` plain `f64`s, computed on one by one (the compiler may still vectorise them).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Portable<const L: usize>(pub [f64; L]);
-
-macro_rules! portable_op {
-    ($trait:ident, $method:ident, $op:tt) => {
-        impl<const L: usize> $trait for Portable<L> {
-            type Output = Self;
-            #[inline(always)]
-            fn $method(self, o: Self) -> Self {
-                Portable(std::array::from_fn(|l| self.0[l] $op o.0[l]))
-            }
-        }
-    };
-}
-portable_op!(Add, add, +);
-portable_op!(Sub, sub, -);
-portable_op!(Mul, mul, *);
-portable_op!(Div, div, /);
-
-impl<const L: usize> Neg for Portable<L> {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Portable(self.0.map(|x| -x))
-    }
-}
-
-impl<const L: usize> Arith for Portable<L> {
+/// One plain `f64`: the lane that [`Portable`] groups.
+impl Arith for f64 {
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        Portable([x; L])
+        x
     }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
-        Portable(std::array::from_fn(|l| self.0[l].mul_add(a.0[l], b.0[l])))
+        f64::mul_add(self, a, b)
     }
     #[inline(always)]
     fn clamp(self, lo: f64, hi: f64) -> Self {
-        Portable(self.0.map(|x| x.clamp(lo, hi)))
+        f64::clamp(self, lo, hi)
     }
     #[inline(always)]
     fn mul_pow2(self, k: Self) -> Self {
-        Portable(std::array::from_fn(|l| self.0[l] * pow2(k.0[l])))
+        self * pow2(k)
     }
 }
 
-impl<const L: usize> Vector for Portable<L> {
-    type Row = [f64; L];
+impl Vector for f64 {
+    type Row = f64;
     const INTERLEAVE: bool = false;
 
     #[inline(always)]
-    fn load(row: &[f64; L]) -> Self {
-        Portable(*row)
+    fn load(row: &f64) -> Self {
+        *row
     }
     #[inline(always)]
-    fn store(self, row: &mut [f64; L]) {
-        *row = self.0;
+    fn store(self, row: &mut f64) {
+        *row = self;
     }
     #[inline(always)]
-    fn rows(flat: &[f64]) -> &[[f64; L]] {
-        let (rows, rest) = flat.as_chunks();
-        debug_assert!(rest.is_empty());
-        rows
+    fn rows(flat: &[f64]) -> &[f64] {
+        flat
     }
     #[inline(always)]
-    fn rows_mut(flat: &mut [f64]) -> &mut [[f64; L]] {
-        let (rows, rest) = flat.as_chunks_mut();
-        debug_assert!(rest.is_empty());
-        rows
+    fn rows_mut(flat: &mut [f64]) -> &mut [f64] {
+        flat
     }
 }
+
+/// `L` plain `f64`s, computed on one by one (the compiler may still vectorise them); its rows
+/// are `[f64; L]`.
+pub(crate) type Portable<const L: usize> = Group<f64, L>;
 
 #[cfg(test)]
 mod tests {
@@ -245,7 +218,7 @@ mod tests {
             &[[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
         );
         let row = &mut Portable::<2>::rows_mut(&mut flat)[1];
-        (Portable::load(row) * Portable::splat(2.0)).store(row);
+        (Portable::<2>::load(row) * Portable::<2>::splat(2.0)).store(row);
         assert_eq!(flat, [1.0, 2.0, 6.0, 8.0, 5.0, 6.0]);
     }
 }

@@ -4,11 +4,13 @@
 //! maps the same sequence of IEEE operations (add, subtract, multiply, divide, fused multiply-add,
 //! exact scaling by a power of two) onto its own instructions, so every backend gives the same
 //! bits:
-//! - [`Portable<L>`]: `L` plain `f64`s, lane by lane. Used for single networks (`L = 1`) and
-//!   wherever no explicit backend applies.
+//! - `f64`: one lane.
 //! - `Avx512` (x86-64 builds whose target CPU has AVX-512F): 8 lanes in one 512-bit register.
 //!   LLVM does not find this layout on its own: it vectorises the sigmoid loop across neurons,
 //!   with gathers and scatters, instead of across networks.
+//! - [`Group<V, G>`]: `G` of those, operation by operation. A population block of 16 networks
+//!   is `Group<Avx512, 2>`; [`Portable<L>`] is `Group<f64, L>`, used for single networks
+//!   (`L = 1`) and wherever no register backend applies.
 //!
 //! Which backend a build uses is fixed at compile time by its target features (see
 //! `.cargo/config.toml`); results do not depend on it.
@@ -43,7 +45,7 @@ pub(crate) trait Arith:
 
 /// A row of values as the integrator stores it, one per network of a block.
 pub(crate) trait Vector: Arith {
-    /// How values are stored: `[f64; lanes]`.
+    /// How a row is stored: its lanes' values in order (`f64`, `[f64; 8]`, or arrays of those).
     type Row: Copy;
     /// Whether a [`Group`] of a few of these still fits in registers, so that running long
     /// dependency chains side by side pays. True for the explicit register backends; plain

@@ -113,25 +113,27 @@ impl Population {
         integ.validate()?;
         let (m, p_len) = (self.n_inputs, self.len);
         match inputs {
-            Inputs::Shared(x) => check_inputs(x, steps * m, "T x M")?,
-            Inputs::PerNetwork(x) => check_inputs(x, p_len * steps * m, "P x T x M")?,
-        }
-        match inputs {
-            Inputs::Shared(x) => self.run_filled(steps, integ, record, cancel, |_, t, row| {
-                for (r, &v) in row.iter_mut().zip(&x[t * m..(t + 1) * m]) {
-                    *r = [v; LANES];
-                }
-            }),
-            Inputs::PerNetwork(x) => self.run_filled(steps, integ, record, cancel, |b, t, row| {
-                for l in 0..LANES {
-                    // Padding lanes repeat the block's first network.
-                    let p = b * LANES + if b * LANES + l < p_len { l } else { 0 };
-                    let at = (p * steps + t) * m;
-                    for (r, &v) in row.iter_mut().zip(&x[at..at + m]) {
-                        r[l] = v;
+            Inputs::Shared(x) => {
+                check_inputs(x, steps * m, "T x M")?;
+                self.run_filled(steps, integ, record, cancel, |_, t, row| {
+                    for (r, &v) in row.iter_mut().zip(&x[t * m..(t + 1) * m]) {
+                        *r = [v; LANES];
                     }
-                }
-            }),
+                })
+            }
+            Inputs::PerNetwork(x) => {
+                check_inputs(x, p_len * steps * m, "P x T x M")?;
+                self.run_filled(steps, integ, record, cancel, |b, t, row| {
+                    for l in 0..LANES {
+                        // Padding lanes repeat the block's first network.
+                        let p = b * LANES + if b * LANES + l < p_len { l } else { 0 };
+                        let at = (p * steps + t) * m;
+                        for (r, &v) in row.iter_mut().zip(&x[at..at + m]) {
+                            r[l] = v;
+                        }
+                    }
+                })
+            }
         }
     }
 

@@ -82,6 +82,10 @@ class EvolutionConfig:
     mutation_rate: float = 0.025
     elitism: int = 0
     """How many of the best individuals are copied unchanged (0 = the paper's GA)."""
+    validation_candidates: int = 10
+    """How many of each generation's best individuals by training fitness are re-scored on the
+    task's validation set (fresh conditions, fixed for the run) to choose the champion; 0 chooses
+    the champion by training fitness, as the paper does. Evolution itself is unchanged."""
     selection: str = "proportional"
     """``"proportional"`` (the paper's) or ``"rank"``."""
     fill: str = "mutants"
@@ -104,6 +108,7 @@ class EvolutionConfig:
         integer("population", 2)
         integer("generations", 1)
         integer("elitism", 0)
+        integer("validation_candidates", 0)
         integer("size", 1)
         integer("n_inputs", 0)
         for name in ("crossover_rate", "mutation_rate"):
@@ -166,6 +171,7 @@ class EvolutionConfig:
             "mutation_rate": float(self.mutation_rate),
             "elitism": self.elitism,
             "selection": self.selection,
+            "validation_candidates": self.validation_candidates,
             "ranges": {k: list(v) for k, v in dataclasses.asdict(self.ranges).items()},
         }
 

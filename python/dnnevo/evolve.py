@@ -49,16 +49,22 @@ class EvolutionResult:
     """What a run produced."""
 
     best: _core.Network
-    """The best network of the run (in its initial state)."""
+    """The champion: the best network of the run by validation (see
+    ``EvolutionConfig.validation_candidates``), or by training fitness when the task has no
+    validation set (in its initial state)."""
     best_fitness: float
+    """The champion's training fitness."""
     best_generation: int
     history: dict[str, npt.NDArray[np.float64]]
-    """Per-generation arrays: generation, best, mean, std, min, champion_success, evals_per_s,
-    elapsed_s."""
+    """Per-generation arrays: generation, best, mean, std, min, champion_success,
+    validation_rate, validation_score, evals_per_s, elapsed_s."""
     config: EvolutionConfig
     seed: int
     run_dir: Path | None
     interrupted: bool = False
+    best_validation: tuple[float, float] | None = None
+    """The champion's validation ``(rate, score)``, or None when it was chosen by training
+    fitness."""
 
     @property
     def first_success(self) -> int | None:
@@ -222,7 +228,7 @@ def _loop(
     task_json = None if callable(task) else json.dumps(config.task_json())
     t_start = time.perf_counter() - (history[-1]["elapsed_s"] if history else 0.0)
     last_checkpoint = last_log = time.perf_counter()
-    best_seen = ga.best_fitness
+    seen = _champion_key(ga)
     success = history[-1]["champion_success"] if history else float("nan")
     interrupted = False
     saved = ""
@@ -249,8 +255,9 @@ def _loop(
                     assert task_json is not None
                     stats, _ = ga._evo.step(task, task_json, threads)
                 seconds = time.perf_counter() - t0
-                if ga.best_fitness != best_seen:
-                    best_seen = ga.best_fitness
+                validation = ga.best_validation or (float("nan"), float("nan"))
+                if _champion_key(ga) != seen:
+                    seen = _champion_key(ga)
                     success = _champion_success(ga, task_json)
                     if run is not None:
                         _write_best(run, ga)
@@ -261,6 +268,8 @@ def _loop(
                     "std": stats["std"],
                     "min": stats["min"],
                     "champion_success": success,
+                    "validation_rate": validation[0],
+                    "validation_score": validation[1],
                     "evals_per_s": config.population / seconds if seconds > 0 else 0.0,
                     "elapsed_s": time.perf_counter() - t_start,
                 })
@@ -298,6 +307,12 @@ def _loop(
     return _result(ga, history, run, interrupted)
 
 
+def _champion_key(ga: GeneticAlgorithm) -> tuple[Any, ...] | None:
+    """What identifies the champion: a new one has another generation, fitness or validation."""
+    champ = ga._evo.champion()
+    return None if champ is None else (champ[1], champ[2], ga.best_validation)
+
+
 def _champion_success(ga: GeneticAlgorithm, task_json: str | None) -> float:
     """1.0 or 0.0 when the built-in task has a success criterion, else NaN."""
     champ = ga._evo.champion()
@@ -312,13 +327,15 @@ def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
     champ = ga._evo.champion()
     assert champ is not None
     net, fitness, generation = champ
-    meta = {
+    meta: dict[str, Any] = {
         "task": ga.config.task,
         "seed": ga.seed,
         "generation": generation,
         "fitness": fitness,
         "dnnevo_version": _core.__version__,
     }
+    if ga.best_validation is not None:
+        meta["validation_rate"], meta["validation_score"] = ga.best_validation
     net.save(run.best, meta=meta)
 
 
@@ -340,4 +357,5 @@ def _result(
         seed=ga.seed,
         run_dir=run.path if run else None,
         interrupted=interrupted,
+        best_validation=ga.best_validation,
     )

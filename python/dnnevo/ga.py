@@ -86,8 +86,14 @@ class GeneticAlgorithm:
 
     @property
     def best_fitness(self) -> float | None:
-        """The fitness of :attr:`best`."""
+        """The training fitness of :attr:`best`."""
         return self._evo.champion_fitness
+
+    @property
+    def best_validation(self) -> tuple[float, float] | None:
+        """The validation ``(rate, score)`` of :attr:`best`, or None when it was chosen by
+        training fitness (``tell`` with fitness from Python never validates)."""
+        return self._evo.champion_validation()
 
     def state_dict(self) -> dict[str, Any]:
         """Everything needed to continue bit for bit (JSON-serialisable)."""

@@ -4,9 +4,10 @@ A run folder holds:
 
 - ``config.toml``: the complete, resolved config, with the seed and the dnnevo version;
 - ``log.csv``: one row per generation (rewritten at most every second, and at every
-  checkpoint, so it may trail the run by a second): best, mean, std and min fitness; whether the champion so
-  far meets the task's success criterion (1 or 0, ``nan`` when the task has none); evaluations
-  per second and elapsed seconds;
+  checkpoint, so it may trail the run by a second): best, mean, std and min fitness; whether the
+  champion so far meets the task's success criterion on fresh conditions (1 or 0, ``nan`` when
+  the task has none); the champion's validation rate and score (``nan`` when it was chosen by
+  training fitness); evaluations per second and elapsed seconds;
 - ``best.json``: the champion in the ``dnnevo-network`` format, with meta;
 - ``checkpoint.json``: the GA state and the history, enough to continue bit for bit.
 """
@@ -31,6 +32,8 @@ LOG_COLUMNS = (
     "std",
     "min",
     "champion_success",
+    "validation_rate",
+    "validation_score",
     "evals_per_s",
     "elapsed_s",
 )
@@ -80,7 +83,8 @@ class RunDir:
     def write_log(self, history: list[dict[str, float]]) -> None:
         """Rewrites ``log.csv`` from the whole history (atomic, so never torn)."""
         lines = [",".join(LOG_COLUMNS)]
-        lines += [",".join(repr(float(row[k])) for k in LOG_COLUMNS) for row in history]
+        # Histories from before a column existed lack it: those generations have no value.
+        lines += [",".join(repr(float(row.get(k, "nan"))) for k in LOG_COLUMNS) for row in history]
         write_atomic(self.log, "\n".join(lines) + "\n")
 
     def write_checkpoint(self, state: dict[str, Any], history: list[dict[str, float]]) -> None:

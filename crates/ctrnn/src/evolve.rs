@@ -2,10 +2,13 @@
 //! ask/tell, a [`Task`] trait for built-in fitness functions, and checkpoints.
 //!
 //! One generation is: decode the genomes, score them all with a task (or with fitness told from
-//! outside), record the statistics and the champion, then breed the next population with
-//! [`crate::ga::next_generation`]. Every random draw comes from a stream keyed by the run's seed
-//! and the generation, so a run resumed from a checkpoint continues with exactly the same bits.
+//! outside), re-score the best candidates on the task's validation set
+//! ([`crate::validation`]), record the statistics and the champion, then breed the next
+//! population with [`crate::ga::next_generation`]. Every random draw comes from a stream keyed
+//! by the run's seed and the generation, so a run resumed from a checkpoint continues with
+//! exactly the same bits.
 
+use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
@@ -16,6 +19,7 @@ use crate::ga::{self, check_fitness, GaConfig};
 use crate::genome::{self, Layout};
 use crate::network::Network;
 use crate::rng::{Purpose, Stream};
+use crate::validation::{candidates, Validation};
 
 /// A fitness function that scores a whole generation at once, so that it can drive the
 /// population integrator.
@@ -40,6 +44,20 @@ pub trait Task: Send + Sync {
     /// `None` (the default) when the task has no criterion.
     fn succeeds(&self, net: &Network, seed: u64) -> Result<Option<bool>> {
         let _ = (net, seed);
+        Ok(None)
+    }
+
+    /// Each network's [`Validation`] on the run's validation set, drawn from
+    /// `Stream::new(seed, 0, Purpose::Validate, 0, t)` and so the same in every generation;
+    /// `None` (the default) when the task has none. Must be a pure function of
+    /// `(self, network, seed)` for each network, whatever the batch it comes in.
+    fn validate(
+        &self,
+        networks: &[Network],
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        let _ = (networks, seed, cancel);
         Ok(None)
     }
 }
@@ -93,6 +111,26 @@ pub struct Champion {
     pub fitness: f64,
     /// The generation in which it was scored.
     pub generation: u64,
+    /// Its score on the validation set, when the champion was chosen by validation (absent in
+    /// checkpoints written before validation existed).
+    #[serde(default)]
+    pub validation: Option<Validation>,
+}
+
+/// The validations of the last generation's candidates, by genome, so that a candidate carried
+/// over unchanged (an elite) is not re-validated. Validation is a pure function of the genome, so
+/// this changes speed, never results; it is not part of a checkpoint and never compared.
+#[derive(Clone, Debug, Default)]
+pub struct ValidationCache(HashMap<Vec<u64>, Validation>);
+
+impl PartialEq for ValidationCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+fn genome_key(genes: &[f64]) -> Vec<u64> {
+    genes.iter().map(|g| g.to_bits()).collect()
 }
 
 /// How to fill the initial population beyond the given seed networks.
@@ -119,8 +157,12 @@ pub struct Evolution {
     pub generation: u64,
     /// The current population, `population x layout.len()` row-major.
     pub population: Vec<f64>,
-    /// The best individual scored so far.
+    /// The best individual scored so far: by validation when the task has a validation set and
+    /// `config.validation_candidates > 0`, else by training fitness.
     pub champion: Option<Champion>,
+    /// Validations of the last generation's candidates (not saved).
+    #[serde(skip)]
+    pub cache: ValidationCache,
 }
 
 impl Evolution {
@@ -191,6 +233,7 @@ impl Evolution {
             generation: 0,
             population,
             champion: None,
+            cache: ValidationCache::default(),
         })
     }
 
@@ -202,9 +245,15 @@ impl Evolution {
             .collect()
     }
 
-    /// Takes the fitness of the current population, updates the champion, breeds the next
-    /// population and advances the generation. Returns the statistics of the scored generation.
+    /// Takes the fitness of the current population, updates the champion (by training fitness:
+    /// fitness told from outside has no validation set), breeds the next population and advances
+    /// the generation. Returns the statistics of the scored generation.
     pub fn tell(&mut self, fitness: &[f64]) -> Result<Stats> {
+        self.tell_validated(fitness, None)
+    }
+
+    /// Checks that `fitness` fits the population and can be selected on.
+    fn check(&self, fitness: &[f64]) -> Result<()> {
         if fitness.len() != self.config.population {
             return Err(Error::Fitness(format!(
                 "got {} fitness values for a population of {}",
@@ -212,19 +261,49 @@ impl Evolution {
                 self.config.population
             )));
         }
-        check_fitness(fitness, self.config.selection)?;
+        check_fitness(fitness, self.config.selection)
+    }
+
+    /// [`tell`](Self::tell), with the champion chosen among `validated` (candidate index and its
+    /// validation, best training fitness first) when given: the first candidate with the best
+    /// validation becomes champion if it beats the champion's.
+    fn tell_validated(
+        &mut self,
+        fitness: &[f64],
+        validated: Option<&[(usize, Validation)]>,
+    ) -> Result<Stats> {
+        self.check(fitness)?;
         let stats = Stats::of(self.generation, fitness);
-        if self
-            .champion
-            .as_ref()
-            .is_none_or(|c| stats.best > c.fitness)
-        {
+        let pick = match validated {
+            None => self
+                .champion
+                .as_ref()
+                .is_none_or(|c| stats.best > c.fitness)
+                .then_some((stats.best_index, None)),
+            Some(list) => {
+                let mut best: Option<&(usize, Validation)> = None;
+                for item in list {
+                    if best.is_none_or(|b| item.1.beats(&b.1)) {
+                        best = Some(item);
+                    }
+                }
+                best.filter(|(_, v)| {
+                    self.champion
+                        .as_ref()
+                        .and_then(|c| c.validation)
+                        .is_none_or(|cv| v.beats(&cv))
+                })
+                .map(|&(i, v)| (i, Some(v)))
+            }
+        };
+        if let Some((index, validation)) = pick {
             let g = self.layout.len();
-            let at = stats.best_index * g;
+            let at = index * g;
             self.champion = Some(Champion {
                 genes: self.population[at..at + g].to_vec(),
-                fitness: stats.best,
+                fitness: fitness[index],
                 generation: self.generation,
+                validation,
             });
         }
         self.population = ga::next_generation(
@@ -257,8 +336,65 @@ impl Evolution {
         }
         let nets = self.networks()?;
         let fitness = task.evaluate(&nets, self.generation, self.seed, cancel)?;
-        let stats = self.tell(&fitness)?;
+        self.check(&fitness)?;
+        let validated = self.validate(task, &nets, &fitness, cancel)?;
+        let stats = self.tell_validated(&fitness, validated.as_deref())?;
         Ok((stats, fitness))
+    }
+
+    /// The top `config.validation_candidates` of `fitness` with their validations, best
+    /// training fitness first; `None` when there are no candidates or the task has no validation
+    /// set. Candidates the last generation validated are taken from the cache.
+    fn validate(
+        &mut self,
+        task: &dyn Task,
+        nets: &[Network],
+        fitness: &[f64],
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<(usize, Validation)>>> {
+        let chosen = candidates(fitness, self.config.validation_candidates);
+        if chosen.is_empty() {
+            return Ok(None);
+        }
+        let g = self.layout.len();
+        let keys: Vec<Vec<u64>> = chosen
+            .iter()
+            .map(|&i| genome_key(&self.population[i * g..(i + 1) * g]))
+            .collect();
+        let fresh: Vec<usize> = (0..chosen.len())
+            .filter(|&k| !self.cache.0.contains_key(&keys[k]))
+            .collect();
+        let batch: Vec<Network> = fresh.iter().map(|&k| nets[chosen[k]].clone()).collect();
+        let scores = if batch.is_empty() {
+            Vec::new()
+        } else {
+            match task.validate(&batch, self.seed, cancel)? {
+                Some(v) if v.len() == batch.len() => v,
+                Some(v) => {
+                    return Err(Error::Fitness(format!(
+                        "the task validated {} networks; it was given {}",
+                        v.len(),
+                        batch.len()
+                    )))
+                }
+                None => return Ok(None),
+            }
+        };
+        let mut cache = HashMap::with_capacity(chosen.len());
+        for (k, v) in fresh.iter().zip(scores) {
+            cache.insert(keys[*k].clone(), v);
+        }
+        let mut out = Vec::with_capacity(chosen.len());
+        for (k, &i) in chosen.iter().enumerate() {
+            let v = match cache.get(&keys[k]) {
+                Some(v) => *v,
+                None => self.cache.0[&keys[k]],
+            };
+            cache.insert(keys[k].clone(), v);
+            out.push((i, v));
+        }
+        self.cache = ValidationCache(cache);
+        Ok(Some(out))
     }
 
     /// The champion as a network, if any generation has been scored.
@@ -323,11 +459,143 @@ mod tests {
         }
     }
 
+    fn excite(net: &Network) -> f64 {
+        let mut n = net.clone();
+        n.run(&[1.0; 5], 5, &crate::Integrator::default()).unwrap();
+        n.outputs()[0]
+    }
+
+    /// Training fitness is half luck: a bonus drawn per (generation, genome), so the fittest
+    /// individual of a generation is often a lucky one. Validation sees the true quality,
+    /// Excite's score, and counts the networks it validated.
+    #[derive(Default)]
+    struct Lucky {
+        validated: std::sync::atomic::AtomicUsize,
+    }
+    impl Task for Lucky {
+        fn layout(&self) -> Layout {
+            Excite.layout()
+        }
+        fn evaluate(
+            &self,
+            networks: &[Network],
+            generation: u64,
+            seed: u64,
+            _cancel: Option<&AtomicBool>,
+        ) -> Result<Vec<f64>> {
+            Ok(networks
+                .iter()
+                .map(|n| {
+                    let bits = genome::encode(n).iter().fold(0u64, |h, g| h ^ g.to_bits());
+                    let luck = Stream::new(seed, generation, Purpose::Trial, bits, 0).uniform();
+                    0.5 * excite(n) + 0.5 * luck
+                })
+                .collect())
+        }
+        fn validate(
+            &self,
+            networks: &[Network],
+            _seed: u64,
+            _cancel: Option<&AtomicBool>,
+        ) -> Result<Option<Vec<Validation>>> {
+            self.validated
+                .fetch_add(networks.len(), std::sync::atomic::Ordering::Relaxed);
+            Ok(Some(
+                networks
+                    .iter()
+                    .map(|n| Validation {
+                        rate: excite(n),
+                        score: 0.0,
+                    })
+                    .collect(),
+            ))
+        }
+    }
+
     fn config() -> GaConfig {
         GaConfig {
             population: 40,
             ..GaConfig::default()
         }
+    }
+
+    #[test]
+    fn validation_picks_the_champion_and_leaves_evolution_unchanged() {
+        let task = Lucky::default();
+        let plain = GaConfig {
+            validation_candidates: 0,
+            ..config()
+        };
+        let mut a = Evolution::new(task.layout(), config(), 3, &[], Fill::Mutants).unwrap();
+        let mut b = Evolution::new(task.layout(), plain, 3, &[], Fill::Mutants).unwrap();
+        let mut best_seen = f64::NEG_INFINITY;
+        for _ in 0..15 {
+            a.step(&task, None).unwrap();
+            b.step(&task, None).unwrap();
+            assert_eq!(
+                a.population, b.population,
+                "validation must not change evolution"
+            );
+            let champ = a.champion.as_ref().unwrap();
+            let v = champ.validation.expect("chosen by validation");
+            assert!(
+                v.rate >= best_seen,
+                "the champion's validation never gets worse"
+            );
+            best_seen = v.rate;
+            assert_eq!(v.rate, excite(&a.champion_network().unwrap().unwrap()));
+        }
+        let by_fitness = b.champion.as_ref().unwrap();
+        assert!(by_fitness.validation.is_none());
+        let (va, vb) = (
+            excite(&a.champion_network().unwrap().unwrap()),
+            excite(&b.champion_network().unwrap().unwrap()),
+        );
+        assert!(
+            va > vb,
+            "validated champion {va} should beat the lucky one {vb}"
+        );
+    }
+
+    #[test]
+    fn validated_runs_resume_identically_and_elites_are_validated_once() {
+        let task = Lucky::default();
+        let elitist = GaConfig {
+            elitism: 5,
+            ..config()
+        };
+        let mut a = Evolution::new(task.layout(), elitist, 8, &[], Fill::Mutants).unwrap();
+        for _ in 0..4 {
+            a.step(&task, None).unwrap();
+        }
+        let mut b = Evolution::from_json(&a.to_json()).unwrap();
+        let counted = task.validated.load(std::sync::atomic::Ordering::Relaxed);
+        assert!(
+            counted < 4 * 10,
+            "elites carried over are not validated again: {counted}"
+        );
+        for _ in 0..4 {
+            a.step(&task, None).unwrap();
+            b.step(&task, None).unwrap();
+        }
+        assert_eq!(a.champion, b.champion);
+        assert_eq!(a.population, b.population);
+        assert_eq!(a.to_json(), b.to_json());
+    }
+
+    #[test]
+    fn tasks_without_validation_and_old_checkpoints_choose_by_fitness() {
+        let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
+        evo.step(&Excite, None).unwrap();
+        let champ = evo.champion.clone().unwrap();
+        assert!(champ.validation.is_none());
+        let old: serde_json::Value = serde_json::json!({"population": 10});
+        let read: GaConfig = serde_json::from_value(old).unwrap();
+        assert_eq!(read.validation_candidates, 0);
+        assert_eq!(
+            GaConfig::default().validation_candidates,
+            ga::VALIDATION_CANDIDATES
+        );
     }
 
     #[test]

@@ -100,7 +100,16 @@ pub struct GaConfig {
     pub selection: Selection,
     /// Intervals for the initial draw and for mutation. Default [`Ranges::default`].
     pub ranges: Ranges,
+    /// How many of each generation's best individuals, by training fitness, are re-scored on the
+    /// task's validation set to choose the champion ([`crate::validation`]); 0 chooses the
+    /// champion by training fitness alone. Default 10; absent from a file (checkpoints written
+    /// before validation existed), 0.
+    #[serde(default)]
+    pub validation_candidates: usize,
 }
+
+/// [`GaConfig::validation_candidates`]'s default.
+pub const VALIDATION_CANDIDATES: usize = 10;
 
 impl Default for GaConfig {
     fn default() -> Self {
@@ -111,6 +120,7 @@ impl Default for GaConfig {
             elitism: 0,
             selection: Selection::Proportional,
             ranges: Ranges::default(),
+            validation_candidates: VALIDATION_CANDIDATES,
         }
     }
 }

@@ -25,6 +25,7 @@ pub mod network;
 pub mod population;
 pub mod rng;
 mod rows;
+pub mod validation;
 mod vector;
 
 pub use error::{Error, Result};
@@ -35,3 +36,4 @@ pub use integrate::{Integrator, Lanes, Method, LANES};
 pub use network::{compose, Network};
 pub use population::{Block, Inputs, Population};
 pub use rng::{Purpose, Stream};
+pub use validation::Validation;

@@ -40,10 +40,14 @@ pub enum Purpose {
     Seeding,
     /// Randomness of an evaluation outside evolution, such as a test run (code 5).
     Evaluate,
+    /// A run's validation set: fresh conditions, fixed for the whole run, on which the best
+    /// candidates of each generation are re-scored to pick the champion (code 6).
+    Validate,
 }
 
 impl Purpose {
-    /// The stable code of this purpose: Init 1, Reproduce 2, Trial 3, Seeding 4, Evaluate 5.
+    /// The stable code of this purpose: Init 1, Reproduce 2, Trial 3, Seeding 4, Evaluate 5,
+    /// Validate 6.
     pub fn code(self) -> u64 {
         match self {
             Purpose::Init => 1,
@@ -51,6 +55,7 @@ impl Purpose {
             Purpose::Trial => 3,
             Purpose::Seeding => 4,
             Purpose::Evaluate => 5,
+            Purpose::Validate => 6,
         }
     }
 }
@@ -230,6 +235,7 @@ mod tests {
             (6, 10, Purpose::Trial, 3, 1),
             (5, 11, Purpose::Trial, 3, 1),
             (5, 10, Purpose::Evaluate, 3, 1),
+            (5, 10, Purpose::Validate, 3, 1),
             (5, 10, Purpose::Trial, 4, 1),
             (5, 10, Purpose::Trial, 3, 2),
             (5, 10, Purpose::Trial, 1, 3), // swapped individual and trial

@@ -20,6 +20,9 @@ use crate::network::{networks_from, PyNetwork};
 #[pyclass(module = "dnnevo._core", name = "Evolution")]
 pub struct PyEvolution {
     inner: Evolution,
+    /// The task `step` last built, with its name and parameters: a run builds its task once, so
+    /// that what the task computes once per run (its validation set) is kept.
+    task: Option<(String, String, Box<dyn Task>)>,
 }
 
 fn config_from_json(text: &str) -> PyResult<GaConfig> {
@@ -107,7 +110,7 @@ impl PyEvolution {
         };
         let layout = Layout { size, n_inputs };
         let inner = Evolution::new(layout, config, seed, &seeds, fill).py_err()?;
-        Ok(PyEvolution { inner })
+        Ok(PyEvolution { inner, task: None })
     }
 
     /// The generation the current population belongs to.
@@ -172,7 +175,16 @@ impl PyEvolution {
         params: &str,
         threads: Option<usize>,
     ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyArrayDyn<f64>>)> {
-        let task = build_task(task, params)?;
+        if !matches!(&self.task, Some((n, p, _)) if n == task && p == params) {
+            self.task = Some((
+                task.to_owned(),
+                params.to_owned(),
+                build_task(task, params)?,
+            ));
+        }
+        let Some((_, _, task)) = &self.task else {
+            unreachable!("the task was just built")
+        };
         let pool = pool(threads)?;
         let inner = &mut self.inner;
         let (stats, fitness) = detached(py, f64::INFINITY, |cancel| {
@@ -197,6 +209,12 @@ impl PyEvolution {
         Ok(Some((PyNetwork::from_core(net), c.fitness, c.generation)))
     }
 
+    /// The champion's validation `(rate, score)`, or None when it was not chosen by validation.
+    fn champion_validation(&self) -> Option<(f64, f64)> {
+        let v = self.inner.champion.as_ref()?.validation?;
+        Some((v.rate, v.score))
+    }
+
     /// The complete state as JSON (floats exact).
     fn to_json(&self) -> String {
         self.inner.to_json()
@@ -207,6 +225,7 @@ impl PyEvolution {
     fn from_json(text: &str) -> PyResult<Self> {
         Ok(PyEvolution {
             inner: Evolution::from_json(text).py_err()?,
+            task: None,
         })
     }
 }

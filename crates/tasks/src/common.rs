@@ -1,7 +1,8 @@
-//! Small pieces every task shares: reading a config from JSON parameters, noticing Ctrl-C, and
-//! reporting a lane whose state stopped being finite.
+//! Small pieces every task shares: reading a config from JSON parameters, noticing Ctrl-C,
+//! reporting a lane whose state stopped being finite, and remembering a value computed once.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 use ctrnn::{Error, Lanes, Result};
 use serde::de::DeserializeOwned;
@@ -74,4 +75,47 @@ pub(crate) fn check_inputs(networks: &[ctrnn::Network], m: usize, what: &str) ->
         }
     }
     Ok(())
+}
+
+/// A value computed once for a key and kept, such as a run's validation set, which is the same
+/// in every generation. Only a cache: a clone starts empty, and any two compare equal.
+pub(crate) struct Memo<K, V>(Mutex<Option<(K, Arc<V>)>>);
+
+impl<K: PartialEq + Clone, V> Memo<K, V> {
+    /// The value for `key`: the kept one if it was computed for `key`, else `make(key)`, kept.
+    pub(crate) fn get_or_try(&self, key: &K, make: impl FnOnce() -> Result<V>) -> Result<Arc<V>> {
+        let mut slot = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((k, v)) = slot.as_ref() {
+            if k == key {
+                return Ok(v.clone());
+            }
+        }
+        let v = Arc::new(make()?);
+        *slot = Some((key.clone(), v.clone()));
+        Ok(v)
+    }
+}
+
+impl<K, V> Default for Memo<K, V> {
+    fn default() -> Self {
+        Memo(Mutex::new(None))
+    }
+}
+
+impl<K, V> Clone for Memo<K, V> {
+    fn clone(&self) -> Self {
+        Memo::default()
+    }
+}
+
+impl<K, V> PartialEq for Memo<K, V> {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl<K, V> std::fmt::Debug for Memo<K, V> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Memo")
+    }
 }

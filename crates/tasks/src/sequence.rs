@@ -67,7 +67,7 @@ use std::sync::atomic::AtomicBool;
 
 use ctrnn::{
     Error, Integrator, Lanes, Layout, Method, Network, Population, Purpose, Result, Stream, Task,
-    LANES,
+    Validation, LANES,
 };
 use rayon::prelude::*;
 
@@ -188,6 +188,9 @@ pub struct SequenceConfig {
     /// Whether each individual draws its own timings (`Purpose::Trial` stream with its index)
     /// instead of sharing the generation's. Default false.
     pub independent_conditions: bool,
+    /// Fresh trials per target in a run's validation set, on which the best candidates of each
+    /// generation are judged by the success rule to choose the champion (at least 1). Default 32.
+    pub validation_trials: usize,
 }
 
 impl Default for SequenceConfig {
@@ -209,6 +212,7 @@ impl Default for SequenceConfig {
                 substeps: 10,
             },
             independent_conditions: false,
+            validation_trials: 32,
         }
     }
 }
@@ -244,6 +248,7 @@ impl SequenceConfig {
             ("trials_per_target", self.trials_per_target),
             ("triggers", self.triggers),
             ("trigger_steps", self.trigger_steps),
+            ("validation_trials", self.validation_trials),
         ] {
             if value == 0 {
                 return config(format!("{name} is 0; it must be >= 1"));
@@ -393,6 +398,9 @@ fn correct(bit: u8, mean_output: f64) -> bool {
         mean_output < 0.5
     }
 }
+
+/// One judged trial: its performance, and whether every trigger after the warm-up was correct.
+type Judged = (f64, bool);
 
 /// Which part of a trigger's cycle a lane is in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -584,8 +592,17 @@ impl SequenceTask {
     /// The (delay, gap) of every trigger of trial `trial` of [`assess`](Self::assess), from
     /// `Stream::new(seed, 0, Purpose::Evaluate, 0, trial)`.
     pub fn assessment_timings(&self, seed: u64, trial: usize) -> Vec<(usize, usize)> {
-        let stream = Stream::new(seed, 0, Purpose::Evaluate, 0, trial as u64);
-        draw_timings(&self.config, stream, self.config.triggers)
+        self.fresh_timings(Purpose::Evaluate, seed, trial)
+    }
+
+    /// The (delay, gap) of every trigger of fresh trial `trial`, from
+    /// `Stream::new(seed, 0, purpose, 0, trial)`: the same for every generation.
+    pub fn fresh_timings(&self, purpose: Purpose, seed: u64, trial: usize) -> Vec<(usize, usize)> {
+        draw_timings(
+            &self.config,
+            Stream::new(seed, 0, purpose, 0, trial as u64),
+            self.config.triggers,
+        )
     }
 
     /// Scores a generation: every network runs every trial, blocks of [`LANES`] networks in
@@ -783,8 +800,45 @@ impl SequenceTask {
     /// Performance uses the numeric `perf_base`, or 0.5 when it is `"generation-mean"`.
     /// Every target must have more triggers than its warm-up, or nothing would be judged.
     pub fn assess(&self, net: &Network, trials_per_target: usize, seed: u64) -> Result<Assessment> {
-        check_inputs(std::slice::from_ref(net), 2, SENSORS)?;
-        if trials_per_target == 0 {
+        let judged = self.judge(&[net], trials_per_target, seed, Purpose::Evaluate, None)?;
+        let targets: Vec<TargetReport> = self
+            .config
+            .targets
+            .iter()
+            .zip(&judged[0])
+            .map(|(pattern, trials)| {
+                let perf: Vec<f64> = trials.iter().map(|t| t.0).collect();
+                let success_fraction =
+                    trials.iter().filter(|t| t.1).count() as f64 / trials.len() as f64;
+                TargetReport {
+                    target: pattern.clone(),
+                    mean_performance: mean(&perf),
+                    success_fraction,
+                    succeeded: success_fraction >= SUCCESS_FRACTION,
+                }
+            })
+            .collect();
+        let success = targets.iter().all(|t| t.succeeded);
+        Ok(Assessment { targets, success })
+    }
+
+    /// Runs every network of `nets` through `per_target` fresh trials of every target, trial `t`
+    /// (numbered target-major) with [`fresh_timings(purpose, seed, t)`](Self::fresh_timings), and
+    /// judges each by the success rule: `out[network][target][trial]` is the trial's performance
+    /// and whether every trigger after the warm-up was correct. (network, trial) pairs run
+    /// [`LANES`] at a time in parallel; a lane's results do not depend on its neighbours.
+    fn judge(
+        &self,
+        nets: &[&Network],
+        per_target: usize,
+        seed: u64,
+        purpose: Purpose,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<Vec<Vec<Judged>>>> {
+        for net in nets {
+            check_inputs(std::slice::from_ref(*net), 2, SENSORS)?;
+        }
+        if per_target == 0 {
             return Err(Error::InvalidArgument(
                 "trials_per_target is 0; assessing needs at least 1 trial per target".into(),
             ));
@@ -798,29 +852,38 @@ impl SequenceTask {
             )));
         }
         let base = self.fixed_base();
-        let refs = [net; LANES];
-        let mut targets = vec![];
+        let mut out = vec![Vec::with_capacity(config.targets.len()); nets.len()];
         for (i, pattern) in config.targets.iter().enumerate() {
             let bits = &self.bits[i];
             let from = warmup(pattern);
-            let first_trial = i * trials_per_target;
-            // (performance, success) per trial, LANES trials at a time.
-            let groups = (0..trials_per_target.div_ceil(LANES))
-                .into_par_iter()
-                .map(|g| {
-                    let count = LANES.min(trials_per_target - g * LANES);
-                    let own: Vec<Vec<(usize, usize)>> = (0..LANES)
-                        .map(|l| {
-                            let j = g * LANES + if l < count { l } else { 0 };
-                            self.assessment_timings(seed, first_trial + j)
-                        })
-                        .collect();
-                    let timings = std::array::from_fn(|l| own[l].as_slice());
+            let timings: Vec<Vec<(usize, usize)>> = (0..per_target)
+                .map(|j| self.fresh_timings(purpose, seed, i * per_target + j))
+                .collect();
+            let pairs: Vec<(usize, usize)> = (0..nets.len())
+                .flat_map(|n| (0..per_target).map(move |j| (n, j)))
+                .collect();
+            let groups = pairs
+                .par_chunks(LANES)
+                .map(|group| {
+                    if interrupted(cancel) {
+                        return Err(Error::Interrupted);
+                    }
+                    // Padding lanes repeat the group's first pair.
+                    let pick = |l: usize| group[if l < group.len() { l } else { 0 }];
+                    let refs: [&Network; LANES] = std::array::from_fn(|l| nets[pick(l).0]);
+                    let lane_timings = std::array::from_fn(|l| timings[pick(l).1].as_slice());
                     let mut lanes = Lanes::<LANES>::new(&refs)?;
-                    let outcome =
-                        run_lanes(config, &mut lanes, bits, timings, true, false, |_, _| {})
-                            .map_err(|d| d.error(0))?;
-                    Ok((0..count)
+                    let outcome = run_lanes(
+                        config,
+                        &mut lanes,
+                        bits,
+                        lane_timings,
+                        true,
+                        false,
+                        |_, _| {},
+                    )
+                    .map_err(|d| d.error(group[0].0))?;
+                    Ok((0..group.len())
                         .map(|l| {
                             let r: Vec<f64> = outcome.r.iter().map(|x| x[l]).collect();
                             let ok = (from..config.triggers)
@@ -830,19 +893,12 @@ impl SequenceTask {
                         .collect::<Vec<_>>())
                 })
                 .collect::<Result<Vec<_>>>()?;
-            let trials: Vec<(f64, bool)> = groups.concat();
-            let perf: Vec<f64> = trials.iter().map(|t| t.0).collect();
-            let success_fraction =
-                trials.iter().filter(|t| t.1).count() as f64 / trials_per_target as f64;
-            targets.push(TargetReport {
-                target: pattern.clone(),
-                mean_performance: mean(&perf),
-                success_fraction,
-                succeeded: success_fraction >= SUCCESS_FRACTION,
-            });
+            let judged = groups.concat();
+            for (n, trials) in judged.chunks(per_target).enumerate() {
+                out[n].push(trials.to_vec());
+            }
         }
-        let success = targets.iter().all(|t| t.succeeded);
-        Ok(Assessment { targets, success })
+        Ok(out)
     }
 }
 
@@ -868,6 +924,35 @@ impl Task for SequenceTask {
     /// [`SequenceTask::assess`] with [`SUCCESS_TRIALS`] trials per target.
     fn succeeds(&self, net: &Network, seed: u64) -> Result<Option<bool>> {
         Ok(Some(self.assess(net, SUCCESS_TRIALS, seed)?.success))
+    }
+
+    /// Each network judged as in [`SequenceTask::assess`] on `validation_trials` trials per
+    /// target drawn with [`Purpose::Validate`]: the rate is the lowest target's fraction of
+    /// correct trials, the score the mean performance over all trials.
+    fn validate(
+        &self,
+        networks: &[Network],
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        let refs: Vec<&Network> = networks.iter().collect();
+        let per_target = self.config.validation_trials;
+        let judged = self.judge(&refs, per_target, seed, Purpose::Validate, cancel)?;
+        Ok(Some(
+            judged
+                .iter()
+                .map(|targets| {
+                    let correct = targets.iter().map(|trials| {
+                        trials.iter().filter(|t| t.1).count() as f64 / per_target as f64
+                    });
+                    let perf: Vec<f64> = targets.iter().flatten().map(|t| t.0).collect();
+                    Validation {
+                        rate: correct.fold(f64::INFINITY, f64::min),
+                        score: mean(&perf),
+                    }
+                })
+                .collect(),
+        ))
     }
 }
 

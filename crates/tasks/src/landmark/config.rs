@@ -42,6 +42,9 @@ pub struct LandmarkConfig {
     pub classifier: usize,
     /// Trials per landmark in one evaluation. Default 3 (the paper's 6 trials in all).
     pub trials_per_landmark: usize,
+    /// Fresh trials per landmark in a run's validation set, on which the best candidates of each
+    /// generation are judged to choose the champion (in the training conditions). Default 50.
+    pub validation_trials: usize,
     /// Simulated seconds per trial. Default 45.
     pub trial_seconds: f64,
     /// The sonar input is `min(1, d0 / range)`. Default 0.5 m.
@@ -70,6 +73,7 @@ impl Default for LandmarkConfig {
             size: 8,
             classifier: 0,
             trials_per_landmark: 3,
+            validation_trials: 50,
             trial_seconds: 45.0,
             d0: sim2d::DEFAULT_D0,
             landmark1: WorldSpec::landmark(1).expect("the shipped world is valid"),
@@ -105,6 +109,7 @@ impl LandmarkConfig {
         for (name, value) in [
             ("size", self.size),
             ("trials_per_landmark", self.trials_per_landmark),
+            ("validation_trials", self.validation_trials),
         ] {
             if value == 0 {
                 return config(format!("{name} is 0; it must be >= 1"));

@@ -3,13 +3,15 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, LANES};
+use ctrnn::{
+    Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, Validation, LANES,
+};
 use rayon::prelude::*;
 use serde::Serialize;
 use sim2d::{Echo, Sim, World, WorldSpec};
 
 use super::config::{config_error, LandmarkConfig};
-use crate::common::{check_inputs, config_from_params, interrupted, Diverged};
+use crate::common::{check_inputs, config_from_params, interrupted, Diverged, Memo};
 
 /// The fraction of fresh trials a network must classify right to have solved the task.
 pub const SUCCESS_RATE: f64 = 0.95;
@@ -21,6 +23,8 @@ pub const SUCCESS_TRIALS: usize = 20;
 #[derive(Clone, Debug, PartialEq)]
 pub struct LandmarkTask {
     config: LandmarkConfig,
+    /// The validation set of the last seed asked for: the same in every generation of a run.
+    validation_set: Memo<u64, Vec<Sensing>>,
 }
 
 /// What the robot sensed in one trial. The wall follower drives the robot, not the network, so
@@ -91,7 +95,10 @@ impl LandmarkTask {
     /// The task for `config`, which is validated.
     pub fn new(config: LandmarkConfig) -> Result<Self> {
         config.validate()?;
-        Ok(LandmarkTask { config })
+        Ok(LandmarkTask {
+            config,
+            validation_set: Memo::default(),
+        })
     }
 
     /// The task from a JSON object of [`LandmarkConfig`] fields (`null` means all defaults).
@@ -172,27 +179,38 @@ impl LandmarkTask {
         seed: u64,
         robot_like: bool,
     ) -> Result<Vec<Sensing>> {
+        self.trials_from(Purpose::Evaluate, per_landmark, seed, robot_like)
+    }
+
+    /// [`fresh_trials`](Self::fresh_trials) drawn from `purpose`'s streams.
+    pub fn trials_from(
+        &self,
+        purpose: Purpose,
+        per_landmark: usize,
+        seed: u64,
+        robot_like: bool,
+    ) -> Result<Vec<Sensing>> {
         (0..2 * per_landmark)
             .into_par_iter()
             .map(|t| {
-                let stream = Stream::new(seed, 0, Purpose::Evaluate, 0, t as u64);
+                let stream = Stream::new(seed, 0, purpose, 0, t as u64);
                 let landmark = if t < per_landmark { 1 } else { 2 };
                 self.sense(landmark, stream, robot_like)
             })
             .collect()
     }
 
-    /// Feeds `input` to every lane from a reset state; `observe` sees the network after each
-    /// step. Returns the classifier's final output on every lane.
+    /// Feeds `inputs[l]` to lane `l` (all of the same length) from a reset state; `observe` sees
+    /// the network after each step. Returns the classifier's final output on every lane.
     fn run_lanes<const L: usize>(
         &self,
         lanes: &mut Lanes<L>,
-        input: &[f64],
+        inputs: [&[f64]; L],
         mut observe: impl FnMut(&Lanes<L>),
     ) -> std::result::Result<[f64; L], Diverged> {
         lanes.reset();
-        for &x in input {
-            lanes.step_row(&[[x; L]], &self.config.integrator);
+        for t in 0..inputs[0].len() {
+            lanes.step_row(&[inputs.map(|x| x[t])], &self.config.integrator);
             observe(lanes);
         }
         Diverged::find(lanes)?;
@@ -222,7 +240,7 @@ impl LandmarkTask {
                         return Err(Error::Interrupted);
                     }
                     let f = self
-                        .run_lanes(block, &trial.input, |_| {})
+                        .run_lanes(block, [trial.input.as_slice(); LANES], |_| {})
                         .map_err(|d| d.error(b * LANES))?;
                     for (l, row) in out.iter_mut().enumerate() {
                         row[t] = f[l];
@@ -232,6 +250,44 @@ impl LandmarkTask {
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(per_block.concat())
+    }
+
+    /// Each network's final classifier output on each trial (`out[p][t]`), with (network,
+    /// trial) pairs [`LANES`] at a time in parallel: for a few networks and many trials, where
+    /// [`outputs`](Self::outputs) would leave lanes and cores idle. A lane's result does not
+    /// depend on its neighbours, so both give the same bits.
+    fn outputs_by_pair(
+        &self,
+        networks: &[Network],
+        trials: &[Sensing],
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<Vec<f64>>> {
+        self.check(networks)?;
+        let pairs: Vec<(usize, usize)> = (0..networks.len())
+            .flat_map(|p| (0..trials.len()).map(move |t| (p, t)))
+            .collect();
+        let groups = pairs
+            .par_chunks(LANES)
+            .map(|group| {
+                if interrupted(cancel) {
+                    return Err(Error::Interrupted);
+                }
+                // Padding lanes repeat the group's first pair.
+                let pick = |l: usize| group[if l < group.len() { l } else { 0 }];
+                let refs: [&Network; LANES] = std::array::from_fn(|l| &networks[pick(l).0]);
+                let mut lanes = Lanes::<LANES>::new(&refs)?;
+                let inputs = std::array::from_fn(|l| trials[pick(l).1].input.as_slice());
+                let f = self
+                    .run_lanes(&mut lanes, inputs, |_| {})
+                    .map_err(|d| d.error(group[0].0))?;
+                Ok(f[..group.len()].to_vec())
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(groups
+            .concat()
+            .chunks(trials.len().max(1))
+            .map(<[f64]>::to_vec)
+            .collect())
     }
 
     /// The fitness of every network in `generation`: the mean trial score over
@@ -265,7 +321,7 @@ impl LandmarkTask {
         let n = net.size();
         let mut outputs = Vec::with_capacity(sensing.input.len());
         let f = self
-            .run_lanes(&mut lanes, &sensing.input, |lanes| {
+            .run_lanes(&mut lanes, [sensing.input.as_slice()], |lanes| {
                 outputs.push((0..n).map(|i| lanes.output(i)[0]).collect());
             })
             .map_err(|d| d.error(0))?;
@@ -348,6 +404,49 @@ impl Task for LandmarkTask {
         let robot_like = self.config.train_robot_like;
         Ok(Some(
             self.assess(net, SUCCESS_TRIALS, seed, robot_like)?.success,
+        ))
+    }
+
+    /// Each network on `validation_trials` trials per landmark in the training conditions, drawn
+    /// as in [`fresh_trials`](LandmarkTask::fresh_trials) from [`Purpose::Validate`]: the
+    /// fraction classified right and the mean trial score. The trials are sensed once per seed.
+    fn validate(
+        &self,
+        networks: &[Network],
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        let c = &self.config;
+        let trials = self.validation_set.get_or_try(&seed, || {
+            self.trials_from(
+                Purpose::Validate,
+                c.validation_trials,
+                seed,
+                c.train_robot_like,
+            )
+        })?;
+        let outputs = self.outputs_by_pair(networks, &trials, cancel)?;
+        let n = trials.len() as f64;
+        Ok(Some(
+            outputs
+                .iter()
+                .map(|f| {
+                    let right = trials
+                        .iter()
+                        .zip(f)
+                        .filter(|(s, &o)| answer(o) == s.landmark)
+                        .count();
+                    let total: f64 = trials
+                        .iter()
+                        .zip(f)
+                        .map(|(s, &o)| score(s.landmark, o))
+                        .sum();
+                    Validation {
+                        rate: right as f64 / n,
+                        score: total / n,
+                    }
+                })
+                .collect(),
         ))
     }
 }

@@ -82,6 +82,9 @@ pub struct Nav1dConfig {
     pub trials_per_environment: usize,
     /// Chains per environment type in one `"single"` evaluation. Default 2.
     pub chains_per_environment: usize,
+    /// Fresh chains (of the success check's length) in a run's validation set, on which the best
+    /// candidates of each generation are judged to choose the champion. Default 40.
+    pub validation_chains: usize,
     /// Half-width of a uniform random shift of the start position in each trial. Default 0 (the
     /// paper's fixed start).
     pub start_jitter: f64,
@@ -111,6 +114,7 @@ impl Default for Nav1dConfig {
             chained: false,
             trials_per_environment: 5,
             chains_per_environment: 2,
+            validation_chains: 40,
             start_jitter: 0.0,
             landmark_jitter: 0.0,
             integrator: Integrator {
@@ -145,6 +149,7 @@ impl Nav1dConfig {
             ("max_steps", self.max_steps),
             ("trials_per_environment", self.trials_per_environment),
             ("chains_per_environment", self.chains_per_environment),
+            ("validation_chains", self.validation_chains),
         ] {
             if value == 0 {
                 return config(format!("{name} is 0; it must be >= 1"));

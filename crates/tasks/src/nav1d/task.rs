@@ -3,7 +3,9 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, LANES};
+use ctrnn::{
+    Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, Validation, LANES,
+};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -190,10 +192,21 @@ impl Nav1dTask {
     /// `Stream::new(seed, 0, Purpose::Evaluate, 0, e)`: its environment uniformly from
     /// `environments`, then for each trial its goal side and jitter.
     pub fn fresh_chains(&self, count: usize, trials: usize, seed: u64) -> Vec<Vec<Condition>> {
+        self.chains_from(Purpose::Evaluate, count, trials, seed)
+    }
+
+    /// [`fresh_chains`](Self::fresh_chains) drawn from `purpose`'s streams.
+    pub fn chains_from(
+        &self,
+        purpose: Purpose,
+        count: usize,
+        trials: usize,
+        seed: u64,
+    ) -> Vec<Vec<Condition>> {
         let c = &self.config;
         (0..count)
             .map(|e| {
-                let mut s = Stream::new(seed, 0, Purpose::Evaluate, 0, e as u64);
+                let mut s = Stream::new(seed, 0, purpose, 0, e as u64);
                 let env = c.environments[s.below(c.environments.len() as u64) as usize];
                 (0..trials)
                     .map(|_| {
@@ -284,9 +297,23 @@ impl Nav1dTask {
     /// Runs `net` through each of `chains` (all of the same length), [`LANES`] chains at a time in
     /// parallel, each from a reset state.
     pub fn episodes(&self, net: &Network, chains: &[Vec<Condition>]) -> Result<Vec<Episode>> {
-        self.check(std::slice::from_ref(net))?;
+        Ok(self.episodes_of(&[net], chains, None)?.concat())
+    }
+
+    /// [`episodes`](Self::episodes) of every network of `nets` (`out[network][chain]`):
+    /// (network, chain) pairs run [`LANES`] at a time in parallel; a lane's results do not
+    /// depend on its neighbours.
+    fn episodes_of(
+        &self,
+        nets: &[&Network],
+        chains: &[Vec<Condition>],
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<Vec<Episode>>> {
+        for net in nets {
+            self.check(std::slice::from_ref(*net))?;
+        }
         let Some(first) = chains.first() else {
-            return Ok(vec![]);
+            return Ok(vec![vec![]; nets.len()]);
         };
         if let Some(e) = chains.iter().position(|c| c.len() != first.len()) {
             return Err(Error::InvalidArgument(format!(
@@ -295,27 +322,61 @@ impl Nav1dTask {
                 first.len()
             )));
         }
-        let refs = [net; LANES];
-        let groups = chains
+        let pairs: Vec<(usize, usize)> = (0..nets.len())
+            .flat_map(|n| (0..chains.len()).map(move |e| (n, e)))
+            .collect();
+        let groups = pairs
             .par_chunks(LANES)
             .map(|group| {
+                if interrupted(cancel) {
+                    return Err(Error::Interrupted);
+                }
+                // Padding lanes repeat the group's last pair.
+                let pick = |l: usize| group[l.min(group.len() - 1)];
+                let refs: [&Network; LANES] = std::array::from_fn(|l| nets[pick(l).0]);
                 let mut lanes = Lanes::<LANES>::new(&refs)?;
-                let pick = std::array::from_fn(|l| group[l.min(group.len() - 1)].as_slice());
-                let outcome = run_chains(&self.config, &mut lanes, pick, true, |_, _, _, _| {})
-                    .map_err(|d| d.error(0))?;
+                let lane_chains = std::array::from_fn(|l| chains[pick(l).1].as_slice());
+                let outcome =
+                    run_chains(&self.config, &mut lanes, lane_chains, true, |_, _, _, _| {})
+                        .map_err(|d| d.error(group[0].0))?;
                 Ok(group
                     .iter()
                     .enumerate()
-                    .map(|(l, chain)| Episode {
-                        environment: chain.first().map_or(Environment::Far, |c| c.environment),
-                        conditions: chain.clone(),
-                        reached: outcome.reached.iter().map(|r| r[l]).collect(),
-                        classification: outcome.classification.iter().map(|c| c[l]).collect(),
+                    .map(|(l, &(_, e))| {
+                        let chain = &chains[e];
+                        Episode {
+                            environment: chain.first().map_or(Environment::Far, |c| c.environment),
+                            conditions: chain.clone(),
+                            reached: outcome.reached.iter().map(|r| r[l]).collect(),
+                            classification: outcome.classification.iter().map(|c| c[l]).collect(),
+                        }
                     })
                     .collect::<Vec<_>>())
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(groups.concat())
+        Ok(groups
+            .concat()
+            .chunks(chains.len())
+            .map(<[Episode]>::to_vec)
+            .collect())
+    }
+
+    /// The mean score of the scored trials of `episodes` (0 when none is scored).
+    fn mean_score(&self, episodes: &[Episode]) -> f64 {
+        let (mut total, mut scored) = (0.0, 0usize);
+        for ep in episodes {
+            for (t, c) in ep.conditions.iter().enumerate() {
+                if let Some((score, _)) = self.judge(t, c, ep.reached[t], ep.classification[t]) {
+                    scored += 1;
+                    total += score;
+                }
+            }
+        }
+        if scored == 0 {
+            0.0
+        } else {
+            total / scored as f64
+        }
     }
 
     /// The fraction of scored trials of `episodes` done right (0 when none is scored).
@@ -454,5 +515,33 @@ impl Task for Nav1dTask {
     /// [`Nav1dTask::assess`] with [`SUCCESS_CHAINS`] chains.
     fn succeeds(&self, net: &Network, seed: u64) -> Result<Option<bool>> {
         Ok(Some(self.assess(net, SUCCESS_CHAINS, seed)?.success))
+    }
+
+    /// Each network on `validation_chains` chains drawn as in
+    /// [`fresh_chains`](Nav1dTask::fresh_chains) from [`Purpose::Validate`]: the rate of scored
+    /// trials done right and their mean score.
+    fn validate(
+        &self,
+        networks: &[Network],
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        let chains = self.chains_from(
+            Purpose::Validate,
+            self.config.validation_chains,
+            self.chain_len(),
+            seed,
+        );
+        let refs: Vec<&Network> = networks.iter().collect();
+        let episodes = self.episodes_of(&refs, &chains, cancel)?;
+        Ok(Some(
+            episodes
+                .iter()
+                .map(|eps| Validation {
+                    rate: self.rate(eps),
+                    score: self.mean_score(eps),
+                })
+                .collect(),
+        ))
     }
 }

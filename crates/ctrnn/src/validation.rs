@@ -1,0 +1,75 @@
+//! Validated champions: the best candidates of each generation, by training fitness, re-scored on
+//! a validation set of fresh conditions that stays fixed for the whole run.
+//!
+//! Training fitness is measured on a few trial conditions per generation (common random
+//! numbers), so the fittest individual of a generation can be one that was lucky on those
+//! conditions. A run therefore re-scores its top `validation_candidates` individuals by training
+//! fitness on the task's validation set, drawn once per run from
+//! `Stream::new(seed, 0, Purpose::Validate, 0, t)`: a stream that neither training
+//! ([`Purpose::Trial`](crate::Purpose::Trial)) nor assessment
+//! ([`Purpose::Evaluate`](crate::Purpose::Evaluate)) draws from. The champion is the candidate
+//! with the best [`Validation`] seen in any generation. Selection and breeding never see these
+//! scores, so evolution itself is unchanged.
+//!
+//! # Example
+//! ```
+//! use ctrnn::validation::{candidates, Validation};
+//! // The top 2 by training fitness; ties go to the lower index.
+//! assert_eq!(candidates(&[0.2, 0.9, 0.5, 0.9], 2), vec![1, 3]);
+//! let a = Validation { rate: 1.0, score: 0.8 };
+//! let b = Validation { rate: 0.95, score: 0.99 };
+//! assert!(a.beats(&b) && !b.beats(&a) && !a.beats(&a));
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+/// How one network did on the validation set.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Validation {
+    /// The fraction of validation conditions done right under the task's success rule (for a
+    /// task with several targets, the lowest target's fraction), in [0, 1].
+    pub rate: f64,
+    /// The mean of the task's trial score over the validation set, in [0, 1]: the margin that
+    /// separates networks with the same rate.
+    pub score: f64,
+}
+
+impl Validation {
+    /// Whether `self` is strictly better than `other`: a higher rate, or the same rate and a
+    /// higher score.
+    pub fn beats(&self, other: &Validation) -> bool {
+        self.rate > other.rate || (self.rate == other.rate && self.score > other.score)
+    }
+}
+
+/// The indices of the `k` highest fitness values (all of them when `k >= fitness.len()`), best
+/// first; among equal fitness the lower index comes first. NaN never occurs here: fitness has
+/// been checked before.
+pub fn candidates(fitness: &[f64], k: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..fitness.len()).collect();
+    order.sort_by(|&a, &b| fitness[b].total_cmp(&fitness[a]).then(a.cmp(&b)));
+    order.truncate(k);
+    order
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn candidates_are_the_best_by_fitness_then_index() {
+        let f = [0.5, 0.7, 0.7, 0.1, 0.9];
+        assert_eq!(candidates(&f, 3), vec![4, 1, 2]);
+        assert_eq!(candidates(&f, 0), Vec::<usize>::new());
+        assert_eq!(candidates(&f, 10), vec![4, 1, 2, 0, 3]);
+    }
+
+    #[test]
+    fn beats_is_lexicographic_and_strict() {
+        let v = |rate, score| Validation { rate, score };
+        assert!(v(0.9, 0.1).beats(&v(0.8, 0.9)));
+        assert!(v(0.9, 0.5).beats(&v(0.9, 0.4)));
+        assert!(!v(0.9, 0.5).beats(&v(0.9, 0.5)));
+        assert!(!v(0.8, 1.0).beats(&v(0.9, 0.0)));
+    }
+}

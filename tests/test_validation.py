@@ -1,0 +1,97 @@
+"""Validated champions: the best candidates of each generation re-scored on a validation set that
+is fixed for the run; evolution itself unchanged, runs deterministic and resume-identical."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dnnevo
+from dnnevo import ConfigError, EvolutionConfig
+
+# Fast configs of each built-in task that leave room for several champions.
+CONFIGS = {
+    "landmark": ("landmark", ["generations=12", "task_params.validation_trials=6",
+                              "task_params.trial_seconds=20"]),
+    "sequence": ("sequence-1bit", ["generations=6", "task_params.validation_trials=8"]),
+    "nav1d": ("nav1d-classifier", ["generations=6", "task_params.validation_chains=12"]),
+}
+FITNESS_COLUMNS = ("generation", "best", "mean", "std", "min")
+RESULT_COLUMNS = (*FITNESS_COLUMNS, "champion_success", "validation_rate", "validation_score")
+
+
+def config(task: str, *extra: str) -> EvolutionConfig:
+    preset, overrides = CONFIGS[task]
+    return dnnevo.presets.get(preset, quick=True, overrides=[*overrides, *extra])
+
+
+def same(a: np.ndarray, b: np.ndarray) -> bool:
+    return bool(np.array_equal(a, b, equal_nan=True))
+
+
+@pytest.mark.parametrize("task", sorted(CONFIGS))
+def test_champion_is_validated_and_evolution_is_unchanged(task: str, tmp_path: Path) -> None:
+    validated = dnnevo.evolve(task, config(task), seed=3, out=tmp_path / "v", progress=False)
+    plain = dnnevo.evolve(task, config(task, "validation_candidates=0"), seed=3, progress=False)
+    for key in FITNESS_COLUMNS:
+        np.testing.assert_array_equal(validated.history[key], plain.history[key])
+    assert validated.best_validation is not None
+    rate, score = validated.best_validation
+    assert 0.0 <= rate <= 1.0 and 0.0 <= score <= 1.0
+    rates = validated.history["validation_rate"]
+    assert np.all(np.diff(rates) >= 0), "the champion's validation rate never falls"
+    assert rates[-1] == rate and validated.history["validation_score"][-1] == score
+    meta = dnnevo.Network.load(tmp_path / "v/best.json").meta
+    assert (meta["validation_rate"], meta["validation_score"]) == (rate, score)
+    # Without validation the champion is the fittest individual, as in the paper.
+    assert plain.best_validation is None
+    assert plain.best_fitness == plain.history["best"].max()
+    assert np.isnan(plain.history["validation_rate"]).all()
+
+
+@pytest.mark.parametrize("task", sorted(CONFIGS))
+def test_validated_run_resumes_identically(task: str, tmp_path: Path) -> None:
+    cfg = config(task)
+    full = dnnevo.evolve(task, cfg, seed=5, out=tmp_path / "full", progress=False)
+    stop_at_3 = lambda stats, ga: ga.generation >= 3  # noqa: E731
+    dnnevo.evolve(task, cfg, seed=5, out=tmp_path / "part", progress=False, callback=stop_at_3)
+    resumed = dnnevo.resume(tmp_path / "part", progress=False)
+    for key in RESULT_COLUMNS:
+        assert same(full.history[key], resumed.history[key]), key
+    assert full.best == resumed.best and full.best_validation == resumed.best_validation
+    assert (tmp_path / "full/best.json").read_bytes() == (tmp_path / "part/best.json").read_bytes()
+
+
+def test_validated_run_is_identical_with_one_and_two_threads() -> None:
+    cfg = config("landmark")
+    one = dnnevo.evolve("landmark", cfg, seed=9, threads=1, progress=False)
+    two = dnnevo.evolve("landmark", cfg, seed=9, threads=2, progress=False)
+    for key in RESULT_COLUMNS:
+        assert same(one.history[key], two.history[key]), key
+    assert one.best == two.best and one.best_validation == two.best_validation
+
+
+def test_python_fitness_has_no_validation() -> None:
+    cfg = EvolutionConfig(population=20, generations=3, size=2, n_inputs=1)
+    result = dnnevo.evolve(lambda nets: np.ones(len(nets)), cfg, seed=0, progress=False)
+    assert result.best_validation is None
+    assert all(math.isnan(v) for v in result.history["validation_rate"])
+
+
+@pytest.mark.parametrize("value", [-1, 1.5, "ten", True])
+def test_bad_validation_candidates_is_a_config_error(value: object) -> None:
+    with pytest.raises(ConfigError, match="validation_candidates"):
+        EvolutionConfig(validation_candidates=value)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("task", "param"),
+    [("landmark", "validation_trials"), ("sequence", "validation_trials"),
+     ("nav1d", "validation_chains")],
+)
+def test_empty_validation_set_is_a_config_error(task: str, param: str) -> None:
+    with pytest.raises(ConfigError, match=f"{param} is 0"):
+        dnnevo.evolve(task, config(task, f"task_params.{param}=0"), seed=0, progress=False)

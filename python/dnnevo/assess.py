@@ -61,10 +61,11 @@ THRESHOLDS = {"sequence": 0.9, "landmark": 0.95, "nav1d": 0.95}
 """Each task's success threshold: the rate its rule needs (``SUCCESS_FRACTION`` in
 ``crates/tasks/src/sequence.rs``, ``SUCCESS_RATE`` in ``nav1d/task.rs`` and ``landmark/task.rs``)."""
 
-DEFAULT_TRIALS = {"sequence": 1000, "landmark": 300, "nav1d": 1000}
+DEFAULT_TRIALS = {"sequence": 1000, "landmark": 500, "nav1d": 1000}
 """``dnnevo evaluate``'s default trial counts: trials per target, trials per landmark, chains.
-Each takes well under a second on one core, except landmark (about 2 s: a robot trial costs
-about 3 ms)."""
+On one core a sequence or nav1d assessment takes under half a second (the 2-bit task's 4000
+trials 0.45 s, nav1d's slowest 0.2 s); landmark's 1000 robot trials take 1.2-1.7 s (about 1.5 ms
+each)."""
 
 UNITS = {"sequence": "trials per target", "landmark": "trials per landmark", "nav1d": "chains"}
 """What a trial count counts, per task."""

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 import dnnevo
-from dnnevo import _cli_landmark, _cli_nav1d, presets
+from dnnevo import _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, presets
+from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.rundir import RunDir, write_atomic
@@ -116,6 +117,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("presets", help="list the presets")
 
+    trials_help = (f"trials per target (sequence, default {DEFAULT_TRIALS['sequence']}), per landmark "
+                   f"(landmark, default {DEFAULT_TRIALS['landmark']}) or chains of trials (nav1d, "
+                   f"default {DEFAULT_TRIALS['nav1d']}); each default takes 2 s at most on one core")
     p = sub.add_parser("sweep", help="independent runs over seeds",
                        epilog="example: dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep")
     p.add_argument("preset")
@@ -124,15 +128,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true")
     run_options(p)
 
-    p = sub.add_parser("evaluate", help="re-score a champion on fresh random conditions",
-                       epilog="example: dnnevo evaluate runs/demo --trials 200")
+    p = sub.add_parser("evaluate", help="judge a champion on fresh random conditions",
+                       description="Judge a run's champion on fresh random conditions: every rate "
+                                   "with a 95% Wilson interval and a verdict (pass, fail or undecided).",
+                       epilog=_cli_evaluate.EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("dir", type=Path)
-    p.add_argument("--trials", type=_positive, default=100,
-                   help="fresh trials per target (sequence), fresh chains of trials (nav1d), "
-                        "or evaluations for other tasks (default 100)")
-    p.add_argument("--seed", type=_nonnegative, default=None, help="seed of the fresh conditions")
+    p.add_argument("--trials", type=_positive, default=None, help="fresh " + trials_help)
+    p.add_argument("--seed", type=_nonnegative, default=None,
+                   help="seed of the fresh conditions (default: a random one, printed)")
     p.add_argument("--robot-like", action="store_true",
                    help="landmark runs: sonar noise, specular misses and a jittered room")
+    p.add_argument("--json", action="store_true",
+                   help="print the whole assessment as JSON on stdout instead of text")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        epilog="example: dnnevo plot runs/demo")
@@ -240,53 +247,6 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_evaluate(args: argparse.Namespace) -> int:
-    run = RunDir(args.dir)
-    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
-    champion = dnnevo.Network.load(run.best)
-    seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
-    if args.robot_like and config.task != "landmark":
-        raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
-    if config.task == "sequence":
-        return _evaluate_sequence(args, config, champion, seed)
-    if config.task == "nav1d":
-        return _cli_nav1d.evaluate(args, config, champion, seed)
-    if config.task == "landmark":
-        return _cli_landmark.evaluate(args, config, champion, seed)
-    fitness = np.array([
-        dnnevo.evaluate(config.task, [champion], generation=k, seed=seed, config=config)[0]
-        for k in range(args.trials)
-    ])
-    print(f"{args.dir}: champion re-scored on {args.trials} fresh evaluations (seed {seed}): "
-          f"mean fitness {fitness.mean():.4f} ± {fitness.std():.4f}, min {fitness.min():.4f}")
-    return 0
-
-
-def _evaluate_sequence(
-    args: argparse.Namespace, config: EvolutionConfig, champion: dnnevo.Network, seed: int
-) -> int:
-    from dnnevo import sequence
-
-    report = sequence.assess(config, champion, args.trials, seed)
-    print(f"{args.dir}: champion on {args.trials} fresh trials per target (seed {seed}).")
-    print("A trial is correct when every trigger from index 2 x len(target) on is; a target is "
-          "learnt when >= 90% of trials are correct.")
-    print(f"{'target':>8} {'mean P':>8} {'correct':>8}  verdict")
-    for t in report["targets"]:
-        verdict = "learnt" if t["succeeded"] else "NOT learnt"
-        print(f"{t['target'] + '*':>8} {t['mean_performance']:>8.3f} "
-              f"{t['success_fraction']:>8.1%}  {verdict}")
-    print(f"overall: {'SUCCESS' if report['success'] else 'failure'}")
-    targets = list(config.task_params.get("targets", ["0", "1"]))
-    if len(targets) >= 2:
-        timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
-        _, _, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
-        after = "never settled" if needed is None else f"settled after {needed} trigger(s)"
-        print(f"switch test ({targets[-1]}* for 8 triggers, then {targets[0]}* without reset): "
-              f"{after}")
-    return 0 if report["success"] else 1
-
-
 def _cmd_plot(args: argparse.Namespace) -> int:
     import matplotlib.pyplot as plt
 
@@ -302,7 +262,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     plt.close(ax.figure)
     written.append("fitness.png")
     if config.task == "sequence":
-        written += _plot_sequence(run, config, args.seed)
+        written += _cli_sequence.plot(run, config, args.seed)
     if config.task == "nav1d":
         written += _cli_nav1d.plot(run, config, args.seed)
     if config.task == "landmark":
@@ -311,42 +271,13 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
-def _plot_sequence(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
-    import matplotlib.pyplot as plt
-
-    from dnnevo import sequence
-    from dnnevo.plot import plot_sequence_trial
-
-    champion = dnnevo.Network.load(run.best)
-    targets = list(config.task_params.get("targets", ["0", "1"]))
-    fig, axes = plt.subplots(len(targets), 1, figsize=(9, 2.6 * len(targets)),
-                             layout="constrained", squeeze=False)
-    for k, (target, ax) in enumerate(zip(targets, axes[:, 0], strict=True)):
-        record = sequence.run_trial(config, champion, target, sequence.timings(config, seed, 0, k))
-        plot_sequence_trial(record, ax=ax, title=f"{target}* positive trial")
-    fig.savefig(run.path / "fig4-trials.png", dpi=120)
-    plt.close(fig)
-    written = ["fig4-trials.png"]
-    if len(targets) >= 2:
-        timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
-        a, b, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
-        fig, ax = plt.subplots(figsize=(11, 3), layout="constrained")
-        plot_sequence_trial(a, ax=ax, follow=b, title=(
-            f"{targets[-1]}* for 8 triggers, then {targets[0]}* without reset "
-            f"({'settled after ' + str(needed) + ' trigger(s)' if needed is not None else 'never settled'})"))
-        fig.savefig(run.path / "fig5-switch.png", dpi=120)
-        plt.close(fig)
-        written.append("fig5-switch.png")
-    return written
-
-
 COMMANDS = {
     "run": _cmd_run,
     "resume": _cmd_resume,
     "show": _cmd_show,
     "presets": _cmd_presets,
     "sweep": _cmd_sweep,
-    "evaluate": _cmd_evaluate,
+    "evaluate": _cli_evaluate.evaluate,
     "plot": _cmd_plot,
     "nav1d-system": _cli_nav1d.system,
 }

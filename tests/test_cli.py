@@ -53,6 +53,8 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
         (["show", "/no/such/dir"], "has no log.csv"),
         (["evaluate", "/no/such/dir"], "No such file"),
         (["evaluate", "x", "--trials", "0"], "must be >= 1"),
+        (["sweep", "sequence-1bit", "--out", "x", "--eval-trials", "0"], "must be >= 1"),
+        (["sweep", "sequence-1bit", "--out", "x", "--eval-seed", "-3"], "-3 is negative"),
         (["sweep", "sequence-1bit", "--seeds", "a-b", "--out", "x"], "not a seed list"),
         (["frobnicate"], "invalid choice"),
     ],

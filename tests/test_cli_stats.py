@@ -1,8 +1,9 @@
-"""``dnnevo evaluate`` reports rates with intervals: ``evaluate --json`` for each task and the
-exit status of each verdict."""
+"""``dnnevo evaluate`` and ``dnnevo sweep`` report rates with intervals: ``evaluate --json`` for
+each task, the exit status of each verdict, and the sweep's summary."""
 
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 
@@ -149,3 +150,35 @@ def test_hint_when_the_rate_is_the_threshold() -> None:
 def test_bad_run_folder_is_one_line(tmp_path: Path) -> None:
     other = write_run(tmp_path / "other", EvolutionConfig(task="mine", size=5, n_inputs=2), silent())
     assert_one_line_error(run_cli("evaluate", other, "--json"), "no success rule")
+
+
+def test_sweep_reports_rates_with_intervals(tmp_path: Path) -> None:
+    # Quick nav1d-near runs: seed 3 meets the rule at generation 6, seed 2 never does.
+    out = tmp_path / "sweep"
+    r = run_cli("sweep", "nav1d-near", "--quick", "--seeds", "2-3", "--out", out, "--threads", "1",
+                "--eval-trials", "50")
+    assert r.returncode == 0, r.stderr
+    assert "seeds whose run met the rule: 1/2 = 50% (95% Wilson interval [9.5%, 90.5%])" in r.stdout
+    assert "median first-success generation: 6 (" in r.stdout
+    rows = list(csv.DictReader((out / "summary.csv").read_text().splitlines()))
+    assert [row["seed"] for row in rows] == ["2", "3", "all"]
+    assert [row["succeeded"] for row in rows[:2]] == ["0", "1"]
+    assert (rows[0]["first_success"], rows[1]["first_success"]) == ("", "6")
+    assert [row["eval_seed"] for row in rows[:2]] == ["1000005", "1000006"]
+    assert {row["final_verdict"] for row in rows[:2]} <= {"pass", "fail", "undecided"}
+    agg = rows[2]
+    assert (agg["succeeded"], agg["first_success"]) == ("0.5", "6")
+    assert float(agg["succeeded_lo"]) == pytest.approx(stats.wilson(1, 2)[0], abs=1e-6)
+    s = json.loads((out / "summary.json").read_text())
+    assert (s["preset"], s["eval_trials"], s["seeds"]) == ("nav1d-near", 50, [2, 3])
+    assert (s["success"]["k"], s["success"]["n"]) == (1, 2)
+    assert s["success"]["interval"] == pytest.approx(list(stats.wilson(1, 2)))
+    m = s["median_first_success"]
+    assert (m["median"], m["reached"], m["censored"]) == (6, True, 1)
+    passing = s["final_champions_pass"]
+    verdicts = [run["final"]["verdict"] for run in s["runs"]]
+    assert passing["k"] == verdicts.count("pass") and passing["n"] == 2
+    assert f"final champions passing on fresh trials: {passing['k']}/2" in r.stdout
+    # The final champion's assessment is evaluate's, on the eval seed.
+    d, _ = evaluate_json(out / "seed-3", "--trials", "50", "--seed", "1000006")
+    assert {**s["runs"][1]["final"], "run": str(out / "seed-3")} == d

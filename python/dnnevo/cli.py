@@ -4,22 +4,19 @@
 from __future__ import annotations
 
 import argparse
-import csv
 import functools
-import io
 import os
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 import dnnevo
-from dnnevo import _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, presets
+from dnnevo import _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, sweep
 from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.rundir import RunDir, write_atomic
+from dnnevo.rundir import RunDir
 
 EXAMPLES = """examples:
   dnnevo presets                                   list the experiments
@@ -120,12 +117,18 @@ def build_parser() -> argparse.ArgumentParser:
     trials_help = (f"trials per target (sequence, default {DEFAULT_TRIALS['sequence']}), per landmark "
                    f"(landmark, default {DEFAULT_TRIALS['landmark']}) or chains of trials (nav1d, "
                    f"default {DEFAULT_TRIALS['nav1d']}); each default takes 2 s at most on one core")
-    p = sub.add_parser("sweep", help="independent runs over seeds",
-                       epilog="example: dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep")
+    p = sub.add_parser("sweep", help="independent runs over seeds, with success statistics",
+                       description="Independent runs of a preset over seeds; each final champion is "
+                                   "judged on fresh conditions as 'dnnevo evaluate' judges it.",
+                       epilog=_cli_sweep.EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("preset")
     p.add_argument("--seeds", type=_parse_seeds, default=_parse_seeds("0-9"), help="e.g. 0-9 or 1,4,7")
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--force", action="store_true")
+    p.add_argument("--eval-seed", type=_nonnegative, default=sweep.EVAL_SEED_BASE, metavar="BASE",
+                   help="seed s's final champion is judged on fresh conditions from seed BASE + s "
+                        f"(default {sweep.EVAL_SEED_BASE}, which no run uses)")
+    p.add_argument("--eval-trials", type=_positive, metavar="N", help="fresh " + trials_help)
     run_options(p)
 
     p = sub.add_parser("evaluate", help="judge a champion on fresh random conditions",
@@ -219,34 +222,6 @@ def _cmd_presets(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_sweep(args: argparse.Namespace) -> int:
-    config = presets.get(args.preset, quick=args.quick, overrides=args.set)
-    RunDir(args.out).create(force=args.force)
-    rows = []
-    for seed in args.seeds:
-        t0 = time.perf_counter()
-        result = dnnevo.evolve(config.task, config, seed=seed, out=args.out / f"seed-{seed}",
-                               threads=args.threads, force=args.force)
-        rows.append({"seed": seed, "best_fitness": result.best_fitness,
-                     "best_generation": result.best_generation,
-                     "first_success": "" if result.first_success is None else result.first_success,
-                     "wall_s": round(time.perf_counter() - t0, 2)})
-        if result.interrupted:
-            break
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    write_atomic(args.out / "summary.csv", buf.getvalue())
-    print("first success: the first generation whose champion met the task's success rule")
-    print(f"{'seed':>5} {'best':>8} {'at gen':>7} {'first success':>14} {'wall s':>8}")
-    for r in rows:
-        print(f"{r['seed']:>5} {r['best_fitness']:>8.4f} {r['best_generation']:>7} "
-              f"{'-' if r['first_success'] == '' else r['first_success']:>14} {r['wall_s']:>8.1f}")
-    print(f"wrote {args.out / 'summary.csv'}")
-    return 0
-
-
 def _cmd_plot(args: argparse.Namespace) -> int:
     import matplotlib.pyplot as plt
 
@@ -276,7 +251,7 @@ COMMANDS = {
     "resume": _cmd_resume,
     "show": _cmd_show,
     "presets": _cmd_presets,
-    "sweep": _cmd_sweep,
+    "sweep": _cli_sweep.sweep_command,
     "evaluate": _cli_evaluate.evaluate,
     "plot": _cmd_plot,
     "nav1d-system": _cli_nav1d.system,

@@ -25,12 +25,13 @@ EXAMPLES = """examples:
   dnnevo run sequence-1bit --set population=200 --set mutation_rate=0.02
   dnnevo resume runs/demo                          continue a stopped run
   dnnevo show runs/demo                            summary and fitness.png
-  dnnevo evaluate runs/demo --trials 200           re-score the champion on fresh conditions
+  dnnevo evaluate runs/demo                        judge the champion on fresh conditions
+  dnnevo evaluate runs/demo --json                 ... as JSON; exit 0 pass, 1 fail, 3 undecided
   dnnevo plot runs/demo                            fitness curve and the paper's figures
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
   dnnevo run nav1d-classifier --out runs/cls       the paper's navigation classifier (6 s)
   dnnevo nav1d-system --classifier runs/cls --far runs/far --near runs/near
-  dnnevo run landmark --out runs/lm && dnnevo evaluate runs/lm --trials 100 --robot-like
+  dnnevo run landmark --out runs/lm && dnnevo evaluate runs/lm --robot-like
 """
 
 

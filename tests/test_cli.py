@@ -55,6 +55,8 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
         (["evaluate", "x", "--trials", "0"], "must be >= 1"),
         (["sweep", "sequence-1bit", "--out", "x", "--eval-trials", "0"], "must be >= 1"),
         (["sweep", "sequence-1bit", "--out", "x", "--eval-seed", "-3"], "-3 is negative"),
+        (["sweep", "sequence-1bit", "--out", "x", "--seeds", "0-1", "--eval-seed", str(2**64 - 1)],
+         "--eval-seed + seed is 18446744073709551616"),
         (["sweep", "sequence-1bit", "--seeds", "a-b", "--out", "x"], "not a seed list"),
         (["frobnicate"], "invalid choice"),
     ],

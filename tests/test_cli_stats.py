@@ -150,6 +150,17 @@ def test_hint_when_the_rate_is_the_threshold() -> None:
 def test_bad_run_folder_is_one_line(tmp_path: Path) -> None:
     other = write_run(tmp_path / "other", EvolutionConfig(task="mine", size=5, n_inputs=2), silent())
     assert_one_line_error(run_cli("evaluate", other, "--json"), "no success rule")
+    seq = write_run(tmp_path / "seq", presets.get("sequence-1bit"), silent())
+    assert_one_line_error(run_cli("evaluate", seq, "--seed", str(2**64)), "seed is 18446744073709551616")
+
+
+def test_a_bug_exits_2_never_1(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """Exit status 1 means "fail"; an unexpected exception must not look like one."""
+    from dnnevo import cli
+
+    monkeypatch.setitem(cli.COMMANDS, "presets", lambda args: 1 // 0)
+    assert cli.main(["presets"]) == 2
+    assert "internal error" in capsys.readouterr().err
 
 
 def test_sweep_reports_rates_with_intervals(tmp_path: Path) -> None:

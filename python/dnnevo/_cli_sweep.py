@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 
 from dnnevo import presets, sweep
+from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
 from dnnevo.errors import ConfigError
 from dnnevo.rundir import RunDir
@@ -28,6 +29,8 @@ def sweep_command(args: argparse.Namespace) -> int:
     config = presets.get(args.preset, quick=args.quick, overrides=args.set)
     if config.task not in DEFAULT_TRIALS:
         raise ConfigError(f"task {config.task!r} has no success rule, so a sweep cannot judge it")
+    for seed in args.seeds:  # before any run, so a bad --eval-seed costs nothing
+        nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
     RunDir(args.out).create(force=args.force)
     trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
     runs = []

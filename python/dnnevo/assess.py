@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from dnnevo import _core, stats
+from dnnevo._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
 from dnnevo.stats import Verdict
@@ -194,6 +195,7 @@ def assess(
                           f"{', '.join(sorted(THRESHOLDS))}")
     if robot_like and config.task != "landmark":
         raise ConfigError(f"robot_like applies to landmark runs; this is a {config.task} run")
+    nonnegative("seed", seed)
     if trials is None:
         trials = DEFAULT_TRIALS[config.task]
     if not isinstance(trials, int) or isinstance(trials, bool) or trials < 1:

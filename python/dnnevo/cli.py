@@ -7,6 +7,7 @@ import argparse
 import functools
 import os
 import sys
+import traceback
 from pathlib import Path
 
 import numpy as np
@@ -280,3 +281,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("dnnevo: interrupted\n")
         return 130
+    except Exception:
+        # A bug: show it, but exit 2 as for any error, never 1 (evaluate's "fail").
+        if args.debug:
+            raise
+        sys.stderr.write("dnnevo: internal error, please report it:\n" + traceback.format_exc())
+        return 2

@@ -3,7 +3,9 @@ each task, the exit status of each verdict, and the sweep's summary."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import io
 import json
 from pathlib import Path
 
@@ -12,7 +14,7 @@ import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
 import dnnevo
-from dnnevo import _cli_evaluate, assess, presets, stats
+from dnnevo import _cli_evaluate, assess, cli, presets, stats
 from dnnevo.config import EvolutionConfig
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
@@ -30,10 +32,19 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     return out
 
 
+def in_process(*args: object) -> tuple[str, int]:
+    """``dnnevo ARGS`` run in this process (no interpreter start-up): stdout and exit status.
+    The tests that check the real process run it in a subprocess."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        status = cli.main([str(a) for a in args])
+    return out.getvalue(), status
+
+
 def evaluate_json(run: Path, *args: str) -> tuple[dict, int]:
-    r = run_cli("evaluate", run, "--json", *args)
-    assert r.returncode in (0, 1, 3), r.stderr
-    return json.loads(r.stdout), r.returncode
+    stdout, status = in_process("evaluate", run, "--json", *args)
+    assert status in (0, 1, 3)
+    return json.loads(stdout), status
 
 
 def check_rate(rate: dict, threshold: float | None) -> None:
@@ -105,12 +116,12 @@ def test_evaluate_json_landmark(runs: dict[str, Path], robot_like: bool) -> None
 
 
 def test_text_shows_intervals(runs: dict[str, Path]) -> None:
-    r = run_cli("evaluate", runs["landmark"], "--trials", "6", "--seed", "1")
+    stdout, _ = in_process("evaluate", runs["landmark"], "--trials", "6", "--seed", "1")
     d, _ = evaluate_json(runs["landmark"], "--trials", "6", "--seed", "1")
     overall = d["rates"][-1]
     lo, hi = overall["interval"]
-    assert f"{overall['k']}/12" in r.stdout and f"[{lo:.2%}, {hi:.2%}]" in r.stdout
-    assert "intervals: Wilson score interval, 95%" in r.stdout
+    assert f"{overall['k']}/12" in stdout and f"[{lo:.2%}, {hi:.2%}]" in stdout
+    assert "intervals: Wilson score interval, 95%" in stdout
 
 
 def write_run(folder: Path, config: EvolutionConfig, net: dnnevo.Network) -> Path:
@@ -134,8 +145,8 @@ def test_exit_status_is_the_verdict(tmp_path: Path) -> None:
     assert r.returncode == 3, (r.stdout, r.stderr)
     assert "overall: undecided" in r.stdout
     assert "0* is undecided: if its rate of 100.0% holds, --trials 35 (trials per target) would decide it" in r.stdout
-    r = run_cli("evaluate", zero_only, "--trials", "35", "--seed", "0", "--json")
-    assert r.returncode == 0 and json.loads(r.stdout)["verdict"] == "pass"
+    d, status = evaluate_json(zero_only, "--trials", "35", "--seed", "0")
+    assert status == 0 and d["verdict"] == "pass"
     both = write_run(tmp_path / "both", presets.get("sequence-1bit"), silent())
     r = run_cli("evaluate", both, "--trials", "20", "--seed", "0")
     assert r.returncode == 1 and "overall: fail (1* fails; every target must pass)" in r.stdout
@@ -156,8 +167,6 @@ def test_bad_run_folder_is_one_line(tmp_path: Path) -> None:
 
 def test_a_bug_exits_2_never_1(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     """Exit status 1 means "fail"; an unexpected exception must not look like one."""
-    from dnnevo import cli
-
     monkeypatch.setitem(cli.COMMANDS, "presets", lambda args: 1 // 0)
     assert cli.main(["presets"]) == 2
     assert "internal error" in capsys.readouterr().err

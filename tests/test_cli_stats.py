@@ -7,6 +7,7 @@ import contextlib
 import csv
 import io
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,7 @@ from cli_helpers import assert_one_line_error, run_cli
 import dnnevo
 from dnnevo import _cli_evaluate, assess, cli, presets, stats
 from dnnevo.config import EvolutionConfig
+from dnnevo.rundir import RunDir
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
 
@@ -172,29 +174,43 @@ def test_a_bug_exits_2_never_1(monkeypatch: pytest.MonkeyPatch, capsys: pytest.C
     assert "internal error" in capsys.readouterr().err
 
 
+def first_success(run: Path) -> int | None:
+    """The first generation whose champion met the rule, read from the run's log."""
+    hits = [int(row["generation"]) for row in RunDir(run).read_log() if row["champion_success"] == 1.0]
+    return hits[0] if hits else None
+
+
 def test_sweep_reports_rates_with_intervals(tmp_path: Path) -> None:
-    # Quick nav1d-near runs: seed 3 meets the rule at generation 6, seed 2 never does.
+    # Quick nav1d-near runs (with this core, seed 3 meets the rule at generation 6 and seed 2
+    # never does); the expectations come from the runs' own logs.
     out = tmp_path / "sweep"
     r = run_cli("sweep", "nav1d-near", "--quick", "--seeds", "2-3", "--out", out, "--threads", "1",
                 "--eval-trials", "50")
     assert r.returncode == 0, r.stderr
-    assert "seeds whose run met the rule: 1/2 = 50% (95% Wilson interval [9.5%, 90.5%])" in r.stdout
-    assert "median first-success generation: 6 (" in r.stdout
+    firsts = [first_success(out / f"seed-{seed}") for seed in (2, 3)]
+    k = sum(f is not None for f in firsts)
+    lo, hi = stats.wilson(k, 2)
+    assert f"seeds whose run met the rule: {k}/2 = {k / 2:.0%} (95% Wilson interval [{lo:.1%}, {hi:.1%}])" in r.stdout
+    median = stats.censored_median([math.inf if f is None else f for f in firsts])
+    shown = f"{median:.0f} (" if math.isfinite(median) else "not reached"
+    assert f"median first-success generation: {shown}" in r.stdout
     rows = list(csv.DictReader((out / "summary.csv").read_text().splitlines()))
     assert [row["seed"] for row in rows] == ["2", "3", "all"]
-    assert [row["succeeded"] for row in rows[:2]] == ["0", "1"]
-    assert (rows[0]["first_success"], rows[1]["first_success"]) == ("", "6")
+    assert [row["succeeded"] for row in rows[:2]] == [str(int(f is not None)) for f in firsts]
+    assert [row["first_success"] for row in rows[:2]] == ["" if f is None else str(f) for f in firsts]
     assert [row["eval_seed"] for row in rows[:2]] == ["1000005", "1000006"]
     assert {row["final_verdict"] for row in rows[:2]} <= {"pass", "fail", "undecided"}
     agg = rows[2]
-    assert (agg["succeeded"], agg["first_success"]) == ("0.5", "6")
-    assert float(agg["succeeded_lo"]) == pytest.approx(stats.wilson(1, 2)[0], abs=1e-6)
+    assert float(agg["succeeded"]) == k / 2
+    assert agg["first_success"] == (str(int(median)) if math.isfinite(median) else "not reached")
+    assert float(agg["succeeded_lo"]) == pytest.approx(lo, abs=1e-6)
     s = json.loads((out / "summary.json").read_text())
     assert (s["preset"], s["eval_trials"], s["seeds"]) == ("nav1d-near", 50, [2, 3])
-    assert (s["success"]["k"], s["success"]["n"]) == (1, 2)
-    assert s["success"]["interval"] == pytest.approx(list(stats.wilson(1, 2)))
+    assert (s["success"]["k"], s["success"]["n"]) == (k, 2)
+    assert s["success"]["interval"] == pytest.approx([lo, hi])
     m = s["median_first_success"]
-    assert (m["median"], m["reached"], m["censored"]) == (6, True, 1)
+    assert (m["reached"], m["censored"]) == (math.isfinite(median), 2 - k)
+    assert m["median"] == (int(median) if math.isfinite(median) else None)
     passing = s["final_champions_pass"]
     verdicts = [run["final"]["verdict"] for run in s["runs"]]
     assert passing["k"] == verdicts.count("pass") and passing["n"] == 2

@@ -27,20 +27,15 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
     r = dnnevo("show", str(out))
     assert r.returncode == 0 and (out / "fitness.png").stat().st_size > 1000
     r = dnnevo("evaluate", str(out), "--trials", "5", "--seed", "1")
-    # Exit status 0 when the champion learnt every target, 1 when it did not.
-    assert r.returncode in (0, 1) and "overall:" in r.stdout and "switch test" in r.stdout
-    assert ("SUCCESS" in r.stdout) == (r.returncode == 0)
+    # Exit status 0 pass, 1 fail, 3 undecided: the overall verdict.
+    verdict = {0: "pass", 1: "fail", 3: "undecided"}[r.returncode]
+    assert f"overall: {verdict}" in r.stdout and "switch test" in r.stdout, r.stdout
     r = dnnevo("plot", str(out))
     assert r.returncode == 0, r.stderr
     for name in ("fitness.png", "fig4-trials.png", "fig5-switch.png"):
         assert (out / name).stat().st_size > 1000
     r = dnnevo("resume", str(out))  # already finished: nothing to do, still a clean exit
     assert r.returncode == 0, r.stderr
-    sweep = tmp_path / "sweep"
-    r = dnnevo("sweep", "sequence-1bit", "--quick", "--seeds", "0-1", "--out", str(sweep),
-               "--set", "generations=2")
-    assert r.returncode == 0, r.stderr
-    assert len((sweep / "summary.csv").read_text().splitlines()) == 3
     r = dnnevo("presets")
     assert r.returncode == 0 and "sequence-1bit" in r.stdout
 
@@ -57,6 +52,11 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
         (["resume", "/no/such/dir"], "has no checkpoint.json"),
         (["show", "/no/such/dir"], "has no log.csv"),
         (["evaluate", "/no/such/dir"], "No such file"),
+        (["evaluate", "x", "--trials", "0"], "must be >= 1"),
+        (["sweep", "sequence-1bit", "--out", "x", "--eval-trials", "0"], "must be >= 1"),
+        (["sweep", "sequence-1bit", "--out", "x", "--eval-seed", "-3"], "-3 is negative"),
+        (["sweep", "sequence-1bit", "--out", "x", "--seeds", "0-1", "--eval-seed", str(2**64 - 1)],
+         "--eval-seed + seed is 18446744073709551616"),
         (["sweep", "sequence-1bit", "--seeds", "a-b", "--out", "x"], "not a seed list"),
         (["frobnicate"], "invalid choice"),
     ],

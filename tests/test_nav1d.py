@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 import dnnevo
-from dnnevo import nav1d, presets
+from dnnevo import assess, nav1d, presets
 from dnnevo.config import apply_overrides
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 
@@ -396,15 +396,14 @@ def test_quick_run_evaluate_and_plot(runs, name):
     log = (run / "log.csv").read_text().splitlines()
     assert len(log) == 1 + 8  # header and the 8 generations of --quick
     r = run_cli("evaluate", run, "--trials", "40", "--seed", "1")
-    assert r.returncode in (0, 1), r.stderr
-    assert "overall" in r.stdout
-    assert ("SUCCESS" in r.stdout) == (r.returncode == 0)
+    assert r.returncode in (0, 1, 3), r.stderr
     # The verdict is the Python API's, on the same fresh chains.
     part = nav1d.load_part(run)
     assert part.config == presets.get(name, quick=True)
     report = nav1d.assess(part.config, part.network, 40, seed=1)
-    assert f"overall: {report['rate']:.1%}" in r.stdout
-    assert report["success"] == (r.returncode == 0)
+    judged = assess.assess(part.config, part.network, 40, seed=1)
+    assert f"overall: {report['rate']:.1%} right; success needs >= 95%: {judged.verdict}" in r.stdout
+    assert assess.EXIT_STATUS[judged.verdict] == r.returncode
     r = run_cli("plot", run)
     assert r.returncode == 0, r.stderr
     pictures = ["fitness.png", "fig2-paths.png"]

@@ -1,29 +1,28 @@
-"""The ``dnnevo`` command's landmark-recognition parts: ``evaluate`` (with ``--robot-like``) and
-``plot`` for ``landmark`` runs."""
+"""The ``dnnevo`` command's landmark-recognition parts: the first lines of ``evaluate`` (with
+``--robot-like``) and ``plot`` for ``landmark`` runs."""
 
 from __future__ import annotations
 
-import argparse
+from pathlib import Path
 from typing import Any
 
 from dnnevo import landmark
+from dnnevo.assess import Assessment
 from dnnevo.config import EvolutionConfig
 from dnnevo.rundir import RunDir
 
 
-def evaluate(args: argparse.Namespace, config: EvolutionConfig, champion: Any, seed: int) -> int:
-    """``dnnevo evaluate`` for a ``landmark`` run: a confusion matrix on fresh trials."""
-    report = landmark.assess(config, champion, args.trials, seed, robot_like=args.robot_like)
-    kind = ("robot-like (sonar noise, specular misses, jittered room)" if args.robot_like
+def preface(where: Path, a: Assessment) -> list[str]:
+    """What ``evaluate`` ran on a ``landmark`` run, and the confusion matrix."""
+    kind = ("robot-like (sonar noise, specular misses, jittered room)" if a.details["robot_like"]
             else "ideal")
-    print(f"{args.dir}: champion on {args.trials} fresh {kind} trials per landmark (seed {seed}).")
-    (a, b), (c, d) = report["confusion"]
-    print(f"{'':>12} {'said 1':>7} {'said 2':>7} {'right':>7}")
-    print(f"{'landmark 1':>12} {a:>7} {b:>7} {a / max(a + b, 1):>7.1%}")
-    print(f"{'landmark 2':>12} {c:>7} {d:>7} {d / max(c + d, 1):>7.1%}")
-    verdict = "SUCCESS" if report["success"] else "failure"
-    print(f"overall: {report['rate']:.1%} right (success needs >= {report['required']:.0%}): {verdict}")
-    return 0 if report["success"] else 1
+    (p, q), (r, s) = a.details["confusion"]
+    return [
+        f"{where}: champion on {a.trials} fresh {kind} trials per landmark (seed {a.seed}).",
+        f"{'':>12} {'said 1':>7} {'said 2':>7}",
+        f"{'landmark 1':>12} {p:>7} {q:>7}",
+        f"{'landmark 2':>12} {r:>7} {s:>7}",
+    ]
 
 
 def plot(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = False) -> list[str]:

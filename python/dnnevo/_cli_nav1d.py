@@ -1,5 +1,6 @@
-"""The ``dnnevo`` command's one-dimensional navigation parts: ``evaluate`` and ``plot`` for
-``nav1d`` runs, and the ``nav1d-system`` command (the integrated system of paper §4.2)."""
+"""The ``dnnevo`` command's one-dimensional navigation parts: the first lines of ``evaluate``
+and ``plot`` for ``nav1d`` runs, and the ``nav1d-system`` command (the integrated system of paper
+§4.2)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from dnnevo import nav1d
+from dnnevo.assess import Assessment
 from dnnevo.config import EvolutionConfig
 from dnnevo.rundir import RunDir, write_atomic
 
@@ -36,28 +38,26 @@ def _rate_table(episodes: Sequence[dict[str, Any]], first_scored: int) -> list[s
     return lines
 
 
-def evaluate(args: argparse.Namespace, config: EvolutionConfig, champion: Any, seed: int) -> int:
-    """``dnnevo evaluate`` for a ``nav1d`` run: the success rule on fresh conditions."""
-    report = nav1d.assess(config, champion, args.trials, seed)
-    objective = report["objective"]
-    episodes = report["episodes"]
-    print(f"{args.dir}: champion ({objective}) on {args.trials} fresh chains (seed {seed}).")
+def preface(where: Path, a: Assessment) -> list[str]:
+    """What ``evaluate`` ran on a ``nav1d`` run, and the rates by case (``classify``) or by
+    environment type and trial index."""
+    objective = a.details["objective"]
+    episodes = a.report["episodes"]
+    lines = [f"{where}: champion ({objective}) on {a.trials} fresh chains (seed {a.seed})."]
     if objective == "classify":
-        print("A trial is right when f(v_C) >= 0.5 exactly in landmark-near environments.")
-        print(f"{'environment':>12} {'goal':>6} {'trials':>6} {'right':>7} {'mean f(v_C)':>12}")
+        lines.append("A trial is right when f(v_C) >= 0.5 exactly in landmark-near environments.")
+        lines.append(f"{'environment':>12} {'goal':>6} {'trials':>6} {'right':>7} {'mean f(v_C)':>12}")
         for env, goal in nav1d.CASES:
             picked = [e for e in episodes if e["environment"] == env
                       and e["conditions"][0]["goal"] == goal]
             if picked:
-                f = np.array([e["classification"][0] for e in picked])
+                f = np.array([np.nan if e["classification"][0] is None else e["classification"][0]
+                              for e in picked])
                 right = (f >= 0.5) if env == "near" else (f < 0.5)
-                print(f"{env:>12} {goal:>6} {len(picked):>6} {right.mean():>7.1%} {f.mean():>12.3f}")
+                lines.append(f"{env:>12} {goal:>6} {len(picked):>6} {right.mean():>7.1%} {f.mean():>12.3f}")
     else:
-        for line in _rate_table(episodes, 1 if objective == "single" else 0):
-            print(line)
-    verdict = "SUCCESS" if report["success"] else "failure"
-    print(f"overall: {report['rate']:.1%} of scored trials right (success needs >= {report['required']:.0%}): {verdict}")
-    return 0 if report["success"] else 1
+        lines += _rate_table(episodes, 1 if objective == "single" else 0)
+    return lines
 
 
 def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:

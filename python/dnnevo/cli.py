@@ -4,21 +4,20 @@
 from __future__ import annotations
 
 import argparse
-import csv
 import functools
-import io
 import os
 import sys
-import time
+import traceback
 from pathlib import Path
 
 import numpy as np
 
 import dnnevo
-from dnnevo import _cli_landmark, _cli_nav1d, presets
+from dnnevo import _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, sweep
+from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.rundir import RunDir, write_atomic
+from dnnevo.rundir import RunDir
 
 EXAMPLES = """examples:
   dnnevo presets                                   list the experiments
@@ -27,12 +26,13 @@ EXAMPLES = """examples:
   dnnevo run sequence-1bit --set population=200 --set mutation_rate=0.02
   dnnevo resume runs/demo                          continue a stopped run
   dnnevo show runs/demo                            summary and fitness.png
-  dnnevo evaluate runs/demo --trials 200           re-score the champion on fresh conditions
+  dnnevo evaluate runs/demo                        judge the champion on fresh conditions
+  dnnevo evaluate runs/demo --json                 ... as JSON; exit 0 pass, 1 fail, 3 undecided
   dnnevo plot runs/demo                            fitness curve and the paper's figures
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
   dnnevo run nav1d-classifier --out runs/cls       the paper's navigation classifier (6 s)
   dnnevo nav1d-system --classifier runs/cls --far runs/far --near runs/near
-  dnnevo run landmark --out runs/lm && dnnevo evaluate runs/lm --trials 100 --robot-like
+  dnnevo run landmark --out runs/lm && dnnevo evaluate runs/lm --robot-like
 """
 
 
@@ -116,23 +116,35 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("presets", help="list the presets")
 
-    p = sub.add_parser("sweep", help="independent runs over seeds",
-                       epilog="example: dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep")
+    trials_help = (f"trials per target (sequence, default {DEFAULT_TRIALS['sequence']}), per landmark "
+                   f"(landmark, default {DEFAULT_TRIALS['landmark']}) or chains of trials (nav1d, "
+                   f"default {DEFAULT_TRIALS['nav1d']}); each default takes 2 s at most on one core")
+    p = sub.add_parser("sweep", help="independent runs over seeds, with success statistics",
+                       description="Independent runs of a preset over seeds; each final champion is "
+                                   "judged on fresh conditions as 'dnnevo evaluate' judges it.",
+                       epilog=_cli_sweep.EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("preset")
     p.add_argument("--seeds", type=_parse_seeds, default=_parse_seeds("0-9"), help="e.g. 0-9 or 1,4,7")
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--force", action="store_true")
+    p.add_argument("--eval-seed", type=_nonnegative, default=sweep.EVAL_SEED_BASE, metavar="BASE",
+                   help="seed s's final champion is judged on fresh conditions from seed BASE + s "
+                        f"(default {sweep.EVAL_SEED_BASE}, which no run uses)")
+    p.add_argument("--eval-trials", type=_positive, metavar="N", help="fresh " + trials_help)
     run_options(p)
 
-    p = sub.add_parser("evaluate", help="re-score a champion on fresh random conditions",
-                       epilog="example: dnnevo evaluate runs/demo --trials 200")
+    p = sub.add_parser("evaluate", help="judge a champion on fresh random conditions",
+                       description="Judge a run's champion on fresh random conditions: every rate "
+                                   "with a 95% Wilson interval and a verdict (pass, fail or undecided).",
+                       epilog=_cli_evaluate.EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("dir", type=Path)
-    p.add_argument("--trials", type=_positive, default=100,
-                   help="fresh trials per target (sequence), fresh chains of trials (nav1d), "
-                        "or evaluations for other tasks (default 100)")
-    p.add_argument("--seed", type=_nonnegative, default=None, help="seed of the fresh conditions")
+    p.add_argument("--trials", type=_positive, default=None, help="fresh " + trials_help)
+    p.add_argument("--seed", type=_nonnegative, default=None,
+                   help="seed of the fresh conditions (default: a random one, printed)")
     p.add_argument("--robot-like", action="store_true",
                    help="landmark runs: sonar noise, specular misses and a jittered room")
+    p.add_argument("--json", action="store_true",
+                   help="print the whole assessment as JSON on stdout instead of text")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        epilog="example: dnnevo plot runs/demo")
@@ -212,81 +224,6 @@ def _cmd_presets(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_sweep(args: argparse.Namespace) -> int:
-    config = presets.get(args.preset, quick=args.quick, overrides=args.set)
-    RunDir(args.out).create(force=args.force)
-    rows = []
-    for seed in args.seeds:
-        t0 = time.perf_counter()
-        result = dnnevo.evolve(config.task, config, seed=seed, out=args.out / f"seed-{seed}",
-                               threads=args.threads, force=args.force)
-        rows.append({"seed": seed, "best_fitness": result.best_fitness,
-                     "best_generation": result.best_generation,
-                     "first_success": "" if result.first_success is None else result.first_success,
-                     "wall_s": round(time.perf_counter() - t0, 2)})
-        if result.interrupted:
-            break
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    write_atomic(args.out / "summary.csv", buf.getvalue())
-    print("first success: the first generation whose champion met the task's success rule")
-    print(f"{'seed':>5} {'best':>8} {'at gen':>7} {'first success':>14} {'wall s':>8}")
-    for r in rows:
-        print(f"{r['seed']:>5} {r['best_fitness']:>8.4f} {r['best_generation']:>7} "
-              f"{'-' if r['first_success'] == '' else r['first_success']:>14} {r['wall_s']:>8.1f}")
-    print(f"wrote {args.out / 'summary.csv'}")
-    return 0
-
-
-def _cmd_evaluate(args: argparse.Namespace) -> int:
-    run = RunDir(args.dir)
-    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
-    champion = dnnevo.Network.load(run.best)
-    seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
-    if args.robot_like and config.task != "landmark":
-        raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
-    if config.task == "sequence":
-        return _evaluate_sequence(args, config, champion, seed)
-    if config.task == "nav1d":
-        return _cli_nav1d.evaluate(args, config, champion, seed)
-    if config.task == "landmark":
-        return _cli_landmark.evaluate(args, config, champion, seed)
-    fitness = np.array([
-        dnnevo.evaluate(config.task, [champion], generation=k, seed=seed, config=config)[0]
-        for k in range(args.trials)
-    ])
-    print(f"{args.dir}: champion re-scored on {args.trials} fresh evaluations (seed {seed}): "
-          f"mean fitness {fitness.mean():.4f} ± {fitness.std():.4f}, min {fitness.min():.4f}")
-    return 0
-
-
-def _evaluate_sequence(
-    args: argparse.Namespace, config: EvolutionConfig, champion: dnnevo.Network, seed: int
-) -> int:
-    from dnnevo import sequence
-
-    report = sequence.assess(config, champion, args.trials, seed)
-    print(f"{args.dir}: champion on {args.trials} fresh trials per target (seed {seed}).")
-    print("A trial is correct when every trigger from index 2 x len(target) on is; a target is "
-          "learnt when >= 90% of trials are correct.")
-    print(f"{'target':>8} {'mean P':>8} {'correct':>8}  verdict")
-    for t in report["targets"]:
-        verdict = "learnt" if t["succeeded"] else "NOT learnt"
-        print(f"{t['target'] + '*':>8} {t['mean_performance']:>8.3f} "
-              f"{t['success_fraction']:>8.1%}  {verdict}")
-    print(f"overall: {'SUCCESS' if report['success'] else 'failure'}")
-    targets = list(config.task_params.get("targets", ["0", "1"]))
-    if len(targets) >= 2:
-        timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
-        _, _, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
-        after = "never settled" if needed is None else f"settled after {needed} trigger(s)"
-        print(f"switch test ({targets[-1]}* for 8 triggers, then {targets[0]}* without reset): "
-              f"{after}")
-    return 0 if report["success"] else 1
-
-
 def _cmd_plot(args: argparse.Namespace) -> int:
     import matplotlib.pyplot as plt
 
@@ -302,7 +239,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     plt.close(ax.figure)
     written.append("fitness.png")
     if config.task == "sequence":
-        written += _plot_sequence(run, config, args.seed)
+        written += _cli_sequence.plot(run, config, args.seed)
     if config.task == "nav1d":
         written += _cli_nav1d.plot(run, config, args.seed)
     if config.task == "landmark":
@@ -311,42 +248,13 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
-def _plot_sequence(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
-    import matplotlib.pyplot as plt
-
-    from dnnevo import sequence
-    from dnnevo.plot import plot_sequence_trial
-
-    champion = dnnevo.Network.load(run.best)
-    targets = list(config.task_params.get("targets", ["0", "1"]))
-    fig, axes = plt.subplots(len(targets), 1, figsize=(9, 2.6 * len(targets)),
-                             layout="constrained", squeeze=False)
-    for k, (target, ax) in enumerate(zip(targets, axes[:, 0], strict=True)):
-        record = sequence.run_trial(config, champion, target, sequence.timings(config, seed, 0, k))
-        plot_sequence_trial(record, ax=ax, title=f"{target}* positive trial")
-    fig.savefig(run.path / "fig4-trials.png", dpi=120)
-    plt.close(fig)
-    written = ["fig4-trials.png"]
-    if len(targets) >= 2:
-        timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
-        a, b, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
-        fig, ax = plt.subplots(figsize=(11, 3), layout="constrained")
-        plot_sequence_trial(a, ax=ax, follow=b, title=(
-            f"{targets[-1]}* for 8 triggers, then {targets[0]}* without reset "
-            f"({'settled after ' + str(needed) + ' trigger(s)' if needed is not None else 'never settled'})"))
-        fig.savefig(run.path / "fig5-switch.png", dpi=120)
-        plt.close(fig)
-        written.append("fig5-switch.png")
-    return written
-
-
 COMMANDS = {
     "run": _cmd_run,
     "resume": _cmd_resume,
     "show": _cmd_show,
     "presets": _cmd_presets,
-    "sweep": _cmd_sweep,
-    "evaluate": _cmd_evaluate,
+    "sweep": _cli_sweep.sweep_command,
+    "evaluate": _cli_evaluate.evaluate,
     "plot": _cmd_plot,
     "nav1d-system": _cli_nav1d.system,
 }
@@ -373,3 +281,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("dnnevo: interrupted\n")
         return 130
+    except Exception:
+        # A bug: show it, but exit 2 as for any error, never 1 (evaluate's "fail").
+        if args.debug:
+            raise
+        sys.stderr.write("dnnevo: internal error, please report it:\n" + traceback.format_exc())
+        return 2

@@ -1,0 +1,117 @@
+"""The ``dnnevo evaluate`` command: a run's champion judged on fresh conditions by
+:func:`dnnevo.assess.assess`, printed as text (default) or JSON (``--json``). The exit status is
+the verdict: 0 pass, 1 fail, 3 undecided (2 is an error)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from dnnevo import _cli_landmark, _cli_nav1d, _cli_sequence, _core, assess
+from dnnevo.assess import Assessment, Rate
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import ConfigError
+from dnnevo.rundir import RunDir
+
+EXAMPLE = """examples:
+  dnnevo evaluate runs/demo                      the champion on fresh trials, default counts
+  dnnevo evaluate runs/demo --trials 2000 --seed 1
+  dnnevo evaluate runs/lm --robot-like --json    the whole assessment as JSON on stdout
+
+Each rate gets a 95% Wilson score interval. Verdict: pass when the interval lies at or above the
+task's threshold (sequence: 90% of trials per target; landmark and nav1d: 95%), fail when it lies
+below, undecided when it straddles it; then the output says how many trials would decide.
+A sequence run passes when every target passes and fails when any fails. nav1d trials within one
+chain share the network's state: with several scored trials per chain the interval counts chains.
+Exit status: 0 pass, 1 fail, 3 undecided, 2 error."""
+
+
+def evaluate(args: argparse.Namespace) -> int:
+    """``dnnevo evaluate``."""
+    run = RunDir(args.dir)
+    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
+    champion = _core.Network.load(run.best)
+    seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
+    if args.robot_like and config.task != "landmark":
+        raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
+    a = assess.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
+    extra = _cli_sequence.switch_test(config, champion, seed) if a.task == "sequence" else {}
+    if args.json:
+        print(json.dumps({"run": str(args.dir), **a.to_dict(), **extra}, indent=1))
+    else:
+        print("\n".join(text(args.dir, a, extra)))
+    return assess.EXIT_STATUS[a.verdict]
+
+
+PREFACES: dict[str, Callable[[Path, Assessment], list[str]]] = {
+    "sequence": _cli_sequence.preface,
+    "landmark": _cli_landmark.preface,
+    "nav1d": _cli_nav1d.preface,
+}
+"""Each task's first lines: what was run, and the task's own table."""
+
+
+def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:
+    """The human report of ``a`` on the run in ``where``."""
+    column = None
+    if a.task == "sequence":
+        column = ("mean P", {f"{t}*": f"{p:.3f}" for t, p in a.details["mean_performance"].items()})
+    lines = [*PREFACES[a.task](where, a), *rate_table(a.rates, column), overall(a)]
+    lines += [hint(r, a.unit) for r in a.judged if r.verdict == "undecided"]
+    lines.append(f"intervals: {a.method}")
+    if "switch_test" in extra:
+        lines.append(_cli_sequence.switch_line(extra["switch_test"]))
+    return lines
+
+
+def percent(x: float, digits: int = 2) -> str:
+    """``x`` as a percentage; 2 decimals so a bound never rounds onto a threshold."""
+    return f"{x:.{digits}%}"
+
+
+def interval(r: Rate) -> str:
+    """``[lo, hi]`` in percent."""
+    return f"[{percent(r.interval[0])}, {percent(r.interval[1])}]"
+
+
+def rate_table(rates: Sequence[Rate], column: tuple[str, dict[str, str]] | None = None) -> list[str]:
+    """One line per rate: right / trials, the rate, its 95% interval, the threshold and verdict
+    (``-`` for a rate that is shown, not judged); ``column`` adds a (header, cells by name)."""
+    width = max(4, *(len(r.name) for r in rates))
+    right = max(5, *(len(f"{r.k}/{r.n}") for r in rates))
+    head = f"{'':>{width}} {'right':>{right}} {'rate':>8}  {'95% interval':<20} {'needs':>7}  verdict"
+    lines = [head + (f"  {column[0]:>8}" if column else "")]
+    for r in rates:
+        needs = "-" if r.threshold is None else f">= {r.threshold:.0%}"
+        line = (f"{r.name:>{width}} {f'{r.k}/{r.n}':>{right}} {percent(r.rate):>8}  {interval(r):<20} "
+                f"{needs:>7}  {r.verdict or '-':<9}")
+        lines.append(line + (f"  {column[1].get(r.name, ''):>8}" if column else "").rstrip())
+    return [line.rstrip() for line in lines]
+
+
+def overall(a: Assessment) -> str:
+    """The verdict line."""
+    if a.task == "sequence":
+        failing = [r.name for r in a.judged if r.verdict == "fail"]
+        open_ = [r.name for r in a.judged if r.verdict == "undecided"]
+        why = {"pass": "every target passes",
+               "fail": f"{', '.join(failing)} {'fails' if len(failing) == 1 else 'fail'}; every target must pass",
+               "undecided": f"no target fails, but {', '.join(open_)} {'is' if len(open_) == 1 else 'are'} undecided"}
+        return f"overall: {a.verdict} ({why[a.verdict]})"
+    r = a.judged[0]
+    return f"overall: {r.rate:.1%} right; success needs >= {r.threshold:.0%}: {a.verdict}"
+
+
+def hint(r: Rate, unit: str) -> str:
+    """What would decide the undecided rate ``r``."""
+    if r.trials_to_decide is not None:
+        return (f"{r.name} is undecided: if its rate of {percent(r.rate, 1)} holds, --trials "
+                f"{r.trials_to_decide} ({unit}) would decide it")
+    if r.rate == r.threshold:
+        return (f"{r.name} is undecided: its rate equals the threshold ({percent(r.rate, 1)}), so no "
+                "number of trials decides it")
+    return f"{r.name} is undecided: its rate is too close to the threshold for any practical number of trials"

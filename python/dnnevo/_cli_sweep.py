@@ -1,0 +1,93 @@
+"""The ``dnnevo sweep`` command: independent runs over seeds, each final champion judged on fresh
+conditions, and the statistics of :mod:`dnnevo.sweep` printed and written to ``summary.csv`` and
+``summary.json``."""
+
+from __future__ import annotations
+
+import argparse
+
+from dnnevo import presets, sweep
+from dnnevo._checks import nonnegative
+from dnnevo.assess import DEFAULT_TRIALS, UNITS
+from dnnevo.errors import ConfigError
+from dnnevo.rundir import RunDir
+
+EXAMPLE = """examples:
+  dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
+  dnnevo sweep landmark --seeds 0-9 --out runs/sweep-lm --eval-trials 100
+
+Reports the seeds whose run met the task's rule (k/n with a 95% Wilson interval), the median
+first-success generation (95% bootstrap interval, fixed bootstrap seed; a seed that never
+succeeded counts as +infinity, so "not reached" when more than half never did), and the final
+champions (best.json) that pass on fresh conditions from seed BASE + seed (--eval-seed), judged as
+'dnnevo evaluate' judges. Writes OUT/summary.csv (a row per seed, then a row 'all') and
+OUT/summary.json."""
+
+
+def sweep_command(args: argparse.Namespace) -> int:
+    """``dnnevo sweep``."""
+    config = presets.get(args.preset, quick=args.quick, overrides=args.set)
+    if config.task not in DEFAULT_TRIALS:
+        raise ConfigError(f"task {config.task!r} has no success rule, so a sweep cannot judge it")
+    for seed in args.seeds:  # before any run, so a bad --eval-seed costs nothing
+        nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
+    RunDir(args.out).create(force=args.force)
+    trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
+    runs = []
+    for seed in args.seeds:
+        result = sweep.run_seed(config, seed, args.out / f"seed-{seed}", threads=args.threads,
+                                force=args.force, eval_seed_base=args.eval_seed, eval_trials=trials)
+        runs.append(result)
+        if result.interrupted:
+            break
+    summary = sweep.summarize(runs)
+    info = {"preset": args.preset, "quick": args.quick, "overrides": list(args.set), "task": config.task,
+            "eval_seed": f"{args.eval_seed} + seed", "eval_trials": trials,
+            "eval_unit": UNITS[config.task]}
+    paths = summary.write(args.out, info)
+    print("\n".join(lines(summary, args.eval_seed, trials, UNITS[config.task])))
+    if runs[-1].interrupted:
+        print(f"interrupted during seed {runs[-1].seed}; the statistics cover the {len(runs)} seed(s) run")
+    print(f"wrote {', '.join(map(str, paths))}")
+    return 0
+
+
+def _generation(x: float) -> str:
+    return "not reached" if x == float("inf") else f"{x:.0f}"
+
+
+def lines(s: sweep.Summary, eval_seed: int, trials: int, unit: str) -> list[str]:
+    """The sweep's table and statistics in words."""
+    out = [
+        "first success: the first generation whose champion met the task's success rule during the run",
+        f"final: the run's final champion on fresh conditions (seed {eval_seed} + seed, {trials} {unit}),"
+        " judged as 'dnnevo evaluate' judges; the weakest judged rate is shown",
+        f"{'seed':>5} {'best':>8} {'at gen':>7} {'first success':>14} {'wall s':>8}  "
+        f"{'final rate':>16}  {'95% interval':<16}  verdict",
+    ]
+    for r in s.runs:
+        w = r.final.weakest
+        rate = f"{w.name} {w.k}/{w.n}" if len(r.final.judged) > 1 else f"{w.k}/{w.n}"
+        bounds = f"[{w.interval[0]:.1%}, {w.interval[1]:.1%}]"
+        out.append(
+            f"{r.seed:>5} {r.best_fitness:>8.4f} {r.best_generation:>7} "
+            f"{'-' if r.first_success is None else r.first_success:>14} {r.wall_s:>8.1f}  "
+            f"{rate:>16}  {bounds:<16}  {r.final.verdict}")
+    n = s.seeds
+    lo, hi = s.success_interval
+    out.append(f"seeds whose run met the rule: {s.succeeded}/{n} = {s.succeeded / n:.0%} "
+               f"(95% Wilson interval [{lo:.1%}, {hi:.1%}])")
+    m = s.first_success
+    censored = (f"{m.censored} of {n} seed(s) never met the rule and count as censored at their last "
+                "generation")
+    bounds = f"95% bootstrap interval [{_generation(m.lo)}, {_generation(m.hi)}]"
+    if m.reached:
+        out.append(f"median first-success generation: {_generation(m.median)} ({bounds}; {censored})")
+    else:
+        out.append(f"median first-success generation: not reached, as more than half the seeds never "
+                   f"met the rule ({censored}; {bounds})")
+    lo, hi = s.pass_interval
+    v = s.verdicts
+    out.append(f"final champions passing on fresh trials: {s.passed}/{n} = {s.passed / n:.0%} "
+               f"(95% Wilson interval [{lo:.1%}, {hi:.1%}]); {v['fail']} fail, {v['undecided']} undecided")
+    return out

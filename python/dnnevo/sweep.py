@@ -1,0 +1,211 @@
+"""Independent runs of one config over several seeds (``dnnevo sweep``), and what they say with
+their uncertainty:
+
+- **success rate**: the fraction of seeds whose run found a champion meeting the task's rule
+  (:attr:`~dnnevo.EvolutionResult.first_success` is not None), with its Wilson interval;
+- **median first-success generation**, with a 95% percentile bootstrap interval (fixed seed
+  :data:`~dnnevo.stats.BOOTSTRAP_SEED`, 10,000 resamples). A seed that never succeeded is
+  censored at its run's last generation and counts as +infinity, so the median is "not
+  reached" when more than half the seeds are censored;
+- **final champions passing**: each seed's final champion (``best.json``) judged by
+  :func:`dnnevo.assess.assess` on fresh conditions from seed :data:`EVAL_SEED_BASE` + the run's
+  seed, which no run uses; the fraction that pass, with its Wilson interval.
+
+>>> from dnnevo import sweep
+>>> sweep.eval_seed(3)
+1000006
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from dnnevo import _core, stats
+from dnnevo.assess import Assessment, assess
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import InvalidArgumentError
+from dnnevo.rundir import RunDir, write_atomic
+from dnnevo.stats import Verdict
+
+__all__ = ["EVAL_SEED_BASE", "CSV_COLUMNS", "SeedResult", "Summary", "eval_seed", "run_seed", "summarize"]
+
+EVAL_SEED_BASE = 1_000_003
+"""The fresh conditions of seed s's final champion come from seed ``EVAL_SEED_BASE + s``."""
+
+CSV_COLUMNS = (
+    "seed", "best_fitness", "best_generation", "first_success", "first_success_lo",
+    "first_success_hi", "last_generation", "succeeded", "succeeded_lo", "succeeded_hi", "wall_s",
+    "eval_seed", "final_rate", "final_k", "final_n", "final_lo", "final_hi", "final_verdict",
+)
+"""The columns of ``summary.csv``: one row per seed, then a row ``all`` whose cells aggregate
+their column (see :meth:`Summary.csv_text`)."""
+
+
+def eval_seed(seed: int, base: int = EVAL_SEED_BASE) -> int:
+    """The seed of the fresh conditions that judge run ``seed``'s final champion."""
+    return base + seed
+
+
+@dataclass(frozen=True)
+class SeedResult:
+    """One seed's run and its final champion's assessment."""
+
+    seed: int
+    best_fitness: float
+    best_generation: int
+    first_success: int | None
+    """The first generation whose champion met the task's rule during the run, if any."""
+    last_generation: int
+    wall_s: float
+    final: Assessment
+    interrupted: bool = False
+
+    @property
+    def censored_at(self) -> float:
+        """The first-success generation, or +infinity for a run that never succeeded (censored at
+        :attr:`last_generation`)."""
+        return math.inf if self.first_success is None else float(self.first_success)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result as plain JSON types."""
+        return {
+            "seed": self.seed, "best_fitness": self.best_fitness, "best_generation": self.best_generation,
+            "first_success": self.first_success, "last_generation": self.last_generation,
+            "succeeded": self.first_success is not None, "wall_s": self.wall_s,
+            "interrupted": self.interrupted, "final": self.final.to_dict(),
+        }
+
+
+def run_seed(
+    config: EvolutionConfig, seed: int, out: Path, *, threads: int | None = None, force: bool = False,
+    eval_seed_base: int = EVAL_SEED_BASE, eval_trials: int | None = None,
+) -> SeedResult:
+    """Runs ``config`` with ``seed`` into ``out``, then judges the final champion (``out /
+    best.json``) on fresh conditions from :func:`eval_seed` with ``eval_trials`` (default: the
+    task's :data:`~dnnevo.assess.DEFAULT_TRIALS`)."""
+    from dnnevo.evolve import evolve
+
+    t0 = time.perf_counter()
+    result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force)
+    wall = time.perf_counter() - t0
+    champion = _core.Network.load(RunDir(out).best)
+    final = assess(config, champion, eval_trials, seed=eval_seed(seed, eval_seed_base))
+    generations = result.history["generation"]
+    return SeedResult(
+        seed=seed, best_fitness=float(result.best_fitness), best_generation=int(result.best_generation),
+        first_success=result.first_success, last_generation=int(generations[-1]) if len(generations) else 0,
+        wall_s=round(wall, 2), final=final, interrupted=result.interrupted,
+    )
+
+
+@dataclass(frozen=True)
+class Summary:
+    """What a sweep's seeds say together."""
+
+    runs: list[SeedResult]
+    succeeded: int
+    """Seeds whose run met the task's rule."""
+    success_interval: tuple[float, float]
+    first_success: stats.Median
+    """The median first-success generation; ``math.inf`` is "not reached"."""
+    passed: int
+    """Final champions whose verdict is pass."""
+    pass_interval: tuple[float, float]
+    verdicts: dict[Verdict, int]
+
+    @property
+    def seeds(self) -> int:
+        """How many seeds ran."""
+        return len(self.runs)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The summary as plain JSON types; "not reached" is null."""
+        m = self.first_success
+
+        def gen(x: float) -> int | None:
+            return int(x) if math.isfinite(x) else None
+
+        return {
+            "seeds": [r.seed for r in self.runs],
+            "success": {"k": self.succeeded, "n": self.seeds, "rate": self.succeeded / self.seeds,
+                        "interval": list(self.success_interval)},
+            "median_first_success": {
+                "median": gen(m.median), "reached": m.reached, "interval": [gen(m.lo), gen(m.hi)],
+                "censored": m.censored, "method": "censored median (failures count as +infinity "
+                "at their last generation; null is not reached), percentile bootstrap",
+                "resamples": m.resamples, "bootstrap_seed": m.seed,
+            },
+            "final_champions_pass": {"k": self.passed, "n": self.seeds, "rate": self.passed / self.seeds,
+                                     "interval": list(self.pass_interval), "verdicts": dict(self.verdicts)},
+            "runs": [r.to_dict() for r in self.runs],
+        }
+
+    def csv_text(self) -> str:
+        """``summary.csv``: a row per seed, then a row ``all`` that holds each column's aggregate:
+        ``succeeded`` the fraction of seeds (with ``succeeded_lo``/``_hi``, its Wilson interval),
+        ``first_success`` the median (``not reached`` when censored, with ``first_success_lo``/
+        ``_hi``, its bootstrap interval), ``final_k``/``final_n`` the final champions passing (with
+        ``final_lo``/``_hi``, its Wilson interval), ``wall_s`` the total."""
+        buf = io.StringIO()
+        writer = csv.DictWriter(buf, fieldnames=CSV_COLUMNS, lineterminator="\n", restval="")
+        writer.writeheader()
+        for r in self.runs:
+            w = r.final.weakest
+            writer.writerow({
+                "seed": r.seed, "best_fitness": r.best_fitness, "best_generation": r.best_generation,
+                "first_success": "" if r.first_success is None else r.first_success,
+                "last_generation": r.last_generation, "succeeded": int(r.first_success is not None),
+                "wall_s": r.wall_s, "eval_seed": r.final.seed, "final_rate": w.name, "final_k": w.k,
+                "final_n": w.n, "final_lo": _round(w.interval[0]), "final_hi": _round(w.interval[1]),
+                "final_verdict": r.final.verdict,
+            })
+        m = self.first_success
+        writer.writerow({
+            "seed": "all", "first_success": _generation(m.median), "first_success_lo": _generation(m.lo),
+            "first_success_hi": _generation(m.hi), "succeeded": _round(self.succeeded / self.seeds),
+            "succeeded_lo": _round(self.success_interval[0]), "succeeded_hi": _round(self.success_interval[1]),
+            "wall_s": round(sum(r.wall_s for r in self.runs), 2), "final_rate": "champions passing",
+            "final_k": self.passed, "final_n": self.seeds, "final_lo": _round(self.pass_interval[0]),
+            "final_hi": _round(self.pass_interval[1]),
+        })
+        return buf.getvalue()
+
+    def write(self, out: Path, info: dict[str, Any] | None = None) -> list[Path]:
+        """Writes ``summary.csv`` and ``summary.json`` (with ``info``, e.g. the preset, first)
+        into ``out``; returns their paths."""
+        paths = [out / "summary.csv", out / "summary.json"]
+        write_atomic(paths[0], self.csv_text())
+        write_atomic(paths[1], json.dumps({**(info or {}), **self.to_dict()}, indent=1) + "\n")
+        return paths
+
+
+def _round(x: float) -> float:
+    return round(x, 6)
+
+
+def _generation(x: float) -> str | int:
+    return int(x) if math.isfinite(x) else "not reached"
+
+
+def summarize(runs: Sequence[SeedResult]) -> Summary:
+    """The sweep's statistics over ``runs`` (at least one)."""
+    if not runs:
+        raise InvalidArgumentError("a sweep summary needs at least one run")
+    succeeded = sum(r.first_success is not None for r in runs)
+    verdicts: dict[Verdict, int] = {"pass": 0, "fail": 0, "undecided": 0}
+    for r in runs:
+        verdicts[r.final.verdict] += 1
+    n = len(runs)
+    return Summary(
+        runs=list(runs), succeeded=succeeded, success_interval=stats.wilson(succeeded, n),
+        first_success=stats.bootstrap_median([r.censored_at for r in runs]),
+        passed=verdicts["pass"], pass_interval=stats.wilson(verdicts["pass"], n), verdicts=verdicts,
+    )

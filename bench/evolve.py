@@ -17,6 +17,11 @@
   generations each. Both runs start from the same seed; their per-generation mean fitness is
   compared as a check that the callable computes the same fitness.
 
+(c) What validated champions cost: for each task, the wall time per generation of a run with the
+  default validation_candidates (10) against the same run with validation_candidates = 0
+  (evolution is bit-identical, so the difference is the validation and the success checks of the
+  champions it picks), runs interleaved, medians of --validation-repeats.
+
     python bench/evolve.py [--generations 40] [--py-generations 3] [--repeats 30] [--quick]
 """
 
@@ -151,6 +156,30 @@ def part_b(cfg, args):
     return dict(py=py, rust=rust, t_py=t_py, t_rust=t_rust)
 
 
+# (preset, overrides, generations): a generation of each task at its paper size.
+VALIDATION_RUNS = (
+    ("sequence-1bit", [], 20),
+    ("nav1d-classifier", [], 10),
+    ("landmark", ["elitism=5"], 60),
+)
+
+
+def part_c(args):
+    rows = []
+    for preset, overrides, generations in VALIDATION_RUNS:
+        generations = max(2, generations // 4) if args.quick else generations
+        cfg = dnnevo.presets.get(preset, overrides=[*overrides, f"generations={generations}"])
+        off = dataclasses.replace(cfg, validation_candidates=0)
+        times = {"on": [], "off": []}
+        for _ in range(args.validation_repeats):
+            for key, c in (("on", cfg), ("off", off)):
+                result = dnnevo.evolve(cfg.task, c, seed=0, progress=False)
+                times[key].append(float(result.history["elapsed_s"][-1]) / generations)
+        rows.append((preset, cfg.validation_candidates, statistics.median(times["on"]),
+                     statistics.median(times["off"])))
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--generations", type=int, default=40,
@@ -163,6 +192,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out-dir", default=None,
                     help="where the timed run folder of (a) is made (default: the system's "
                          "temporary folder); fsync costs depend on the disk")
+    ap.add_argument("--validation-repeats", type=int, default=3,
+                    help="interleaved runs with and without validation in (c) (default 3)")
     ap.add_argument("--quick", action="store_true", help="fewer generations and repeats")
     args = ap.parse_args(argv)
     args.eval_repeats = 7
@@ -171,8 +202,9 @@ def main(argv=None) -> int:
         args.py_generations = min(args.py_generations, 2)
         args.repeats = min(args.repeats, 10)
         args.eval_repeats = 3
-    if min(args.generations, args.py_generations, args.repeats) < 1:
-        ap.error("--generations, --py-generations and --repeats must be >= 1")
+        args.validation_repeats = 1
+    if min(args.generations, args.py_generations, args.repeats, args.validation_repeats) < 1:
+        ap.error("--generations, --py-generations, --repeats and --validation-repeats must be >= 1")
 
     cfg = dnnevo.presets.get("sequence-1bit")
     describe_machine()
@@ -230,6 +262,16 @@ def main(argv=None) -> int:
     ok = diff <= 1e-9
     print(f"same fitness: per-generation mean fitness of the two runs differs by at most "
           f"{diff:.1e}: {'OK' if ok else 'DIFFERENT'}")
+
+    print()
+    print(f"(c) validated champions: wall time per generation (medians of "
+          f"{args.validation_repeats} interleaved runs each)")
+    header = (f"{'preset':<18}  {'candidates':>10}  {'with ms/gen':>11}  {'without ms/gen':>14}  "
+              f"{'overhead':>8}")
+    print(header)
+    print("-" * len(header))
+    for preset, k, on, off in part_c(args):
+        print(f"{preset:<18}  {k:>10}  {on * 1e3:>11.1f}  {off * 1e3:>14.1f}  {on / off - 1:>8.1%}")
     print(f"total benchmark time: {time.perf_counter() - start:.1f} s")
     return 0 if ok else 1
 

@@ -8,23 +8,35 @@ The world: a point agent on the line [-H, H] (``half_length``). A condition is `
 goal, start, landmark)``; the landmark sensor (input 0) reads 1 while ``|x - landmark| <=
 landmark_width / 2``. A network with two sensors also gets the reinforcement as input 1.
 
+The world is updated once per *tick*. In the continuous world (``world = "continuous"``, the
+default) a tick is one forward-Euler step of ``dt``, ``substeps`` of them to a time step: the
+agent's ``dx/dt = f(v_R - theta_R) - f(v_L - theta_L)`` is integrated with the network. In the
+stepped world (``world = "stepped"``) a tick is a whole time step of ``substeps`` Euler steps with
+the inputs held, and the agent moves once at its end.
+
 One trial, from ``x = start`` and the state left by the previous trial (0 for the first one unless
 a ``state`` is given):
 
-1. moving: each time step reads the inputs at the current ``x`` (landmark; reinforcement 0),
-   integrates the network for one time step, then moves
-   ``x += dt * substeps * (f(v_R - theta_R) - f(v_L - theta_L))`` with the rates after the step.
-   The trial's moving phase ends when ``x >= H`` (the right end), ``x <= -H`` (the left end) or
-   after ``max_steps`` time steps. The goal is reached iff the end reached is the goal's side;
+1. moving: each tick reads the inputs at the current ``x`` (landmark; reinforcement 0),
+   integrates the network for the tick, then moves
+   ``x += tick_time * (f(v_R - theta_R) - f(v_L - theta_L))`` with the rates after the tick
+   (``tick_time`` is ``dt``, or ``dt * substeps`` in the stepped world). The trial's moving phase
+   ends when ``x >= H`` (the right end), ``x <= -H`` (the left end) or after ``max_steps`` time
+   steps. The goal is reached iff the end reached is the goal's side;
 2. reinforcement: ``reinforcement_steps`` more time steps with landmark input 0 and reinforcement
    1 if the goal was reached, else 0; ``x`` stays where it is. The classifier's rate
    ``f(v_C - theta_C)`` at the end is the trial's classification.
 
-One time step holds the inputs for ``substeps`` forward-Euler steps of ``dt``::
+One Euler step, with the tick's inputs ``I`` held::
 
     v <- v + dt / tau * (-v + W f(v - theta) + S I),        f(x) = 1 / (1 + exp(-x))
 
 with ``W[i, j]`` the weight from neuron j to neuron i and ``S[i, k]`` from sensor k to neuron i.
+
+The chain is logged once per time step of each phase, counted from the phase's start: after every
+``substeps``-th tick of the moving phase and of the reinforcement period, and after the moving
+phase's last tick, which may end a partial time step. Each entry holds ``x`` and the rates after
+its last tick, and the mean of its ticks' landmark inputs.
 """
 
 from __future__ import annotations
@@ -66,9 +78,11 @@ def run_chain(params, tau, theta, weights, sensor_weights, conditions, state=Non
     ``landmark``.
 
     Returns a dict of ``x``, ``landmark``, ``reinforcement`` (T,), ``outputs`` (T, N): the
-    position, the inputs the network got (the reinforcement is 0 throughout for M = 1) and the
-    firing rates of every time step of the chain (position and rates after the step); ``trial`` (T,) the trial of each step; ``moving`` (T,) whether the step was in a
-    moving phase; ``reached`` and ``classification`` per trial; ``final_state`` (N,).
+    position, the inputs the network got (the landmark input as the fraction of the time step's
+    ticks that read 1; the reinforcement is 0 throughout for M = 1) and the firing rates of every
+    logged time step of the chain (position and rates after the step); ``trial`` (T,) the trial
+    of each step; ``moving`` (T,) whether the step was in a moving phase; ``reached`` and
+    ``classification`` per trial; ``final_state`` (N,).
     """
     p = {**DEFAULTS, **params}
     integrator = params.get("integrator", {})
@@ -76,6 +90,14 @@ def run_chain(params, tau, theta, weights, sensor_weights, conditions, state=Non
         raise ValueError("the reference integrates with forward Euler only")
     dt = float(integrator.get("dt", 0.1))
     substeps = int(integrator.get("substeps", 10))
+    world = params.get("world", "continuous")
+    if world == "continuous":
+        euler_per_tick, ticks_per_step = 1, substeps
+    elif world == "stepped":
+        euler_per_tick, ticks_per_step = substeps, 1
+    else:
+        raise ValueError(f"world {world!r}; expected 'continuous' or 'stepped'")
+    tick_time = dt * euler_per_tick
     h = float(p["half_length"])
     half_width = float(p["landmark_width"]) / 2.0
     left, right, classifier = int(p["left_motor"]), int(p["right_motor"]), int(p["classifier"])
@@ -92,10 +114,10 @@ def run_chain(params, tau, theta, weights, sensor_weights, conditions, state=Non
     out = {"x": [], "landmark": [], "reinforcement": [], "outputs": [], "trial": [],
            "moving": [], "reached": [], "classification": []}
 
-    def time_step(landmark_input, reinforcement_input):
+    def tick(landmark_input, reinforcement_input):
         nonlocal v
         inputs = np.array([landmark_input, reinforcement_input][:m])
-        for _ in range(substeps):
+        for _ in range(euler_per_tick):
             v = v + dt / tau * (-v + w @ rate(v - theta) + s @ inputs)
         return rate(v - theta)
 
@@ -112,22 +134,27 @@ def run_chain(params, tau, theta, weights, sensor_weights, conditions, state=Non
         landmark = float(_field(condition, "landmark"))
         goal = _field(condition, "goal")
         end = None
-        steps = 0
-        while end is None and steps < int(p["max_steps"]):
+        ticks = 0
+        sensed_in_step = []  # the landmark inputs of the time step's ticks so far
+        while end is None and ticks < int(p["max_steps"]) * ticks_per_step:
             sensed = 1.0 if abs(x - landmark) <= half_width else 0.0
-            rates = time_step(sensed, 0.0)
-            x = x + dt * substeps * (rates[right] - rates[left])
-            steps += 1
+            rates = tick(sensed, 0.0)
+            x = x + tick_time * (rates[right] - rates[left])
+            ticks += 1
             if x >= h:
                 end = "right"
             elif x <= -h:
                 end = "left"
-            log(k, x, sensed, 0.0, rates, True)
+            sensed_in_step.append(sensed)
+            if ticks % ticks_per_step == 0 or end is not None:
+                log(k, x, sum(sensed_in_step) / len(sensed_in_step), 0.0, rates, True)
+                sensed_in_step = []
         reached = end == goal
         r = 1.0 if reached else 0.0
-        for _ in range(int(p["reinforcement_steps"])):
-            rates = time_step(0.0, r)
-            log(k, x, 0.0, r if m == 2 else 0.0, rates, False)
+        for i in range(int(p["reinforcement_steps"]) * ticks_per_step):
+            rates = tick(0.0, r)
+            if (i + 1) % ticks_per_step == 0:
+                log(k, x, 0.0, r if m == 2 else 0.0, rates, False)
         out["reached"].append(reached)
         out["classification"].append(float(rate(v[classifier] - theta[classifier])))
 

@@ -38,6 +38,13 @@ PRESETS = ["nav1d-far", "nav1d-near", "nav1d-classifier"]
 JITTER = ["task_params.start_jitter=1.5", "task_params.landmark_jitter=2.0"]
 SHORT = ["task_params.max_steps=200"]
 """Random networks mostly wander: 200 time steps per trial keep the reference quick."""
+WORLDS = ["continuous", "stepped"]
+"""The agent moves at every Euler step (the default) or once per time step."""
+
+
+def in_world(world):
+    """The override that picks ``world``."""
+    return f'task_params.world="{world}"'
 
 
 def config(name, *overrides):
@@ -109,9 +116,10 @@ def check_chain(cfg, net, conditions, *, reset=True):
 # -- recorded chains against the reference ----------------------------------------------------
 
 
+@pytest.mark.parametrize("world", WORLDS)
 @pytest.mark.parametrize("name", PRESETS)
-def test_random_networks_match_reference(name):
-    cfg = config(name, *SHORT)
+def test_random_networks_match_reference(name, world):
+    cfg = config(name, *SHORT, in_world(world))
     conditions = nav1d.cases(cfg)  # a chain of four trials, A to D, without a reset
     reached = []
     for seed in range(5):
@@ -123,9 +131,10 @@ def test_random_networks_match_reference(name):
     assert any(reached) and not all(reached)
 
 
+@pytest.mark.parametrize("world", WORLDS)
 @pytest.mark.parametrize("name", PRESETS)
-def test_hand_built_networks_match_reference(name):
-    cfg = config(name)  # the full 1000 time steps: standing still never ends a trial
+def test_hand_built_networks_match_reference(name, world):
+    cfg = config(name, in_world(world))  # the full 1000 time steps: standing still never ends a trial
     nets = [always_right(cfg.n_inputs), always_left(cfg.n_inputs), standing_still(cfg.n_inputs)]
     if cfg.n_inputs == 2:
         nets.append(landmark_and_reward())
@@ -135,10 +144,10 @@ def test_hand_built_networks_match_reference(name):
 
 # No shrinking: each example runs the reference, and a failing one is small enough as it is.
 @settings(max_examples=8, deadline=None, phases=[Phase.explicit, Phase.reuse, Phase.generate])
-@given(name=st.sampled_from(["nav1d-far", "nav1d-classifier"]),
+@given(name=st.sampled_from(["nav1d-far", "nav1d-classifier"]), world=st.sampled_from(WORLDS),
        net_seed=st.integers(0, 2**32 - 1), chain_seed=st.integers(0, 2**32 - 1))
-def test_jittered_chains_match_reference(name, net_seed, chain_seed):
-    cfg = config(name, *SHORT, *JITTER)
+def test_jittered_chains_match_reference(name, world, net_seed, chain_seed):
+    cfg = config(name, *SHORT, *JITTER, in_world(world))
     (chain,) = nav1d.fresh_chains(cfg, 1, 3, chain_seed)
     assert len(chain) == 3
     assert len({(c.start, c.landmark) for c in chain}) == 3, "jitter should move every trial"
@@ -149,14 +158,15 @@ def test_jittered_chains_match_reference(name, net_seed, chain_seed):
         check_chain(cfg, landmark_and_reward(), chain)
 
 
-def test_other_settings_match_reference():
+@pytest.mark.parametrize("world", WORLDS)
+def test_other_settings_match_reference(world):
     """Other motor and classifier neurons, geometry, timing and integrator."""
     settings_ = ["task_params.left_motor=3", "task_params.right_motor=0", "task_params.classifier=4",
                  "task_params.half_length=12.0", "task_params.landmark_offset=5.0",
                  "task_params.landmark_width=3.0", "task_params.start=1.0",
                  "task_params.max_steps=120", "task_params.reinforcement_steps=7",
                  "integrator.dt=0.05", "integrator.substeps=12", "size=6"]  # time step 0.6
-    cfg = config("nav1d-classifier", *settings_)
+    cfg = config("nav1d-classifier", *settings_, in_world(world))
     assert [c.start for c in nav1d.cases(cfg)] == [1.0] * 4
     assert {abs(c.landmark) for c in nav1d.cases(cfg)} == {5.0}
     reached, sensed = [], 0.0
@@ -201,10 +211,11 @@ def test_a_chain_carries_the_state_from_trial_to_trial():
     assert not np.allclose(alone.outputs[0], second.outputs[0]), "the state should matter"
 
 
+@pytest.mark.parametrize("world", WORLDS)
 @pytest.mark.parametrize("start, seen", [(12.0, 1.0), (8.0, 1.0), (12.000001, 0.0), (7.999999, 0.0)])
-def test_landmark_sensor_includes_its_edges(start, seen):
+def test_landmark_sensor_includes_its_edges(start, seen, world):
     """The landmark (centre 10, width 4) covers [8, 12], both ends included."""
-    cfg = config("nav1d-far", "task_params.max_steps=5")
+    cfg = config("nav1d-far", "task_params.max_steps=5", in_world(world))
     condition = nav1d.Condition("far", "left", start, 10.0)
     rec = check_chain(cfg, standing_still(1), [condition])
     np.testing.assert_array_equal(rec.x, start)
@@ -214,9 +225,9 @@ def test_landmark_sensor_includes_its_edges(start, seen):
 
 @pytest.mark.parametrize("name", PRESETS)
 def test_the_ends_are_inclusive(name):
-    """Rates of exactly 1 and (nearly) 0 move exactly 1 per time step: from 0 the agent is at
-    +-20.0 after 20 time steps, and that ends the trial."""
-    cfg = config(name)
+    """Rates of exactly 1 and (nearly) 0 move exactly 1 per time step in the stepped world: from 0
+    the agent is at +-20.0 after 20 time steps, and that ends the trial."""
+    cfg = config(name, in_world("stepped"))
     for theta, goal in (([800.0, -40.0], "right"), ([-40.0, 800.0], "left")):
         net = hand_built(theta, cfg.n_inputs)
         cases = [c for c in nav1d.cases(cfg) if c.goal == goal]
@@ -225,6 +236,14 @@ def test_the_ends_are_inclusive(name):
         for k in range(2):
             x = rec.x[(rec.trial == k) & rec.moving]
             np.testing.assert_array_equal(np.abs(x), np.arange(1.0, 21.0))
+        # In the continuous world it moves 0.1 per Euler step and reaches the end after 200 of
+        # them (the sum of 200 steps of 0.1 lands just past 20): again 20 time steps.
+        rec = check_chain(config(name), net, cases)
+        assert rec.reached == [True, True]
+        for k in range(2):
+            x = rec.x[(rec.trial == k) & rec.moving]
+            np.testing.assert_allclose(np.abs(x), np.arange(1.0, 21.0), rtol=0, atol=1e-12)
+            assert abs(x[-1]) >= 20.0
 
 
 # -- the hand-built networks -------------------------------------------------------------------
@@ -269,6 +288,50 @@ def test_hand_built_classifier_uses_landmark_and_reinforcement():
     assert chain.classification[1] > 0.9 > 0.1 > f[1]
 
 
+# -- the continuous world at a finer dt --------------------------------------------------------
+
+
+def outcomes(cfg, net, conditions):
+    """Per trial, each alone: whether the goal was reached and whether f(v_C) >= 0.5."""
+    out = []
+    for c in conditions:
+        rec = nav1d.record(cfg, net, [c])
+        out.append((rec.reached[0], bool(rec.classification[0] >= 0.5)))
+    return out
+
+
+@pytest.mark.parametrize("name, settings_", [
+    ("nav1d-far", ["population=100", "generations=4"]),
+    ("nav1d-classifier", ["population=200", "generations=15"]),
+])
+def test_evolved_champions_keep_their_outcomes_at_a_finer_dt(name, settings_):
+    """A champion evolved at dt = 0.1 does the same at dt = 0.01 (100 Euler steps per time step):
+    in the continuous world its success is not an artefact of the step."""
+    cfg = config(name, *settings_)
+    result = dnnevo.evolve("nav1d", cfg, seed=0, progress=False, threads=1)
+    net = result.best
+    assert nav1d.assess(cfg, net, 100, seed=1)["success"], "the champion should succeed"
+    fine = config(name, *settings_, "integrator.dt=0.01", "integrator.substeps=100")
+    conditions = nav1d.cases(cfg) + [
+        chain[0] for chain in nav1d.fresh_chains(config(name, *JITTER), 12, 1, seed=3)]
+    coarse = outcomes(cfg, net, conditions)
+    assert outcomes(fine, net, conditions) == coarse
+    # The champion does its job in the exact cases A-D (it was evolved without jitter).
+    if name == "nav1d-far":
+        assert [reached for reached, _ in coarse[:2]] == [True, True]
+    else:
+        assert [near for _, near in coarse[:4]] == [False, False, True, True]
+
+
+def test_an_unknown_world_is_a_config_error(tmp_path):
+    cfg = config("nav1d-far", 'task_params.world="smooth"')
+    with pytest.raises(ConfigError, match="unknown variant `smooth`, expected `continuous` or `stepped`"):
+        nav1d.cases(cfg)
+    r = run_cli("run", "nav1d-far", "--quick", "--set", 'task_params.world="smooth"',
+                "--out", tmp_path / "smooth")
+    assert_one_line_error(r, "smooth")
+
+
 # -- fitness, assessment, integrated system ----------------------------------------------------
 
 
@@ -284,10 +347,11 @@ def reference_fitness(cfg, nets, generation, seed):
     return np.array(out)
 
 
+@pytest.mark.parametrize("world", WORLDS)
 @pytest.mark.parametrize("name", PRESETS)
 @pytest.mark.parametrize("generation, seed, jitter", [(0, 0, False), (3, 11, True)])
-def test_evaluate_matches_reference(name, generation, seed, jitter):
-    cfg = config(name, "task_params.max_steps=150", *(JITTER if jitter else []))
+def test_evaluate_matches_reference(name, generation, seed, jitter, world):
+    cfg = config(name, "task_params.max_steps=150", *(JITTER if jitter else []), in_world(world))
     m = cfg.n_inputs
     nets = [dnnevo.Network.random(5, m, seed=300 + s) for s in range(7)]
     nets += [always_right(m), always_left(m), standing_still(m)]

@@ -1,10 +1,13 @@
 """One-dimensional navigation (paper §4): trial conditions, recorded chains of trials, the
 success assessment, and the integrated system of §4.2, for networks evolved on the ``nav1d`` task.
 
-The world (see ``crates/tasks/src/nav1d/world.rs``): a point agent on [-20, 20] starts at 0 and
-moves at ``f(v_R) - f(v_L)``; the goal is at one end; a landmark of width 4 is centred at ±10, on
-the goal's side (landmark-near) or the other side (landmark-far). A trial ends at either end or
-after 1000 time steps, and 50 time steps of reinforcement (1 if the goal was reached) follow.
+The world (see ``crates/tasks/src/nav1d/world.rs`` and ``docs/nav1d.md``): a point agent on
+[-20, 20] starts at 0 and moves at ``dx/dt = f(v_R) - f(v_L)``; the goal is at one end; a landmark
+of width 4 is centred at ±10, on the goal's side (landmark-near) or the other side
+(landmark-far). A trial ends at either end or after 1000 time steps, and 50 time steps of
+reinforcement (1 if the goal was reached) follow. The agent moves and its sensors are read at
+every Euler step of the network (``task_params.world = "continuous"``, the default), or once per
+time step (``"stepped"``, dnnevo's world before; kept for comparison).
 
 Success rule: on fresh conditions, at least 95% of the scored trials are done right (the goal
 reached, or the environment classified right: ``f(v_C) >= 0.5`` means landmark-near).
@@ -65,7 +68,13 @@ class Condition:
 
 @dataclass(frozen=True)
 class Record:
-    """A chain of trials, time step by time step (arrays of length T; ``outputs`` is (T, N))."""
+    """A chain of trials, time step by time step (arrays of length T; ``outputs`` is (T, N)).
+
+    Time steps are counted from the start of each trial's moving phase and of its reinforcement
+    period; a moving phase that ends inside a time step ends with that partial time step. ``x``
+    and ``outputs`` are taken at the end of each time step, ``landmark`` is the fraction of its
+    Euler steps on the landmark (0 or 1 in the stepped world). Outcomes (``reached``,
+    ``classification``) come from every Euler step, not from these samples."""
 
     conditions: list[Condition]
     x: npt.NDArray[np.float64]

@@ -144,8 +144,14 @@ struct Scratch<const L: usize> {
     h6: Rows<L>,
     /// Sensor drive S I of the current row.
     ext: Rows<L>,
+    /// Whether `ext` is the sensor drive of the last [`Lanes::step_row`], for
+    /// [`Lanes::step_held`].
+    held: bool,
     /// Firing rates.
     out: Rows<L>,
+    /// Whether `out` holds the firing rates of the current state, computed by
+    /// [`Lanes::outputs`]; the next step then starts from them instead of computing them again.
+    fresh: bool,
     /// RK4's first three slopes (the fourth is used as soon as it is known).
     k: [Rows<L>; 3],
     probe: Rows<L>,
@@ -196,7 +202,9 @@ impl<const L: usize> Lanes<L> {
                 h2: zeros(n),
                 h6: zeros(n),
                 ext: zeros(n),
+                held: false,
                 out: zeros(n),
+                fresh: false,
                 k: [zeros(n), zeros(n), zeros(n)],
                 probe: zeros(n),
             },
@@ -228,12 +236,48 @@ impl<const L: usize> Lanes<L> {
     pub fn output(&self, i: usize) -> [f64; L] {
         std::array::from_fn(|l| sigmoid(self.state[i][l] - self.theta[i][l]))
     }
+    /// Every neuron's firing rate in every lane, `outputs()[i][l] = f(v_i - theta_i)`, with the
+    /// same bits as [`output`](Self::output). Computed once per state, in the lane vectors of a
+    /// step; the next step starts from these rates instead of computing them again, so reading
+    /// them after every step costs nothing.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Integrator, Lanes, Network};
+    /// let net = Network::new(vec![1.0], vec![0.5], vec![0.0], vec![1.0], None).unwrap();
+    /// let mut lanes = Lanes::<1>::new(&[&net]).unwrap();
+    /// lanes.step_row(&[[1.0]], &Integrator::default());
+    /// let one = lanes.output(0);
+    /// assert_eq!(lanes.outputs()[0], one);
+    /// ```
+    pub fn outputs(&mut self) -> &[[f64; L]] {
+        if !self.scratch.fresh {
+            self.compute_outputs();
+            self.scratch.fresh = true;
+        }
+        &self.scratch.out
+    }
+
+    fn compute_outputs(&mut self) {
+        with_backend!(self.compute_outputs_with())
+    }
+
+    fn compute_outputs_with<V: Vector>(&mut self) {
+        rates::<V>(
+            V::rows(self.theta.as_flattened()),
+            V::rows(self.state.as_flattened()),
+            V::rows_mut(self.scratch.out.as_flattened_mut()),
+        );
+    }
+
     /// Sets every lane's state to zero.
     pub fn reset(&mut self) {
+        self.scratch.fresh = false;
         self.state.fill([0.0; L]);
     }
     /// Sets the state of lane `l` (length N).
     pub fn set_lane_state(&mut self, l: usize, state: &[f64]) {
+        self.scratch.fresh = false;
         for (row, &v) in self.state.iter_mut().zip(state) {
             row[l] = v;
         }
@@ -276,12 +320,52 @@ impl<const L: usize> Lanes<L> {
 
     #[inline(always)]
     fn step_row_with<V: Vector>(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
+        let fresh = std::mem::take(&mut self.scratch.fresh);
+        self.scratch.held = true;
         let (mut work, state) = self.work::<V>();
         work.step(
             V::rows_mut(state.as_flattened_mut()),
             V::rows(inputs.as_flattened()),
             integ,
+            fresh,
         );
+    }
+
+    /// [`step_row`](Self::step_row) with the inputs of the last `step_row` call, held: the same
+    /// bits, without computing their sensor drive again. A world that moves one integration step
+    /// at a time mostly holds its inputs.
+    ///
+    /// # Panics
+    /// If `step_row` has not been called on these lanes, or [`run_rows`](Self::run_rows) has
+    /// been called since.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Integrator, Lanes, Network};
+    /// let net = Network::new(vec![1.0], vec![0.5], vec![0.0], vec![1.0], None).unwrap();
+    /// let (mut a, integ) = (Lanes::<1>::new(&[&net]).unwrap(), Integrator::default());
+    /// let mut b = a.clone();
+    /// a.step_row(&[[1.0]], &integ);
+    /// a.step_row(&[[1.0]], &integ);
+    /// b.step_row(&[[1.0]], &integ);
+    /// b.step_held(&integ);
+    /// assert_eq!(a.state(0), b.state(0));
+    /// ```
+    #[inline(always)]
+    pub fn step_held(&mut self, integ: &Integrator) {
+        assert!(
+            self.scratch.held,
+            "step_held needs a step_row before it, with no run_rows in between"
+        );
+        self.prepare(integ.dt);
+        with_backend!(self.step_held_with(integ))
+    }
+
+    #[inline(always)]
+    fn step_held_with<V: Vector>(&mut self, integ: &Integrator) {
+        let fresh = std::mem::take(&mut self.scratch.fresh);
+        let (mut work, state) = self.work::<V>();
+        work.integrate(V::rows_mut(state.as_flattened_mut()), integ, fresh);
     }
 
     /// Runs `steps` input rows. `row(t, inputs)` fills the sensors of row `t`; after each row
@@ -312,6 +396,8 @@ impl<const L: usize> Lanes<L> {
         let mut inputs = Rows::<L>::zeros(self.n_inputs);
         // The row views are taken once: taken row by row, they cost 10% at N = 5.
         let inputs: &mut [[f64; L]] = &mut inputs;
+        let mut fresh = std::mem::take(&mut self.scratch.fresh);
+        self.scratch.held = false;
         let (mut work, state) = self.work::<V>();
         for t in 0..steps {
             if t % CANCEL_CHECK_ROWS == 0 && cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
@@ -319,7 +405,8 @@ impl<const L: usize> Lanes<L> {
             }
             row(t, inputs);
             let v = V::rows_mut(state.as_flattened_mut());
-            work.step(v, V::rows(inputs.as_flattened()), integ);
+            work.step(v, V::rows(inputs.as_flattened()), integ, fresh);
+            fresh = false;
             record(t, state);
         }
         Ok(())
@@ -392,32 +479,44 @@ struct Work<'a, V: Vector> {
 }
 
 impl<V: Vector> Work<'_, V> {
-    /// Holds `inputs` for `integ.substeps` steps of the state `v`.
+    /// Holds `inputs` for `integ.substeps` steps of the state `v`. With `fresh`, `out` already
+    /// holds the firing rates of `v` and the first step starts from them.
     #[inline(always)]
-    fn step(&mut self, v: &mut [V::Row], inputs: &[V::Row], integ: &Integrator) {
+    fn step(&mut self, v: &mut [V::Row], inputs: &[V::Row], integ: &Integrator, fresh: bool) {
         sensor_drive::<V>(self.sensor_weights, inputs, self.ext);
-        for _ in 0..integ.substeps {
+        self.integrate(v, integ, fresh);
+    }
+
+    /// `integ.substeps` steps of the state `v` with the sensor drive in `ext`; `fresh` as for
+    /// [`step`](Self::step).
+    #[inline(always)]
+    fn integrate(&mut self, v: &mut [V::Row], integ: &Integrator, fresh: bool) {
+        for s in 0..integ.substeps {
+            let fresh = fresh && s == 0;
             match integ.method {
-                Method::Euler => self.euler_step(v),
-                Method::Rk4 => self.rk4_step(v),
+                Method::Euler => self.euler_step(v, fresh),
+                Method::Rk4 => self.rk4_step(v, fresh),
             }
         }
     }
 
-    /// One Euler step: `v += h * (ext + W f(v - theta) - v)`.
+    /// One Euler step: `v += h * (ext + W f(v - theta) - v)`; with `fresh`, `out` already holds
+    /// `f(v - theta)`.
     #[inline(always)]
-    fn euler_step(&mut self, v: &mut [V::Row]) {
+    fn euler_step(&mut self, v: &mut [V::Row], fresh: bool) {
         let h = self.h;
-        rates::<V>(self.theta, v, self.out);
+        if !fresh {
+            rates::<V>(self.theta, v, self.out);
+        }
         drive::<V>(self.weights, self.ext, self.out, |i, acc| {
             let x = V::load(&v[i]);
             V::load(&h[i]).mul_add(acc - x, x).store(&mut v[i]);
         });
     }
 
-    /// One classical RK4 step.
+    /// One classical RK4 step; with `fresh`, `out` already holds `f(v - theta)`.
     #[inline(always)]
-    fn rk4_step(&mut self, v: &mut [V::Row]) {
+    fn rk4_step(&mut self, v: &mut [V::Row], fresh: bool) {
         let Work {
             theta,
             weights,
@@ -432,7 +531,9 @@ impl<V: Vector> Work<'_, V> {
         } = self;
         let (weights, ext) = (*weights, &**ext);
         // Slope 1 at v; the next probe is v + h/2 k1.
-        rates::<V>(theta, v, out);
+        if !fresh {
+            rates::<V>(theta, v, out);
+        }
         drive::<V>(weights, ext, out, |i, acc| {
             let x = V::load(&v[i]);
             let d = acc - x;
@@ -774,7 +875,6 @@ mod tests {
     }
 
     /// Random networks of one shape, from a fixed seed.
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
     fn random_networks(count: usize, n: usize, m: usize, seed: u64) -> Vec<Network> {
         use crate::rng::{Purpose, Stream};
         let mut rng = Stream::new(seed, 0, Purpose::Init, 0, 0);
@@ -842,6 +942,101 @@ mod tests {
     fn avx512_blocks_match_the_portable_kernel_bit_for_bit() {
         backends_agree::<Avx512, [f64; 8], 8>();
         backends_agree::<Group<Avx512, 2>, [[f64; 8]; 2], 16>();
+    }
+
+    #[test]
+    fn reading_the_outputs_between_steps_changes_nothing() {
+        let nets = random_networks(LANES, 5, 2, 3);
+        let refs: Vec<&Network> = nets.iter().collect();
+        for method in [Method::Euler, Method::Rk4] {
+            let integ = Integrator {
+                method,
+                dt: 0.1,
+                substeps: 3,
+            };
+            let mut plain = Lanes::<LANES>::new(&refs).unwrap();
+            let mut read = plain.clone();
+            let same = |a: &Lanes<LANES>, b: &Lanes<LANES>| {
+                (0..5).all(|i| {
+                    let (x, y) = (a.state(i), b.state(i));
+                    x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+                })
+            };
+            for t in 0..30 {
+                // Rates read after row 9 and row 19 must not survive the reset and the new state.
+                if t == 10 {
+                    plain.reset();
+                    read.reset();
+                }
+                if t == 20 {
+                    plain.set_lane_state(3, &[1.0; 5]);
+                    read.set_lane_state(3, &[1.0; 5]);
+                }
+                let inputs = [[(t % 3) as f64; LANES], [1.0 - (t % 2) as f64; LANES]];
+                plain.step_row(&inputs, &integ);
+                read.step_row(&inputs, &integ);
+                assert!(same(&plain, &read), "{method:?}, row {t}");
+                if t % 4 != 2 {
+                    let out: Vec<[f64; LANES]> = read.outputs().to_vec();
+                    for (i, row) in out.iter().enumerate() {
+                        let want = read.output(i);
+                        assert!(row
+                            .iter()
+                            .zip(&want)
+                            .all(|(a, b)| a.to_bits() == b.to_bits()));
+                    }
+                }
+            }
+            let mut rows = read.clone();
+            let _ = rows.outputs();
+            let record = |_: usize, _: &[[f64; LANES]]| {};
+            rows.run_rows(5, &integ, None, |_, r| r[0][0] = 1.0, record)
+                .unwrap();
+            plain
+                .run_rows(5, &integ, None, |_, r| r[0][0] = 1.0, record)
+                .unwrap();
+            assert!(same(&plain, &rows), "{method:?}, run_rows");
+        }
+    }
+
+    #[test]
+    fn holding_the_inputs_is_stepping_them_again() {
+        let nets = random_networks(LANES, 5, 2, 4);
+        let refs: Vec<&Network> = nets.iter().collect();
+        for method in [Method::Euler, Method::Rk4] {
+            let integ = Integrator {
+                method,
+                dt: 0.1,
+                substeps: 2,
+            };
+            let mut again = Lanes::<LANES>::new(&refs).unwrap();
+            let mut held = again.clone();
+            for t in 0..12 {
+                let inputs = [[(t / 4) as f64; LANES], [0.5; LANES]];
+                again.step_row(&inputs, &integ);
+                if t % 4 == 0 {
+                    held.step_row(&inputs, &integ);
+                } else {
+                    held.step_held(&integ);
+                }
+                if t % 3 == 0 {
+                    let _ = held.outputs();
+                }
+            }
+            for i in 0..5 {
+                let (a, b) = (again.state(i), held.state(i));
+                assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()));
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "step_held needs a step_row before it")]
+    fn holding_needs_a_row() {
+        let net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+        Lanes::<1>::new(&[&net])
+            .unwrap()
+            .step_held(&Integrator::default());
     }
 
     #[test]

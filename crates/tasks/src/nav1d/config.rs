@@ -34,6 +34,32 @@ impl Objective {
     }
 }
 
+/// How often the world (the agent's position and what its sensors read) is updated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum World {
+    /// At every integration step of the network (default): the paper's `dx/dt = f(v_R) -
+    /// f(v_L)` is integrated together with the network, so that a finer `dt` gives the same
+    /// behaviour more accurately.
+    #[default]
+    Continuous,
+    /// Once per time step: the sensors are read and held for the time step's `substeps`
+    /// integration steps, then the agent moves `dt * substeps * (f(v_R) - f(v_L))` at once. This
+    /// was dnnevo's world before the continuous one; a behaviour that needs it is an artefact of
+    /// the coarse step.
+    Stepped,
+}
+
+impl World {
+    /// The name used in configs: `"continuous"` or `"stepped"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            World::Continuous => "continuous",
+            World::Stepped => "stepped",
+        }
+    }
+}
+
 /// The one-dimensional navigation settings. Every number of the world lives here.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -90,9 +116,13 @@ pub struct Nav1dConfig {
     pub start_jitter: f64,
     /// Half-width of a uniform random shift of the landmark's centre in each trial. Default 0.
     pub landmark_jitter: f64,
-    /// How one time step is integrated; the agent moves `dt * substeps * velocity` per time step.
-    /// Default 10 Euler steps of dt = 0.1.
+    /// How one time step is integrated: `substeps` steps of `dt` (one time step is `dt *
+    /// substeps` units of simulated time). Default 10 Euler steps of dt = 0.1.
     pub integrator: Integrator,
+    /// How often the agent moves and its sensors are read: `"continuous"` (default) at every
+    /// integration step, `"stepped"` once per time step (see [`World`]). Time limits and
+    /// reinforcement periods are in time steps either way.
+    pub world: World,
 }
 
 impl Default for Nav1dConfig {
@@ -122,6 +152,7 @@ impl Default for Nav1dConfig {
                 dt: 0.1,
                 substeps: 10,
             },
+            world: World::Continuous,
         }
     }
 }
@@ -230,7 +261,20 @@ impl Nav1dConfig {
         self.integrator.validate().map_err(|e| match e {
             Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
             other => other,
-        })
+        })?;
+        for (name, steps) in [
+            ("max_steps", self.max_steps),
+            ("reinforcement_steps", self.reinforcement_steps),
+        ] {
+            if steps.checked_mul(self.integrator.substeps).is_none() {
+                return config(format!(
+                    "{name} is {steps}; with {} substeps per time step that is more integration \
+                     steps than fit in a counter",
+                    self.integrator.substeps
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Sensors per network: 2 with the reinforcement input, else 1.
@@ -245,5 +289,21 @@ impl Nav1dConfig {
     /// Simulated time of one time step, `dt * substeps`.
     pub fn step_time(&self) -> f64 {
         self.integrator.dt * self.integrator.substeps as f64
+    }
+
+    /// What one update of the world integrates, and how many of them make a time step: one
+    /// step of `dt` and `substeps` per time step in the continuous world, one whole time step
+    /// in the stepped world.
+    pub fn tick(&self) -> (Integrator, usize) {
+        match self.world {
+            World::Continuous => (
+                Integrator {
+                    substeps: 1,
+                    ..self.integrator
+                },
+                self.integrator.substeps,
+            ),
+            World::Stepped => (self.integrator, 1),
+        }
     }
 }

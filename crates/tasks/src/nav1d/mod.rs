@@ -7,7 +7,9 @@
 //! of width `landmark_width` (default 4) centred at `landmark_offset` (default 10) from the
 //! centre: on the goal's side in a landmark-near environment, on the other side in a
 //! landmark-far one. Input 0 is the landmark sensor; input 1, if the network has it, is the
-//! reinforcement. See [`world`] for one time step and the end of a trial.
+//! reinforcement. By default the world is continuous: the agent moves and its sensors are read at
+//! every integration step of the network ([`World`]). See [`world`] for one update of the world
+//! and the end of a trial, and `docs/nav1d.md`.
 //!
 //! # What is scored
 //! [`Objective`] picks the experiment: the paper's goal-seeking networks (`goal`), its
@@ -38,7 +40,7 @@ mod system;
 mod task;
 pub mod world;
 
-pub use config::{Nav1dConfig, Objective};
+pub use config::{Nav1dConfig, Objective, World};
 pub use system::{Part, System, SystemAssessment, SystemEpisode};
 pub use task::{Assessment, Episode, Nav1dTask, Record, SUCCESS_CHAINS, SUCCESS_RATE};
 pub use world::{Condition, Environment, Side};

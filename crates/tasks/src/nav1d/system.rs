@@ -73,6 +73,14 @@ fn same_world(a: &Nav1dConfig, b: &Nav1dConfig, which: &str) -> Result<()> {
             )));
         }
     }
+    if a.world != b.world {
+        return Err(Error::Config(format!(
+            "the {which} network's world is {:?} but the classifier's is {:?}; the parts must \
+             share one world",
+            b.world.name(),
+            a.world.name()
+        )));
+    }
     Ok(())
 }
 

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::config::{Nav1dConfig, Objective};
-use super::world::{run_chains, Condition, Environment, Phase, Side};
+use super::world::{run_chains, Condition, Environment, Side};
 use crate::common::{check_inputs, config_from_params, interrupted};
 
 /// The fraction of scored trials a network must get right on fresh conditions to have solved its
@@ -57,13 +57,20 @@ pub struct Assessment {
 }
 
 /// One chain of one network, time step by time step (all of length T; `outputs` is T x N).
+///
+/// Time steps are counted from the start of each trial's moving phase and of its reinforcement
+/// period. The moving phase of the continuous world can end inside a time step; that partial time
+/// step is the phase's last entry, so a trial that moves for `s` time steps (a fraction counts as
+/// one) has `s + reinforcement_steps` entries. Outcomes come from every integration step, not
+/// from these samples.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Record {
     /// Each trial's world.
     pub conditions: Vec<Condition>,
     /// The agent's position after each time step.
     pub x: Vec<f64>,
-    /// The landmark input during each time step.
+    /// The landmark input during each time step: the fraction of its integration steps that
+    /// read 1 (in the stepped world, 0 or 1).
     pub landmark: Vec<f64>,
     /// The reinforcement input during each time step.
     pub reinforcement: Vec<f64>,
@@ -270,7 +277,7 @@ impl Nav1dTask {
                         block,
                         [chain.as_slice(); LANES],
                         true,
-                        |_, _, _, _| {},
+                        |_, _, _| {},
                     )
                     .map_err(|d| d.error(b * LANES))?;
                     for (t, condition) in chain.iter().enumerate() {
@@ -336,9 +343,8 @@ impl Nav1dTask {
                 let refs: [&Network; LANES] = std::array::from_fn(|l| nets[pick(l).0]);
                 let mut lanes = Lanes::<LANES>::new(&refs)?;
                 let lane_chains = std::array::from_fn(|l| chains[pick(l).1].as_slice());
-                let outcome =
-                    run_chains(&self.config, &mut lanes, lane_chains, true, |_, _, _, _| {})
-                        .map_err(|d| d.error(group[0].0))?;
+                let outcome = run_chains(&self.config, &mut lanes, lane_chains, true, |_, _, _| {})
+                    .map_err(|d| d.error(group[0].0))?;
                 Ok(group
                     .iter()
                     .enumerate()
@@ -445,20 +451,27 @@ impl Nav1dTask {
             classification: vec![],
             final_state: vec![0.0; n],
         };
+        // The landmark input summed over the ticks of the time step so far, and their count.
+        let (mut landmark, mut ticks) = (0.0, 0usize);
         let outcome = run_chains(
             &self.config,
             &mut lanes,
             [chain],
             reset,
-            |inputs, lanes, before, after| {
-                let (b, a) = (before[0], after[0]);
-                rec.x.push(if a.trial == b.trial { a.x } else { b.x });
-                rec.landmark.push(inputs[0][0]);
+            |inputs, outputs, lanes| {
+                let tick = lanes.get(0);
+                landmark += inputs[0][0];
+                ticks += 1;
+                if !tick.closes {
+                    return;
+                }
+                rec.x.push(tick.x);
+                rec.landmark.push(landmark / ticks as f64);
                 rec.reinforcement.push(inputs.get(1).map_or(0.0, |r| r[0]));
-                rec.outputs
-                    .push((0..n).map(|i| lanes.output(i)[0]).collect());
-                rec.trial.push(b.trial);
-                rec.moving.push(b.phase == Phase::Move);
+                rec.outputs.push(outputs.iter().map(|o| o[0]).collect());
+                rec.trial.push(tick.trial);
+                rec.moving.push(tick.moving);
+                (landmark, ticks) = (0.0, 0);
             },
         )
         .map_err(|d| d.error(0))?;

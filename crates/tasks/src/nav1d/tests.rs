@@ -165,14 +165,11 @@ fn the_rightward_network_reaches_exactly_the_goal_right_trials() {
 
 #[test]
 fn batched_evaluation_equals_the_record_and_ignores_threads() {
-    for objective in [Objective::Goal, Objective::Classify, Objective::Single] {
-        let t = task(Nav1dConfig {
-            objective,
-            landmark_jitter: 1.0,
-            start_jitter: 0.5,
-            trials_per_environment: 3,
-            ..Nav1dConfig::default()
-        });
+    let cases = [Objective::Goal, Objective::Classify, Objective::Single]
+        .into_iter()
+        .flat_map(|o| [World::Continuous, World::Stepped].map(|w| (o, w)));
+    for (objective, world) in cases {
+        let t = task(jittered(objective, world));
         let nets = random_networks(19, 5, 2, 11);
         let fitness = t.evaluate(&nets, 4, 9, None).unwrap();
         let chains = t.chains(9, 4);
@@ -190,7 +187,7 @@ fn batched_evaluation_equals_the_record_and_ignores_threads() {
             assert_eq!(
                 fitness[p].to_bits(),
                 (sum / count as f64).to_bits(),
-                "{objective:?} {p}"
+                "{objective:?} {world:?} {p}"
             );
         }
         let one = rayon::ThreadPoolBuilder::new()
@@ -350,6 +347,19 @@ fn the_system_picks_a_network_by_the_classification() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("far network's half_length is 30"), "{e}");
+    let stepped = Nav1dTask::new(Nav1dConfig {
+        world: World::Stepped,
+        ..Nav1dConfig::default()
+    })
+    .unwrap();
+    let e = System::new(
+        part(&classify, &says_near),
+        part(&goal, &leftward),
+        part(&stepped, &leftward),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("near network's world is \"stepped\""), "{e}");
     // Each part must have its role.
     let e = System::new(
         part(&goal, &says_near),
@@ -405,6 +415,15 @@ fn config_errors_name_the_field() {
             .contains("integrator")
     );
     assert!(err(json!({"landmarks": 1})).contains("unknown field `landmarks`"));
+    let e = err(json!({"world": "smooth"}));
+    assert!(
+        e.contains("unknown variant `smooth`, expected `continuous` or `stepped`"),
+        "{e}"
+    );
+    let e = err(
+        json!({"max_steps": usize::MAX / 2, "integrator": {"method": "euler", "dt": 0.1, "substeps": 10}}),
+    );
+    assert!(e.contains("max_steps is"), "{e}");
     // A goal task needs no classifier neuron; a 2-neuron network is enough.
     let t = Nav1dTask::from_params(&json!({"size": 2, "classifier": 9})).unwrap();
     assert_eq!(t.layout().size, 2);
@@ -480,4 +499,253 @@ fn chained_goal_trials_run_both_orders_without_reset() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("chained is true"), "{e}");
+}
+
+/// A config of `world`, with the given objective and jitter.
+fn jittered(objective: Objective, world: World) -> Nav1dConfig {
+    Nav1dConfig {
+        objective,
+        landmark_jitter: 1.0,
+        start_jitter: 0.5,
+        trials_per_environment: 3,
+        world,
+        ..Nav1dConfig::default()
+    }
+}
+
+#[test]
+fn the_stepped_world_reproduces_the_old_results_bit_for_bit() {
+    // Computed by dnnevo before the continuous world (commit 269d343), when every world was
+    // stepped: the classify fitness of 19 random networks, and a recorded chain of "single".
+    let fitness: [u64; 19] = [
+        0x3fdffffffea50b73,
+        0x3fdfffffdf25db00,
+        0x3fdffffffffffed0,
+        0x3fe0000000000000,
+        0x3fe0000000000000,
+        0x3fdfffffff71fb14,
+        0x3fe00000000070d8,
+        0x3fdfffffffff1fd7,
+        0x3fe00000140cd984,
+        0x3fe0000000000000,
+        0x3fe0000000000000,
+        0x3fe0000000bd6365,
+        0x3fdffff14a1e0012,
+        0x3fe330ce2d20d230,
+        0x3fdffffffffa4154,
+        0x3fe0000000000000,
+        0x3fdfffffffb3e296,
+        0x3fdffffffff82d28,
+        0x3fe000ac654c02f7,
+    ];
+    let nets = random_networks(19, 5, 2, 11);
+    let t = task(jittered(Objective::Classify, World::Stepped));
+    let got: Vec<u64> = t
+        .evaluate(&nets, 4, 9, None)
+        .unwrap()
+        .iter()
+        .map(|f| f.to_bits())
+        .collect();
+    assert_eq!(got, fitness);
+    let t = task(jittered(Objective::Single, World::Stepped));
+    let rec = t.record(&nets[3], &t.chains(9, 4)[0], true).unwrap();
+    assert_eq!(
+        (rec.x.len(), rec.reached.clone()),
+        (282, vec![false, false, true])
+    );
+    assert_eq!(rec.x.last().unwrap().to_bits(), 0xc0341c928e7cbb89);
+    let state: Vec<u64> = rec.final_state.iter().map(|v| v.to_bits()).collect();
+    assert_eq!(
+        state,
+        [
+            0xbff2e770e4edfd8c,
+            0xc024a8b698219621,
+            0x403aa12f880078ec,
+            0xc01f75005a706055,
+            0x3ff8bdb83a8a6ab1
+        ]
+    );
+    // The continuous world is another world: the same networks score differently.
+    let t = task(jittered(Objective::Classify, World::Continuous));
+    let continuous: Vec<u64> = t
+        .evaluate(&nets, 4, 9, None)
+        .unwrap()
+        .iter()
+        .map(|f| f.to_bits())
+        .collect();
+    assert_ne!(continuous, fitness);
+}
+
+/// `config` with `substeps` Euler steps of `1 / substeps` per time step.
+fn at_dt(config: &Nav1dConfig, substeps: usize) -> Nav1dTask {
+    task(Nav1dConfig {
+        integrator: ctrnn::Integrator {
+            method: config.integrator.method,
+            dt: 1.0 / substeps as f64,
+            substeps,
+        },
+        ..config.clone()
+    })
+}
+
+/// A network with tau 1 whose weights and sensor weights are the given `(i, j, w)` entries.
+fn wired(
+    theta: [f64; 5],
+    weights: &[(usize, usize, f64)],
+    sensors: &[(usize, usize, f64)],
+) -> Network {
+    let (mut w, mut s) = (vec![0.0; 25], vec![0.0; 10]);
+    for &(i, j, x) in weights {
+        w[i * 5 + j] = x;
+    }
+    for &(i, k, x) in sensors {
+        s[i * 2 + k] = x;
+    }
+    Network::new(vec![1.0; 5], theta.to_vec(), w, s, None).unwrap()
+}
+
+/// Moves right until it meets the landmark, then left for good: neuron 3 latches on (self-weight
+/// 10, threshold 5) once the landmark is sensed, and turns the right motor off and the left on.
+/// It reaches the goal in every landmark-far trial and in no landmark-near one.
+fn far_seeker() -> Network {
+    wired(
+        [8.0, -8.0, 0.0, 5.0, 0.0],
+        &[(3, 3, 10.0), (1, 3, -16.0), (0, 3, 16.0)],
+        &[(3, 0, 10.0)],
+    )
+}
+
+/// Always moves right. Neuron 3 latches on at the landmark; the classifier (neuron 2, threshold
+/// 7.5) fires only with both the latch and the reinforcement, that is in a landmark-near trial
+/// with the goal on the right.
+fn landmark_and_reward() -> Network {
+    wired(
+        [8.0, -8.0, 7.5, 5.0, 0.0],
+        &[(3, 3, 10.0), (2, 3, 5.0)],
+        &[(3, 0, 10.0), (2, 1, 5.0)],
+    )
+}
+
+#[test]
+fn the_agent_converges_with_first_order_in_dt() {
+    // No sensors reach the network: the right motor fires at f(-1) and the left motor's state
+    // rises smoothly to 2 f(-1), so the agent drifts left at a smoothly changing speed, and
+    // stays clear of the landmark (|x| < 5) for the 10 time steps of the trial.
+    let net = wired([0.0, 1.0, 0.0, 0.0, 0.0], &[(0, 1, 2.0), (0, 0, 0.5)], &[]);
+    for method in [ctrnn::Method::Euler, ctrnn::Method::Rk4] {
+        let mut base = Nav1dConfig {
+            max_steps: 10,
+            reinforcement_steps: 0,
+            ..Nav1dConfig::default()
+        };
+        base.integrator.method = method;
+        let chain = [Condition::exact(&base, Environment::Far, Side::Right)];
+        let end = |config: &Nav1dConfig, substeps: usize| {
+            let rec = at_dt(config, substeps).record(&net, &chain, true).unwrap();
+            assert_eq!(rec.x.len(), 10);
+            assert!(rec.landmark.iter().all(|&s| s == 0.0));
+            rec.x[9]
+        };
+        let fine = end(&base, 1000);
+        assert!((-5.0..-3.0).contains(&fine), "{fine}");
+        let [coarse, medium] = [10, 100].map(|s| (end(&base, s) - fine).abs());
+        // First order: ten times the step, about ten times the error (11 against the finest).
+        let ratio = coarse / medium;
+        assert!(
+            (8.0..14.0).contains(&ratio),
+            "{method:?}: {coarse} / {medium} = {ratio}"
+        );
+        assert!(medium < 1e-2, "{medium}");
+        // The stepped world moves once per time step, whatever dt: a finer dt hardly helps it,
+        // and it is off by several times the continuous world's error at dt = 0.1.
+        let stepped = Nav1dConfig {
+            world: World::Stepped,
+            ..base.clone()
+        };
+        let errors = [10, 100].map(|s| (end(&stepped, s) - fine).abs());
+        assert!(errors[1] > 0.8 * errors[0], "{errors:?}");
+        assert!(errors[1] > 4.0 * coarse, "{errors:?} vs {coarse}");
+    }
+}
+
+#[test]
+fn hand_built_networks_keep_their_outcomes_at_a_finer_dt() {
+    let jitter = Nav1dConfig {
+        start_jitter: 1.5,
+        landmark_jitter: 2.0,
+        objective: Objective::Classify,
+        ..Nav1dConfig::default()
+    };
+    let mut conditions: Vec<Condition> = [Environment::Far, Environment::Near]
+        .into_iter()
+        .flat_map(|e| [Side::Left, Side::Right].map(|g| Condition::exact(&jitter, e, g)))
+        .collect();
+    conditions.extend(
+        task(jitter.clone())
+            .fresh_chains(12, 1, 3)
+            .into_iter()
+            .flatten(),
+    );
+    let chains: Vec<Vec<Condition>> = conditions.iter().map(|c| vec![*c]).collect();
+    let outcomes = |net: &Network, substeps: usize| -> Vec<(bool, bool)> {
+        at_dt(&jitter, substeps)
+            .episodes(net, &chains)
+            .unwrap()
+            .iter()
+            .map(|e| (e.reached[0], e.classification[0] >= 0.5))
+            .collect()
+    };
+    let far = outcomes(&far_seeker(), 10);
+    for (c, (reached, _)) in conditions.iter().zip(&far) {
+        assert_eq!(*reached, c.environment == Environment::Far, "{c:?}");
+    }
+    assert_eq!(outcomes(&far_seeker(), 100), far);
+    let classified = outcomes(&landmark_and_reward(), 10);
+    for (c, &(reached, near)) in conditions.iter().zip(&classified) {
+        assert_eq!(reached, c.goal == Side::Right, "{c:?}");
+        let saw = c.environment == Environment::Near && c.goal == Side::Right;
+        assert_eq!(near, saw, "{c:?}");
+    }
+    assert_eq!(outcomes(&landmark_and_reward(), 100), classified);
+}
+
+#[test]
+fn the_record_samples_the_continuous_world_once_per_time_step() {
+    // The rightward agent crosses x = 20 after 20.013 time steps: the trial moves for 201 ticks
+    // of dt = 0.1, recorded as 20 whole time steps and the partial 21st, then 50 of reinforcement.
+    let t = goal_task(&[Environment::Near]);
+    let chain = [Condition::exact(t.config(), Environment::Near, Side::Right)];
+    let rec = t.record(&rightward(2), &chain, true).unwrap();
+    assert_eq!(rec.moving.iter().filter(|&&m| m).count(), 21);
+    assert_eq!(rec.x.len(), 21 + 50);
+    assert!(rec.x[20] >= 20.0 && rec.x[20] < 20.0 + 0.1 && rec.x[19] < 20.0);
+    let speed = rec.x[0];
+    assert!((rec.x[19] - 20.0 * speed).abs() < 1e-9, "{}", rec.x[19]);
+    // The landmark [8, 12] is entered and left inside time steps 9 and 13: the landmark input
+    // is the fraction of each time step's ticks that read 1.
+    let expect = |k: usize| {
+        let reads = (0..10)
+            .filter(|&i| (8.0..=12.0).contains(&((10 * k + i) as f64 * 0.1 * speed)))
+            .count();
+        reads as f64 / 10.0
+    };
+    for k in 0..20 {
+        assert_eq!(rec.landmark[k], expect(k), "time step {k}");
+    }
+    let partial: Vec<f64> = rec.landmark[..21]
+        .iter()
+        .copied()
+        .filter(|&s| s > 0.0 && s < 1.0)
+        .collect();
+    assert_eq!(partial.len(), 2, "{:?}", &rec.landmark[..21]);
+    assert_eq!(rec.reached, vec![true]);
+    assert!(rec.reinforcement[21..].iter().all(|&r| r == 1.0));
+    // The stepped world reads the sensor once per time step.
+    let stepped = task(Nav1dConfig {
+        world: World::Stepped,
+        environments: vec![Environment::Near],
+        ..Nav1dConfig::default()
+    });
+    let rec = stepped.record(&rightward(2), &chain, true).unwrap();
+    assert!(rec.landmark.iter().all(|&s| s == 0.0 || s == 1.0));
 }

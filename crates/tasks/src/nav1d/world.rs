@@ -1,19 +1,28 @@
 //! The line world and its trial loop: where the goal and the landmark are, what the sensors read,
 //! how the agent moves, and when a trial ends.
 //!
-//! # One time step
+//! # One update of the world
+//! The world is updated once per *tick*: in the continuous world (the default, see
+//! [`World`](super::World)) a tick is one integration step of `dt` (one Euler step, or one RK4
+//! step), `substeps` of them to a time step; in the stepped world a tick is a whole time step.
+//! With `tick_time` the simulated time of a tick (`dt`, or `dt * substeps`):
 //! 1. The sensors are read at the agent's position `x`: input 0 is 1 while the agent is on the
 //!    landmark (`|x - landmark| <= landmark_width / 2`), else 0; input 1 (the reinforcement, if
 //!    the network has it) is 0 while the agent moves.
-//! 2. The network integrates one time step with these inputs held.
-//! 3. The agent moves: `x += step_time * (f(v_R) - f(v_L))`, with the firing rates after the step.
+//! 2. The network integrates the tick with these inputs held.
+//! 3. The agent moves: `x += tick_time * (f(v_R) - f(v_L))`, with the firing rates after the
+//!    tick. In the continuous world this is a forward Euler step of `dx/dt = f(v_R) - f(v_L)`
+//!    taken together with the network's; with RK4 the network takes one RK4 step with the inputs
+//!    held and the agent then the same Euler step, so `x` stays first-order accurate in `dt`.
 //! 4. The trial ends when `x >= half_length` or `x <= -half_length` (the agent reached that end),
-//!    or after `max_steps` time steps. The goal is reached when the end is the goal's.
+//!    or after `max_steps` time steps (`max_steps * substeps` ticks in the continuous world). The
+//!    goal is reached when the end is the goal's.
 //!
-//! After the trial, the network runs `reinforcement_steps` more time steps with the landmark input
-//! 0 and the reinforcement input 1 if the goal was reached, 0 otherwise. The classifier's output
-//! `f(v_C)` at the end of that period is the trial's classification. The next trial of a chain
-//! starts at its own start position, from the state the last one left.
+//! After the trial, the network runs `reinforcement_steps` more time steps (as many ticks as that
+//! takes) with the landmark input 0 and the reinforcement input 1 if the goal was reached, 0
+//! otherwise. The classifier's output `f(v_C)` at the end of that period is the trial's
+//! classification. The next trial of a chain starts at its own start position, from the state the
+//! last one left.
 
 use ctrnn::{Lanes, Stream};
 use serde::{Deserialize, Serialize};
@@ -131,29 +140,43 @@ impl Condition {
     }
 }
 
-/// Which part of a trial a lane is in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Phase {
-    /// The agent moves.
-    Move,
-    /// The trial has ended; this many time steps of the reinforcement period are left.
-    Reinforce(usize),
-    /// The chain is over.
-    Done,
+/// What one tick did on one lane, for [`run_chains`]'s observer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Tick {
+    /// The trial the tick belonged to.
+    pub(crate) trial: usize,
+    /// Whether the agent moved during the tick (false in the reinforcement period).
+    pub(crate) moving: bool,
+    /// The agent's position after the tick.
+    pub(crate) x: f64,
+    /// Whether the tick ends a time step of its phase: the `substeps`-th tick of the moving
+    /// phase or of the reinforcement period, counted from the phase's start, or the phase's last
+    /// tick. Every tick of the stepped world does.
+    pub(crate) closes: bool,
 }
 
-/// One lane's place in its chain of trials.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Cursor {
-    /// The trial of the chain.
-    pub(crate) trial: usize,
-    pub(crate) phase: Phase,
-    /// The agent's position.
-    pub(crate) x: f64,
-    /// Time steps the agent has moved in this trial.
-    pub(crate) steps: usize,
-    /// Whether this trial reached the goal.
-    pub(crate) reached: bool,
+/// Every lane's [`Tick`], worked out only when asked for: evaluation never asks.
+pub(crate) struct Ticks<'a, const L: usize> {
+    trial: &'a [usize; L],
+    moving: &'a [bool; L],
+    x: &'a [f64; L],
+    left: &'a [usize; L],
+    per_step: usize,
+    half_length: f64,
+}
+
+impl<const L: usize> Ticks<'_, L> {
+    /// What the tick did on lane `l`.
+    pub(crate) fn get(&self, l: usize) -> Tick {
+        let (x, h) = (self.x[l], self.half_length);
+        let ended = self.left[l] == 0 || (self.moving[l] && (x >= h || x <= -h));
+        Tick {
+            trial: self.trial[l],
+            moving: self.moving[l],
+            x,
+            closes: ended || self.left[l].is_multiple_of(self.per_step),
+        }
+    }
 }
 
 /// What each trial of a chain did, on every lane: `reached[t][l]`, `classification[t][l]`.
@@ -163,96 +186,124 @@ pub(crate) struct Outcome<const L: usize> {
 }
 
 /// Runs chains of trials on every lane in lockstep, lane `l` through `chains[l]` (all of the same
-/// length). With `reset` the state starts at 0. `observe(inputs, lanes, before, after)` sees each
-/// time step's inputs, the network after it, and each lane's cursor before the step and after the
-/// agent moved (a finished trial's cursor has moved on to the next trial). This is the
-/// only trial loop: evaluation (`L = LANES`) and recording (`L = 1`) both run it, so they agree
-/// bit for bit.
+/// length), one tick at a time. With `reset` the state starts at 0. `observe(inputs, outputs,
+/// ticks)` sees each tick's inputs, every neuron's firing rate after it (`outputs[i][l]`) and
+/// what it did on each lane, while any lane's chain is still running. This is the only trial
+/// loop: evaluation (`L = LANES`) and recording (`L = 1`) both run it, so they agree bit for bit.
 pub(crate) fn run_chains<const L: usize>(
     config: &Nav1dConfig,
     lanes: &mut Lanes<L>,
     chains: [&[Condition]; L],
     reset: bool,
-    mut observe: impl FnMut(&[[f64; L]], &Lanes<L>, &[Cursor; L], &[Cursor; L]),
+    mut observe: impl FnMut(&[[f64; L]], &[[f64; L]], &Ticks<L>),
 ) -> Result<Outcome<L>, Diverged> {
     let k = chains[0].len();
     debug_assert!(chains.iter().all(|c| c.len() == k));
     if reset {
         lanes.reset();
     }
-    let (h, dt) = (config.half_length, config.step_time());
+    let (tick, per_step) = config.tick();
+    let tick_time = tick.dt * tick.substeps as f64;
+    let (h, half_width) = (config.half_length, 0.5 * config.landmark_width);
+    let move_ticks = config.max_steps * per_step;
+    let reinforce_ticks = config.reinforcement_steps * per_step;
+    let (left_motor, right_motor) = (config.left_motor, config.right_motor);
+    let classifier = (config.classifier < lanes.size()).then_some(config.classifier);
+    let m = config.n_inputs();
     let mut reached = vec![[false; L]; k];
     let mut classification = vec![[0.0; L]; k];
-    let mut cursors: [Cursor; L] = std::array::from_fn(|l| Cursor {
-        trial: 0,
-        phase: if k == 0 { Phase::Done } else { Phase::Move },
-        x: chains[l].first().map_or(0.0, |c| c.start),
-        steps: 0,
-        reached: false,
-    });
+    // Each lane's place in its chain: the trial, whether the agent is moving (else the trial is
+    // in its reinforcement period, or the chain is over), its position, the landmark's centre,
+    // the ticks left in the phase (usize::MAX once the chain is over) and whether the trial
+    // reached the goal.
+    let mut trial = [0usize; L];
+    let mut moving = [k > 0; L];
+    let mut x: [f64; L] = std::array::from_fn(|l| chains[l].first().map_or(0.0, |c| c.start));
+    let mut centre: [f64; L] =
+        std::array::from_fn(|l| chains[l].first().map_or(0.0, |c| c.landmark));
+    let mut left = [if k > 0 { move_ticks } else { usize::MAX }; L];
+    let mut goal = [false; L];
+    let mut running = if k > 0 { L } else { 0 };
     let mut inputs = [[0.0; L]; 2];
-    let m = config.n_inputs();
-    while cursors.iter().any(|c| c.phase != Phase::Done) {
-        for (l, c) in cursors.iter().enumerate() {
-            (inputs[0][l], inputs[1][l]) = match c.phase {
-                Phase::Move => (
-                    chains[l][c.trial].landmark_input(c.x, config.landmark_width),
-                    0.0,
-                ),
-                Phase::Reinforce(_) if c.reached => (0.0, 1.0),
-                _ => (0.0, 0.0),
-            };
+    // Whether each lane's landmark input is 1.
+    let mut sensing = [false; L];
+    // Whether the inputs differ from the last tick's (they do at the first).
+    let mut changed = true;
+    while running > 0 {
+        // Branch-free loops over the lanes, so that they compile to lane vectors.
+        for l in 0..L {
+            let on = moving[l] & ((x[l] - centre[l]).abs() <= half_width);
+            changed |= on != sensing[l];
+            sensing[l] = on;
+            inputs[0][l] = f64::from(u8::from(on));
         }
-        lanes.step_row(&inputs[..m], &config.integrator);
-        let left = lanes.output(config.left_motor);
-        let right = lanes.output(config.right_motor);
-        let before = cursors;
-        for (l, c) in cursors.iter_mut().enumerate() {
-            let ended = match c.phase {
-                Phase::Move => {
-                    c.x += dt * (right[l] - left[l]);
-                    c.steps += 1;
-                    let end = if c.x >= h {
-                        Some(Side::Right)
-                    } else if c.x <= -h {
-                        Some(Side::Left)
-                    } else {
-                        None
-                    };
-                    c.reached = end == Some(chains[l][c.trial].goal);
-                    if end.is_some() || c.steps == config.max_steps {
-                        c.phase = Phase::Reinforce(config.reinforcement_steps);
-                    }
-                    c.phase == Phase::Reinforce(0)
-                }
-                Phase::Reinforce(left) => {
-                    c.phase = Phase::Reinforce(left - 1);
-                    left == 1
-                }
-                Phase::Done => false,
-            };
-            if ended {
-                reached[c.trial][l] = c.reached;
-                classification[c.trial][l] = if config.classifier < lanes.size() {
-                    lanes.output(config.classifier)[l]
+        if changed {
+            lanes.step_row(&inputs[..m], &tick);
+        } else {
+            lanes.step_held(&tick);
+        }
+        changed = false;
+        let out = lanes.outputs();
+        let (vl, vr) = (&out[left_motor], &out[right_motor]);
+        let mut event = false;
+        for l in 0..L {
+            let moved = x[l] + tick_time * (vr[l] - vl[l]);
+            let xl = if moving[l] { moved } else { x[l] };
+            x[l] = xl;
+            left[l] -= 1;
+            event |= (left[l] == 0) | (moving[l] & ((xl >= h) | (xl <= -h)));
+        }
+        let ticks = Ticks {
+            trial: &trial,
+            moving: &moving,
+            x: &x,
+            left: &left,
+            per_step,
+            half_length: h,
+        };
+        observe(&inputs[..m], out, &ticks);
+        if !event {
+            continue;
+        }
+        // A phase ends: the reinforcement input may change.
+        changed = true;
+        for l in 0..L {
+            if moving[l] && (left[l] == 0 || x[l] >= h || x[l] <= -h) {
+                let end = if x[l] >= h {
+                    Some(Side::Right)
+                } else if x[l] <= -h {
+                    Some(Side::Left)
                 } else {
-                    f64::NAN
+                    None
                 };
-                c.trial += 1;
-                if c.trial == k {
-                    c.phase = Phase::Done;
-                } else {
-                    *c = Cursor {
-                        trial: c.trial,
-                        phase: Phase::Move,
-                        x: chains[l][c.trial].start,
-                        steps: 0,
-                        reached: false,
-                    };
+                goal[l] = end == Some(chains[l][trial[l]].goal);
+                moving[l] = false;
+                left[l] = reinforce_ticks;
+                inputs[1][l] = if goal[l] { 1.0 } else { 0.0 };
+            }
+            if moving[l] || left[l] != 0 {
+                continue;
+            }
+            // The trial is over.
+            let t = trial[l];
+            reached[t][l] = goal[l];
+            classification[t][l] = classifier.map_or(f64::NAN, |c| out[c][l]);
+            trial[l] += 1;
+            inputs[1][l] = 0.0;
+            goal[l] = false;
+            match chains[l].get(t + 1) {
+                Some(c) => {
+                    moving[l] = true;
+                    x[l] = c.start;
+                    centre[l] = c.landmark;
+                    left[l] = move_ticks;
+                }
+                None => {
+                    left[l] = usize::MAX;
+                    running -= 1;
                 }
             }
         }
-        observe(&inputs[..m], lanes, &before, &cursors);
     }
     Diverged::find(lanes)?;
     Ok(Outcome {

@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 import dnnevo
+from dnnevo.stats import wilson
 from dnnevo import assess, nav1d, presets
 from dnnevo.config import apply_overrides
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
@@ -499,6 +500,8 @@ def test_system_command(runs, tmp_path):
         right = [(e["classification"] >= 0.5) == (e["environment"] == "near") for e in episodes]
         assert report["classification_rate"] == pytest.approx(np.mean(right))
         assert f"goal reached in {report['goal_rate']:.1%}" in r.stdout
+        lo, hi = wilson(report["goal_rate"] * 50, 50)
+        assert f"95% interval {lo:.1%}-{hi:.1%}, clustered by environment: n = 50" in r.stdout
         assert_png(out / "fig2-system.png")
         reports[label] = report
     # The same environments either way, and the same classifier trial.

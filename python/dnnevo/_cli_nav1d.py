@@ -127,6 +127,7 @@ def add_system_parser(sub: Any) -> None:
 def system(args: argparse.Namespace) -> int:
     """``dnnevo nav1d-system``."""
     from dnnevo.errors import ConfigError
+    from dnnevo.stats import wilson
 
     if args.environments < 1 or args.trials < 1 or args.seed < 0:
         raise ConfigError("--environments and --trials must be >= 1 and --seed >= 0")
@@ -140,8 +141,15 @@ def system(args: argparse.Namespace) -> int:
           f"(seed {args.seed}; state {state}): goal rate by trial")
     for line in _rate_table(report["episodes"], 0):
         print(line)
-    print(f"classifier right in {report['classification_rate']:.1%} of environments; "
-          f"goal reached in {report['goal_rate']:.1%} of all trials")
+    envs, trials = args.environments, args.environments * args.trials
+    right = report["classification_rate"] * envs
+    lo, hi = wilson(right, envs)
+    print(f"classifier right in {report['classification_rate']:.1%} of environments "
+          f"(95% interval {lo:.1%}-{hi:.1%})")
+    # The trials of one environment share the system's state, so count environments, not trials.
+    lo, hi = wilson(report["goal_rate"] * envs, envs)
+    print(f"goal reached in {report['goal_rate']:.1%} of {trials} trials (95% interval "
+          f"{lo:.1%}-{hi:.1%}, clustered by environment: n = {envs})")
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
         write_atomic(args.out / "report.json", json.dumps(report, indent=1))

@@ -218,3 +218,15 @@ def test_sweep_reports_rates_with_intervals(tmp_path: Path) -> None:
     # The final champion's assessment is evaluate's, on the eval seed.
     d, _ = evaluate_json(out / "seed-3", "--trials", "50", "--seed", "1000006")
     assert {**s["runs"][1]["final"], "run": str(out / "seed-3")} == d
+
+
+def test_evaluate_with_a_finer_step(runs: dict[str, Path]) -> None:
+    coarse, _ = evaluate_json(runs["nav1d-single"], "--trials", "20", "--seed", "3")
+    fine, _ = evaluate_json(runs["nav1d-single"], "--trials", "20", "--seed", "3", "--dt", "0.05")
+    assert "integrator" not in coarse
+    assert fine["integrator"] == {"method": "euler", "dt": 0.05, "substeps": 20}
+    text, _ = in_process("evaluate", runs["sequence-1bit"], "--trials", "5", "--dt", "0.02")
+    assert "integrated with dt = 0.02, 50 steps per time step" in text
+    for bad in ("0.03", "-1", "nan"):
+        r = run_cli("evaluate", runs["landmark"], "--trials", "2", "--dt", bad)
+        assert_one_line_error(r, "--dt")

@@ -5,7 +5,9 @@ the verdict: 0 pass, 1 fail, 3 undecided (2 is an error)."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import math
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -21,12 +23,15 @@ EXAMPLE = """examples:
   dnnevo evaluate runs/demo                      the champion on fresh trials, default counts
   dnnevo evaluate runs/demo --trials 2000 --seed 1
   dnnevo evaluate runs/lm --robot-like --json    the whole assessment as JSON on stdout
+  dnnevo evaluate runs/demo --dt 0.01            the same champion integrated 10x finer
 
 Each rate gets a 95% Wilson score interval. Verdict: pass when the interval lies at or above the
 task's threshold (sequence: 90% of trials per target; landmark and nav1d: 95%), fail when it lies
 below, undecided when it straddles it; then the output says how many trials would decide.
 A sequence run passes when every target passes and fails when any fails. nav1d trials within one
 chain share the network's state: with several scored trials per chain the interval counts chains.
+--dt integrates the champion with a finer (or coarser) Euler step, each time step kept as long:
+a behaviour that vanishes at a finer step is an artefact of the integrator, not a result.
 Exit status: 0 pass, 1 fail, 3 undecided, 2 error."""
 
 
@@ -38,8 +43,12 @@ def evaluate(args: argparse.Namespace) -> int:
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     if args.robot_like and config.task != "landmark":
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
+    if args.dt is not None:
+        config = with_dt(config, args.dt)
     a = assess.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
     extra = _cli_sequence.switch_test(config, champion, seed) if a.task == "sequence" else {}
+    if args.dt is not None:
+        extra = {"integrator": dataclasses.asdict(config.integrator), **extra}
     if args.json:
         print(json.dumps({"run": str(args.dir), **a.to_dict(), **extra}, indent=1))
     else:
@@ -63,9 +72,27 @@ def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:
     lines = [*PREFACES[a.task](where, a), *rate_table(a.rates, column), overall(a)]
     lines += [hint(r, a.unit) for r in a.judged if r.verdict == "undecided"]
     lines.append(f"intervals: {a.method}")
+    if "integrator" in extra:
+        i = extra["integrator"]
+        lines.append(f"integrated with dt = {i['dt']:g}, {i['substeps']} steps per time step "
+                     "(--dt); the run was evolved with its config's step")
     if "switch_test" in extra:
         lines.append(_cli_sequence.switch_line(extra["switch_test"]))
     return lines
+
+
+def with_dt(config: EvolutionConfig, dt: float) -> EvolutionConfig:
+    """``config`` integrated with step ``dt``, as many steps per time step as keep a time step
+    ``integrator.dt * integrator.substeps`` long; a ``dt`` that does not divide it is an error."""
+    if not (math.isfinite(dt) and dt > 0):
+        raise ConfigError(f"--dt is {dt}; it must be a number > 0")
+    step = config.integrator.dt * config.integrator.substeps
+    substeps = round(step / dt)
+    if substeps < 1 or not math.isclose(substeps * dt, step, rel_tol=1e-9):
+        raise ConfigError(f"--dt {dt} does not divide the run's time step of {step:g} "
+                          f"(dt {config.integrator.dt:g} x {config.integrator.substeps} steps)")
+    integrator = dataclasses.replace(config.integrator, dt=dt, substeps=substeps)
+    return dataclasses.replace(config, integrator=integrator)
 
 
 def percent(x: float, digits: int = 2) -> str:

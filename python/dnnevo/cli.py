@@ -145,6 +145,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="landmark runs: sonar noise, specular misses and a jittered room")
     p.add_argument("--json", action="store_true",
                    help="print the whole assessment as JSON on stdout instead of text")
+    p.add_argument("--dt", type=float, default=None,
+                   help="integrate with this Euler step instead of the run's, each time step kept "
+                        "as long (e.g. 0.01 for 10x finer): tells a behaviour from a step artefact")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        epilog="example: dnnevo plot runs/demo")

@@ -6,8 +6,9 @@
   GA step       ga._evo.tell(fitness) with a fixed fitness vector: proportional selection,
                 crossover, mutation and the champion/statistics bookkeeping, in Rust (median)
   loop          dnnevo.evolve("sequence", ..., out=folder) for --generations generations: wall
-                time per generation minus the evaluate median (= GA step + Python bookkeeping:
-                run log, best.json, checkpoints, progress); and, from the run's own history,
+                time per generation minus the evaluate median (= GA step + the validation of the
+                champion's candidates, measured alone in (c) + Python bookkeeping: run log,
+                best.json, checkpoints, progress); and, from the run's own history,
                 the Python bookkeeping alone (time between generations outside the Rust step)
   numpy GA      the same operators in NumPy (selection by cumsum + searchsorted, one-point
                 crossover at neuron boundaries, per-gene resampling, statistics and champion)
@@ -227,7 +228,7 @@ def main(argv=None) -> int:
         print(f"{name:<46}  {t * 1e3:>13.3f}  {share:>12.2%}  {tgt:>7}  {met:>3}")
 
     row(f"dnnevo GA step (tell, median of {args.repeats})", a["tell"])
-    row(f"evolve loop - evaluate ({args.generations} gens, out=)", a["per_gen"] - e)
+    row(f"evolve loop - evaluate ({args.generations} gens, out=; with (c))", a["per_gen"] - e)
     row("  of which Python bookkeeping (from history)", a["bookkeeping"])
     row(f"  run setup + final checkpoint, / {args.generations} gens", a["setup"] / args.generations,
         False)

@@ -5,6 +5,8 @@ use ctrnn::{Error, Integrator, Method, Result};
 use serde::{Deserialize, Serialize};
 use sim2d::{SimSpec, WorldSpec};
 
+use super::training::Training;
+
 /// Conditions that make a simulated trial more like the real robot's: sonar noise, specular
 /// misses and a jittered room. Each trial draws its own jitter.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -61,6 +63,11 @@ pub struct LandmarkConfig {
     pub train_robot_like: bool,
     /// What "robot-like" means. Default [`RobotLike::default`].
     pub robot_like: RobotLike,
+    /// How the training trials vary: a minimal simulation that varies what a network must not
+    /// rely on, differing in kind from the robot-like test (see [`Training`]). Default
+    /// [`Training::default`]: no variation, the paper's training. Cannot be combined with
+    /// `train_robot_like`.
+    pub training: Training,
     /// How the network is integrated over one robot step; `dt * substeps` is one unit of network
     /// time, so by default one robot step of 0.1 s is one network time step. Default 10 Euler
     /// steps of 0.1.
@@ -81,6 +88,7 @@ impl Default for LandmarkConfig {
             sim: SimSpec::default(),
             train_robot_like: false,
             robot_like: RobotLike::default(),
+            training: Training::default(),
             integrator: Integrator {
                 method: Method::Euler,
                 dt: 0.1,
@@ -153,6 +161,7 @@ impl LandmarkConfig {
                 return config(format!("{name} is {value}; it must be in [0, {hi}]"));
             }
         }
+        self.training.validate(self)?;
         self.integrator.validate().map_err(|e| match e {
             Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
             other => other,

@@ -32,11 +32,13 @@
 
 mod config;
 mod task;
+mod training;
 
 pub use config::{LandmarkConfig, RobotLike};
 pub use task::{
     answer, score, Assessment, LandmarkTask, Record, Sensing, SUCCESS_RATE, SUCCESS_TRIALS,
 };
+pub use training::Training;
 
 #[cfg(test)]
 mod tests;

@@ -8,7 +8,7 @@ use ctrnn::{
 };
 use rayon::prelude::*;
 use serde::Serialize;
-use sim2d::{Echo, Sim, World, WorldSpec};
+use sim2d::{Echo, Sim, SimSpec, World, WorldSpec};
 
 use super::config::{config_error, LandmarkConfig};
 use crate::common::{check_inputs, config_from_params, interrupted, Diverged, Memo};
@@ -128,18 +128,31 @@ impl LandmarkTask {
         } else {
             spec.clone()
         };
-        let world = World::new(&world_spec).map_err(config_error)?;
         let mut sim_spec = c.sim.clone();
         if robot_like {
             sim_spec.sonars[0].noise_sd = rl.noise_sd;
             sim_spec.sonars[0].specular_max_incidence_deg = Some(rl.specular_max_incidence_deg);
         }
-        let mut sim = Sim::random_start(&world, &sim_spec, &mut stream).map_err(config_error)?;
-        let steps = c.steps();
+        self.sense_in(landmark, world_spec, &sim_spec, c.steps(), stream)
+    }
+
+    /// Runs the robot through `steps` steps in `world_spec` with `sim_spec`, drawing the start
+    /// pose, then the sonar noise from `stream`.
+    pub(crate) fn sense_in(
+        &self,
+        landmark: u8,
+        world_spec: WorldSpec,
+        sim_spec: &SimSpec,
+        steps: usize,
+        mut stream: Stream,
+    ) -> Result<Sensing> {
+        let world = World::new(&world_spec).map_err(config_error)?;
+        let mut sim = Sim::random_start(&world, sim_spec, &mut stream).map_err(config_error)?;
+        let d0 = self.config.d0;
         let mut echoes = vec![Echo::default(); sim_spec.sonars.len()];
         let mut sensing = Sensing {
             landmark,
-            world: world_spec.clone(),
+            world: world_spec,
             input: Vec::with_capacity(steps),
             range: Vec::with_capacity(steps),
             poses: Vec::with_capacity(steps),
@@ -151,23 +164,20 @@ impl LandmarkTask {
             sensing.poses.push([p.x, p.y, p.heading]);
             sensing.range.push(echoes[0].range);
             sensing.echoes.push(echoes[0].point);
-            sensing.input.push(sim2d::input(echoes[0].range, c.d0));
+            sensing.input.push(sim2d::input(echoes[0].range, d0));
         }
         Ok(sensing)
     }
 
     /// The trials every individual of `generation` runs: `trials_per_landmark` with landmark 1,
     /// then as many with landmark 2; trial `t` draws from
-    /// `Stream::new(seed, generation, Purpose::Trial, 0, t)`, robot-like if `train_robot_like`.
+    /// `Stream::new(seed, generation, Purpose::Trial, 0, t)`, robot-like if `train_robot_like`,
+    /// varied as [`LandmarkConfig::training`] says (`training.rs`).
     pub fn trials(&self, seed: u64, generation: u64) -> Result<Vec<Sensing>> {
         let k = self.config.trials_per_landmark;
         (0..2 * k)
             .into_par_iter()
-            .map(|t| {
-                let stream = Stream::new(seed, generation, Purpose::Trial, 0, t as u64);
-                let landmark = if t < k { 1 } else { 2 };
-                self.sense(landmark, stream, self.config.train_robot_like)
-            })
+            .map(|t| self.training_trial(seed, generation, t))
             .collect()
     }
 

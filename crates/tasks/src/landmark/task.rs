@@ -417,8 +417,9 @@ impl Task for LandmarkTask {
         ))
     }
 
-    /// Each network on `validation_trials` trials per landmark in the training conditions, drawn
-    /// as in [`fresh_trials`](LandmarkTask::fresh_trials) from [`Purpose::Validate`]: the
+    /// Each network on `validation_trials` trials per landmark in the training conditions
+    /// without `training`'s variations (the ideal world, or robot-like with `train_robot_like`),
+    /// drawn as in [`fresh_trials`](LandmarkTask::fresh_trials) from [`Purpose::Validate`]: the
     /// fraction classified right and the mean trial score. The trials are sensed once per seed.
     fn validate(
         &self,

@@ -1010,22 +1010,34 @@ mod tests {
                 substeps: 2,
             };
             let mut again = Lanes::<LANES>::new(&refs).unwrap();
-            let mut held = again.clone();
+            let (mut held, mut together) = (again.clone(), again.clone());
+            let same = |a: &Lanes<LANES>, b: &Lanes<LANES>| {
+                (0..5).all(|i| {
+                    let (x, y) = (a.state(i), b.state(i));
+                    x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+                })
+            };
             for t in 0..12 {
                 let inputs = [[(t / 4) as f64; LANES], [0.5; LANES]];
                 again.step_row(&inputs, &integ);
                 if t % 4 == 0 {
                     held.step_row(&inputs, &integ);
+                    // Four rows of the same inputs as one row of four times the steps.
+                    let four = Integrator {
+                        substeps: 4 * integ.substeps,
+                        ..integ
+                    };
+                    together.step_row(&inputs, &four);
                 } else {
                     held.step_held(&integ);
                 }
                 if t % 3 == 0 {
                     let _ = held.outputs();
                 }
-            }
-            for i in 0..5 {
-                let (a, b) = (again.state(i), held.state(i));
-                assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()));
+                assert!(same(&again, &held), "{method:?}, row {t}");
+                if t % 4 == 3 {
+                    assert!(same(&again, &together), "{method:?}, row {t}");
+                }
             }
         }
     }

@@ -460,8 +460,8 @@ impl Nav1dTask {
             reset,
             |inputs, outputs, lanes| {
                 let tick = lanes.get(0);
-                landmark += inputs[0][0];
-                ticks += 1;
+                landmark += inputs[0][0] * lanes.count as f64;
+                ticks += lanes.count;
                 if !tick.closes {
                     return;
                 }

@@ -264,8 +264,9 @@ impl LandmarkTask {
 
     /// Each network's final classifier output on each trial (`out[p][t]`), with (network,
     /// trial) pairs [`LANES`] at a time in parallel: for a few networks and many trials, where
-    /// [`outputs`](Self::outputs) would leave lanes and cores idle. A lane's result does not
-    /// depend on its neighbours, so both give the same bits.
+    /// [`outputs`](Self::outputs) would leave lanes and cores idle. Lanes share a time axis, so a
+    /// group holds only trials of one length (varied trials differ in length). A lane's result
+    /// does not depend on its neighbours, so both give the same bits.
     fn outputs_by_pair(
         &self,
         networks: &[Network],
@@ -273,11 +274,26 @@ impl LandmarkTask {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<Vec<f64>>> {
         self.check(networks)?;
-        let pairs: Vec<(usize, usize)> = (0..networks.len())
+        let mut pairs: Vec<(usize, usize)> = (0..networks.len())
             .flat_map(|p| (0..trials.len()).map(move |t| (p, t)))
             .collect();
-        let groups = pairs
-            .par_chunks(LANES)
+        // A stable sort: pairs of one length keep their order, so unvaried sets group as before.
+        pairs.sort_by_key(|&(_, t)| trials[t].input.len());
+        let mut groups: Vec<&[(usize, usize)]> = vec![];
+        let mut rest = pairs.as_slice();
+        while let Some(&(_, t0)) = rest.first() {
+            let len = trials[t0].input.len();
+            let n = rest
+                .iter()
+                .take(LANES)
+                .take_while(|&&(_, t)| trials[t].input.len() == len)
+                .count();
+            let (group, tail) = rest.split_at(n);
+            groups.push(group);
+            rest = tail;
+        }
+        let results = groups
+            .par_iter()
             .map(|group| {
                 if interrupted(cancel) {
                     return Err(Error::Interrupted);
@@ -293,11 +309,13 @@ impl LandmarkTask {
                 Ok(f[..group.len()].to_vec())
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(groups
-            .concat()
-            .chunks(trials.len().max(1))
-            .map(<[f64]>::to_vec)
-            .collect())
+        let mut out = vec![vec![0.0; trials.len()]; networks.len()];
+        for (group, f) in groups.iter().zip(results) {
+            for (&(p, t), y) in group.iter().zip(f) {
+                out[p][t] = y;
+            }
+        }
+        Ok(out)
     }
 
     /// The fitness of every network in `generation`: the mean trial score over
@@ -419,8 +437,10 @@ impl Task for LandmarkTask {
 
     /// Each network on `validation_trials` trials per landmark in the training conditions
     /// without `training`'s variations (the ideal world, or robot-like with `train_robot_like`),
-    /// drawn as in [`fresh_trials`](LandmarkTask::fresh_trials) from [`Purpose::Validate`]: the
-    /// fraction classified right and the mean trial score. The trials are sensed once per seed.
+    /// drawn as in [`fresh_trials`](LandmarkTask::fresh_trials) from [`Purpose::Validate`]; when
+    /// `training` varies, on as many varied trials per landmark besides (`training.rs`). Gives
+    /// the fraction classified right and the mean trial score. The trials are sensed once per
+    /// seed.
     fn validate(
         &self,
         networks: &[Network],
@@ -429,12 +449,14 @@ impl Task for LandmarkTask {
     ) -> Result<Option<Vec<Validation>>> {
         let c = &self.config;
         let trials = self.validation_set.get_or_try(&seed, || {
-            self.trials_from(
-                Purpose::Validate,
-                c.validation_trials,
-                seed,
-                c.train_robot_like,
-            )
+            self.varied_validation_trials(seed).unwrap_or_else(|| {
+                self.trials_from(
+                    Purpose::Validate,
+                    c.validation_trials,
+                    seed,
+                    c.train_robot_like,
+                )
+            })
         })?;
         let outputs = self.outputs_by_pair(networks, &trials, cancel)?;
         let n = trials.len() as f64;

@@ -21,8 +21,15 @@
 //! sonar's cone offset, the trial-length offset, the input's gain and offset, then one normal
 //! variate per step for the input noise (only when `input_noise_sd > 0`). Every draw is made even
 //! when its range is 0, so changing one range never moves another's draws.
+//!
+//! # Validation
+//! A champion chosen on the ideal world alone can be one that relies on exactly what training
+//! varies. So when training varies, the validation set ([`Task::validate`](ctrnn::Task)) holds
+//! `validation_trials` varied trials per landmark besides the ideal ones, drawn as above from
+//! `Purpose::Validate`'s streams at generation 0 instead of `Purpose::Trial`'s.
 
 use ctrnn::{Error, Purpose, Result, Stream};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sim2d::{BoxSpec, WorldSpec};
 
@@ -238,14 +245,51 @@ impl LandmarkTask {
     /// landmark's first `ideal_trials_per_landmark`, else varied (see the [module docs](self)).
     pub(crate) fn training_trial(&self, seed: u64, generation: u64, t: usize) -> Result<Sensing> {
         let c = self.config();
-        let k = c.trials_per_landmark;
+        let set = TrialSet {
+            purpose: Purpose::Trial,
+            generation,
+            per_landmark: c.trials_per_landmark,
+            ideal_per_landmark: c.training.ideal_trials_per_landmark,
+        };
+        self.drawn_trial(&set, seed, t)
+    }
+
+    /// The validation set when training varies: `validation_trials` unvaried trials per landmark
+    /// followed by as many varied ones, drawn like training trials but from
+    /// [`Purpose::Validate`]'s streams at generation 0, so that the champion is chosen on the
+    /// conditions training varies over as well as on the ideal world. `None` when training is off.
+    pub(crate) fn varied_validation_trials(&self, seed: u64) -> Option<Result<Vec<Sensing>>> {
+        let c = self.config();
+        if c.training.is_off() {
+            return None;
+        }
+        let set = TrialSet {
+            purpose: Purpose::Validate,
+            generation: 0,
+            per_landmark: 2 * c.validation_trials,
+            ideal_per_landmark: c.validation_trials,
+        };
+        Some(
+            (0..2 * set.per_landmark)
+                .into_par_iter()
+                .map(|t| self.drawn_trial(&set, seed, t))
+                .collect(),
+        )
+    }
+
+    /// Trial `t` of `set` (landmark 1 for `t < per_landmark`, then 2), from the streams
+    /// `(seed, generation, purpose, 0, t)` for its start pose and sonar, and
+    /// `(seed, generation, purpose, 1, t)` for its variation.
+    fn drawn_trial(&self, set: &TrialSet, seed: u64, t: usize) -> Result<Sensing> {
+        let c = self.config();
+        let k = set.per_landmark;
         let (landmark, index) = if t < k { (1, t) } else { (2, t - k) };
-        let stream = Stream::new(seed, generation, Purpose::Trial, 0, t as u64);
+        let stream = Stream::new(seed, set.generation, set.purpose, 0, t as u64);
         let training = &c.training;
-        if training.is_off() || index < training.ideal_trials_per_landmark {
+        if training.is_off() || index < set.ideal_per_landmark {
             return self.sense(landmark, stream, c.train_robot_like);
         }
-        let mut draws = Stream::new(seed, generation, Purpose::Trial, 1, t as u64);
+        let mut draws = Stream::new(seed, set.generation, set.purpose, 1, t as u64);
         let v = training.draw(&mut draws);
         let world = move_landmark(c.world(landmark), &v)?;
         let mut sim = c.sim.clone();
@@ -261,6 +305,16 @@ impl LandmarkTask {
         }
         Ok(sensing)
     }
+}
+
+/// Which trials a set holds and whose streams they draw from.
+struct TrialSet {
+    purpose: Purpose,
+    generation: u64,
+    /// Trials per landmark.
+    per_landmark: usize,
+    /// The first this-many trials of each landmark are unvaried.
+    ideal_per_landmark: usize,
 }
 
 #[cfg(test)]
@@ -486,5 +540,71 @@ mod tests {
             ..c
         });
         assert_eq!(wild.trials(6, 3).unwrap(), t.trials(6, 3).unwrap());
+    }
+
+    /// With training varied, the validation set is `validation_trials` ideal trials per landmark
+    /// and as many varied ones, from the Validate streams (never a training trial), and each
+    /// network's rate counts its right answers over the whole set, trials of every length.
+    #[test]
+    fn varied_training_validates_on_ideal_and_varied_trials() {
+        let c = LandmarkConfig {
+            validation_trials: 3,
+            ..varied()
+        };
+        let t = task(c.clone());
+        let set = t.varied_validation_trials(21).unwrap().unwrap();
+        assert_eq!(set.len(), 12);
+        let steps = c.steps();
+        for (i, s) in set.iter().enumerate() {
+            let landmark = if i < 6 { 1 } else { 2 };
+            assert_eq!(s.landmark, landmark, "trial {i}");
+            let ideal = i % 6 < 3;
+            assert_eq!(&s.world == c.world(landmark), ideal, "trial {i}");
+            if ideal {
+                assert_eq!(s.input.len(), steps, "trial {i}");
+            }
+        }
+        let lengths: std::collections::BTreeSet<_> = set.iter().map(|s| s.input.len()).collect();
+        assert!(
+            lengths.len() > 2,
+            "varied trials differ in length: {lengths:?}"
+        );
+        let training: Vec<_> = (0..20)
+            .flat_map(|g| t.trials(21, g).unwrap())
+            .map(|s| s.poses[0])
+            .collect();
+        assert!(set.iter().all(|s| !training.contains(&s.poses[0])));
+        // Training off: the unvaried set of before.
+        let plain = task(LandmarkConfig {
+            training: Training::default(),
+            ..c
+        });
+        assert!(plain.varied_validation_trials(21).is_none());
+
+        let nets: Vec<_> = (0..3)
+            .map(|i| {
+                let mut s = Stream::new(5, 0, Purpose::Init, i, 0);
+                let layout = t.layout();
+                let genes = ctrnn::genome::random(layout, &Default::default(), &mut s);
+                ctrnn::genome::decode(layout, &genes).unwrap()
+            })
+            .collect();
+        let vs = t.validate(&nets, 21, None).unwrap().unwrap();
+        for (net, v) in nets.iter().zip(&vs) {
+            let records: Vec<_> = set
+                .iter()
+                .map(|s| t.record(net, s.clone()).unwrap())
+                .collect();
+            let right = records
+                .iter()
+                .filter(|r| super::super::answer(r.classification) == r.sensing.landmark)
+                .count();
+            assert_eq!(v.rate, right as f64 / 12.0);
+            let total: f64 = records
+                .iter()
+                .map(|r| super::super::score(r.sensing.landmark, r.classification))
+                .sum();
+            assert_eq!(v.score, total / 12.0);
+        }
     }
 }

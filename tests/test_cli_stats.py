@@ -215,9 +215,38 @@ def test_sweep_reports_rates_with_intervals(tmp_path: Path) -> None:
     verdicts = [run["final"]["verdict"] for run in s["runs"]]
     assert passing["k"] == verdicts.count("pass") and passing["n"] == 2
     assert f"final champions passing on fresh trials: {passing['k']}/2" in r.stdout
-    # The final champion's assessment is evaluate's, on the eval seed.
-    d, _ = evaluate_json(out / "seed-3", "--trials", "50", "--seed", "1000006")
+    # The final champion's assessment is evaluate's, on the eval seed, and so is its step check.
+    d, _ = evaluate_json(out / "seed-3", "--trials", "50", "--seed", "1000006", "--dt-check")
+    check = d.pop("step_check")
     assert {**s["runs"][1]["final"], "run": str(out / "seed-3")} == d
+    assert s["runs"][1]["step_check"] == check
+    artefacts = [run["step_check"]["artefact"] for run in s["runs"]]
+    assert s["step_artefacts"] == {"k": sum(artefacts), "n": 2}
+    assert [row["step_artefact"] for row in rows] == [*(str(int(a)) for a in artefacts), str(sum(artefacts))]
+    assert f"step artefacts: {sum(artefacts)} of 2 final champions" in r.stdout
+
+
+def test_dt_check_judges_the_same_trials_at_finer_steps(runs: dict[str, Path]) -> None:
+    for name in runs:
+        plain, status = evaluate_json(runs[name], "--trials", "10", "--seed", "4")
+        d, checked_status = evaluate_json(runs[name], "--trials", "10", "--seed", "4", "--dt-check")
+        check = d.pop("step_check")
+        assert d == plain
+        assert check["integrators"]["run"] == {"method": "euler", "dt": 0.1, "substeps": 10}
+        assert check["integrators"]["dt/10"] == {"method": "euler", "dt": 0.01, "substeps": 100}
+        assert check["integrators"]["rk4"] == {"method": "rk4", "dt": 0.1, "substeps": 10}
+        # The dt/10 check is what --dt 0.01 reports.
+        fine, _ = evaluate_json(runs[name], "--trials", "10", "--seed", "4", "--dt", "0.01")
+        fine.pop("integrator")
+        fine.pop("switch_test", None)
+        assert {**check["checks"]["dt/10"], "run": fine["run"]} == fine
+        assert checked_status == (1 if check["artefact"] else status)
+        changes = [abs(c["rate"] - b["rate"]) for a in check["checks"].values()
+                   for b, c in zip(plain["rates"], a["rates"]) if b["verdict"] is not None]
+        assert check["max_change"] == max(changes)
+    text, _ = in_process("evaluate", runs["sequence-1bit"], "--trials", "5", "--dt-check")
+    assert "time-step check, same trials (run: euler, dt 0.1; dt/10: dt 0.01)" in text
+    assert ("step check: no artefact" in text) != ("step artefact" in text)
 
 
 def test_evaluate_with_a_finer_step(runs: dict[str, Path]) -> None:

@@ -60,3 +60,21 @@ def test_median_not_reached_when_more_than_half_are_censored() -> None:
 def test_empty_sweep_is_an_error() -> None:
     with pytest.raises(InvalidArgumentError, match="at least one run"):
         sweep.summarize([])
+
+
+def test_summary_counts_step_artefacts() -> None:
+    from dnnevo.stepcheck import StepCheck
+
+    runs = [seed_result(0, 4, 100), seed_result(1, 9, 100), seed_result(2, None, 50)]
+    fine = [seed_result(s, None, k).final for s, k in ((0, 100), (1, 20), (2, 10))]
+    runs = [sweep.SeedResult(**{**vars(r), "step": StepCheck(base=r.final, checks={"dt/10": f},
+                                                             integrators={})})
+            for r, f in zip(runs, fine)]
+    s = sweep.summarize(runs)
+    # Seed 1 passes at the run's step and fails at the finer one; seed 2 fails at both.
+    assert (s.checked, s.artefacts) == (3, 1)
+    assert [r.artefact for r in runs] == [False, True, False]
+    assert s.to_dict()["step_artefacts"] == {"k": 1, "n": 3}
+    rows = list(csv.DictReader(s.csv_text().splitlines()))
+    assert [r["step_artefact"] for r in rows] == ["0", "1", "0", "1"]
+    assert [float(r["step_change"]) for r in rows[:3]] == [0.0, 0.8, 0.4]

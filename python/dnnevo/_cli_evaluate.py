@@ -18,12 +18,14 @@ from dnnevo.assess import Assessment, Rate
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.rundir import RunDir
+from dnnevo.stepcheck import StepCheck, step_check, with_dt
 
 EXAMPLE = """examples:
   dnnevo evaluate runs/demo                      the champion on fresh trials, default counts
   dnnevo evaluate runs/demo --trials 2000 --seed 1
   dnnevo evaluate runs/lm --robot-like --json    the whole assessment as JSON on stdout
   dnnevo evaluate runs/demo --dt 0.01            the same champion integrated 10x finer
+  dnnevo evaluate runs/demo --dt-check           also at a 10x finer step and with RK4
 
 Each rate gets a 95% Wilson score interval. Verdict: pass when the interval lies at or above the
 task's threshold (sequence: 90% of trials per target; landmark and nav1d: 95%), fail when it lies
@@ -32,6 +34,9 @@ A sequence run passes when every target passes and fails when any fails. nav1d t
 chain share the network's state: with several scored trials per chain the interval counts chains.
 --dt integrates the champion with a finer (or coarser) Euler step, each time step kept as long:
 a behaviour that vanishes at a finer step is an artefact of the integrator, not a result.
+--dt-check judges the champion again on the same trials at a 10x finer step and with RK4 (with
+Euler runs), and calls it a step artefact when a rate that does not fail at the run's step fails
+at either; an artefact's exit status is 1, whatever the run's step says.
 Exit status: 0 pass, 1 fail, 3 undecided, 2 error."""
 
 
@@ -44,15 +49,21 @@ def evaluate(args: argparse.Namespace) -> int:
     if args.robot_like and config.task != "landmark":
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
     if args.dt is not None:
-        config = with_dt(config, args.dt)
+        config = with_dt(config, args.dt, "--dt")
     a = assess.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
     extra = _cli_sequence.switch_test(config, champion, seed) if a.task == "sequence" else {}
     if args.dt is not None:
         extra = {"integrator": dataclasses.asdict(config.integrator), **extra}
+    check = None
+    if args.dt_check:
+        check = step_check(config, champion, seed=seed, robot_like=args.robot_like, base=a)
+        extra = {**extra, "step_check": check.to_dict()}
     if args.json:
         print(json.dumps({"run": str(args.dir), **a.to_dict(), **extra}, indent=1))
     else:
-        print("\n".join(text(args.dir, a, extra)))
+        print("\n".join(text(args.dir, a, extra) + (step_lines(check) if check else [])))
+    if check is not None and check.artefact:
+        return assess.EXIT_STATUS["fail"]
     return assess.EXIT_STATUS[a.verdict]
 
 
@@ -81,18 +92,27 @@ def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:
     return lines
 
 
-def with_dt(config: EvolutionConfig, dt: float) -> EvolutionConfig:
-    """``config`` integrated with step ``dt``, as many steps per time step as keep a time step
-    ``integrator.dt * integrator.substeps`` long; a ``dt`` that does not divide it is an error."""
-    if not (math.isfinite(dt) and dt > 0):
-        raise ConfigError(f"--dt is {dt}; it must be a number > 0")
-    step = config.integrator.dt * config.integrator.substeps
-    substeps = round(step / dt)
-    if substeps < 1 or not math.isclose(substeps * dt, step, rel_tol=1e-9):
-        raise ConfigError(f"--dt {dt} does not divide the run's time step of {step:g} "
-                          f"(dt {config.integrator.dt:g} x {config.integrator.substeps} steps)")
-    integrator = dataclasses.replace(config.integrator, dt=dt, substeps=substeps)
-    return dataclasses.replace(config, integrator=integrator)
+def step_lines(check: StepCheck) -> list[str]:
+    """The time-step check's report: each judged rate at the run's step and at each check."""
+    names = list(check.checks)
+    judged = [r for r in check.base.rates if r.verdict is not None]
+    width = max(4, *(len(r.name) for r in judged))
+    run = check.integrators["run"]
+    lines = [f"time-step check, same trials (run: {run['method']}, dt {run['dt']:g}; "
+             f"dt/10: dt {check.integrators[names[0]]['dt']:g})",
+             f"{'':>{width}} {'run step':>10}" + "".join(f" {n:>10}" for n in names)]
+    for r in judged:
+        cells = [next(c for c in check.checks[n].rates if c.name == r.name) for n in names]
+        lines.append(f"{r.name:>{width}} {percent(r.rate, 1):>10}"
+                     + "".join(f" {percent(c.rate, 1) + ('!' if c.verdict == 'fail' else ''):>10}"
+                               for c in cells))
+    change = f"largest change {100 * check.max_change:.1f} points"
+    if check.artefact:
+        lines.append(f"step artefact ({change}): fails only at a finer step: {'; '.join(check.artefacts)} "
+                     "(! marks a failing rate)")
+    else:
+        lines.append(f"step check: no artefact ({change})")
+    return lines
 
 
 def percent(x: float, digits: int = 2) -> str:

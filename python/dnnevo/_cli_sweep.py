@@ -20,8 +20,10 @@ Reports the seeds whose run met the task's rule (k/n with a 95% Wilson interval)
 first-success generation (95% bootstrap interval, fixed bootstrap seed; a seed that never
 succeeded counts as +infinity, so "not reached" when more than half never did), and the final
 champions (best.json) that pass on fresh conditions from seed BASE + seed (--eval-seed), judged as
-'dnnevo evaluate' judges. Writes OUT/summary.csv (a row per seed, then a row 'all') and
-OUT/summary.json."""
+'dnnevo evaluate' judges. Each final champion is also judged on the same conditions at a 10x
+finer step and with RK4 ('dnnevo evaluate --dt-check'); one that fails there where it did not at
+the run's step is counted as a step artefact (--no-dt-check skips the check). Writes
+OUT/summary.csv (a row per seed, then a row 'all') and OUT/summary.json."""
 
 
 def sweep_command(args: argparse.Namespace) -> int:
@@ -36,7 +38,8 @@ def sweep_command(args: argparse.Namespace) -> int:
     runs = []
     for seed in args.seeds:
         result = sweep.run_seed(config, seed, args.out / f"seed-{seed}", threads=args.threads,
-                                force=args.force, eval_seed_base=args.eval_seed, eval_trials=trials)
+                                force=args.force, eval_seed_base=args.eval_seed, eval_trials=trials,
+                                dt_check=args.dt_check)
         runs.append(result)
         if result.interrupted:
             break
@@ -72,7 +75,8 @@ def lines(s: sweep.Summary, eval_seed: int, trials: int, unit: str) -> list[str]
         out.append(
             f"{r.seed:>5} {r.best_fitness:>8.4f} {r.best_generation:>7} "
             f"{'-' if r.first_success is None else r.first_success:>14} {r.wall_s:>8.1f}  "
-            f"{rate:>16}  {bounds:<16}  {r.final.verdict}")
+            f"{rate:>16}  {bounds:<16}  {r.final.verdict}"
+            + ("  (step artefact)" if r.artefact else ""))
     n = s.seeds
     lo, hi = s.success_interval
     out.append(f"seeds whose run met the rule: {s.succeeded}/{n} = {s.succeeded / n:.0%} "
@@ -90,4 +94,7 @@ def lines(s: sweep.Summary, eval_seed: int, trials: int, unit: str) -> list[str]
     v = s.verdicts
     out.append(f"final champions passing on fresh trials: {s.passed}/{n} = {s.passed / n:.0%} "
                f"(95% Wilson interval [{lo:.1%}, {hi:.1%}]); {v['fail']} fail, {v['undecided']} undecided")
+    if s.checked:
+        out.append(f"step artefacts: {s.artefacts} of {s.checked} final champions fail at a 10x finer "
+                   "step or with RK4 on the same trials where the run's step did not")
     return out

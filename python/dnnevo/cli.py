@@ -131,6 +131,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="seed s's final champion is judged on fresh conditions from seed BASE + s "
                         f"(default {sweep.EVAL_SEED_BASE}, which no run uses)")
     p.add_argument("--eval-trials", type=_positive, metavar="N", help="fresh " + trials_help)
+    p.add_argument("--no-dt-check", dest="dt_check", action="store_false",
+                   help="skip judging each final champion again at a 10x finer step and with RK4")
     run_options(p)
 
     p = sub.add_parser("evaluate", help="judge a champion on fresh random conditions",
@@ -148,6 +150,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dt", type=float, default=None,
                    help="integrate with this Euler step instead of the run's, each time step kept "
                         "as long (e.g. 0.01 for 10x finer): tells a behaviour from a step artefact")
+    p.add_argument("--dt-check", action="store_true",
+                   help="also judge the champion on the same trials at a 10x finer step and with "
+                        "RK4; a success that fails there is flagged as a step artefact (exit 1)")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        epilog="example: dnnevo plot runs/demo")

@@ -9,7 +9,9 @@ their uncertainty:
   reached" when more than half the seeds are censored;
 - **final champions passing**: each seed's final champion (``best.json``) judged by
   :func:`dnnevo.assess.assess` on fresh conditions from seed :data:`EVAL_SEED_BASE` + the run's
-  seed, which no run uses; the fraction that pass, with its Wilson interval.
+  seed, which no run uses; the fraction that pass, with its Wilson interval;
+- **step artefacts**: final champions that the time-step check (:mod:`dnnevo.stepcheck`: the same
+  conditions at a 10x finer step and with RK4) finds failing where the run's step did not.
 
 >>> from dnnevo import sweep
 >>> sweep.eval_seed(3)
@@ -34,6 +36,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.rundir import RunDir, write_atomic
 from dnnevo.stats import Verdict
+from dnnevo.stepcheck import StepCheck, step_check
 
 __all__ = ["EVAL_SEED_BASE", "CSV_COLUMNS", "SeedResult", "Summary", "eval_seed", "run_seed", "summarize"]
 
@@ -44,6 +47,7 @@ CSV_COLUMNS = (
     "seed", "best_fitness", "best_generation", "first_success", "first_success_lo",
     "first_success_hi", "last_generation", "succeeded", "succeeded_lo", "succeeded_hi", "wall_s",
     "eval_seed", "final_rate", "final_k", "final_n", "final_lo", "final_hi", "final_verdict",
+    "step_change", "step_artefact",
 )
 """The columns of ``summary.csv``: one row per seed, then a row ``all`` whose cells aggregate
 their column (see :meth:`Summary.csv_text`)."""
@@ -67,6 +71,13 @@ class SeedResult:
     wall_s: float
     final: Assessment
     interrupted: bool = False
+    step: StepCheck | None = None
+    """The final champion's time-step check, when the sweep made one."""
+
+    @property
+    def artefact(self) -> bool:
+        """Whether the time-step check found the final champion to be a step artefact."""
+        return self.step is not None and self.step.artefact
 
     @property
     def censored_at(self) -> float:
@@ -81,28 +92,32 @@ class SeedResult:
             "first_success": self.first_success, "last_generation": self.last_generation,
             "succeeded": self.first_success is not None, "wall_s": self.wall_s,
             "interrupted": self.interrupted, "final": self.final.to_dict(),
+            "step_check": None if self.step is None else self.step.to_dict(),
         }
 
 
 def run_seed(
     config: EvolutionConfig, seed: int, out: Path, *, threads: int | None = None, force: bool = False,
-    eval_seed_base: int = EVAL_SEED_BASE, eval_trials: int | None = None,
+    eval_seed_base: int = EVAL_SEED_BASE, eval_trials: int | None = None, dt_check: bool = True,
 ) -> SeedResult:
     """Runs ``config`` with ``seed`` into ``out``, then judges the final champion (``out /
     best.json``) on fresh conditions from :func:`eval_seed` with ``eval_trials`` (default: the
-    task's :data:`~dnnevo.assess.DEFAULT_TRIALS`)."""
+    task's :data:`~dnnevo.assess.DEFAULT_TRIALS`), and, with ``dt_check``, checks it at finer
+    steps on the same conditions (:func:`~dnnevo.stepcheck.step_check`)."""
     from dnnevo.evolve import evolve
 
     t0 = time.perf_counter()
     result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force)
     wall = time.perf_counter() - t0
     champion = _core.Network.load(RunDir(out).best)
-    final = assess(config, champion, eval_trials, seed=eval_seed(seed, eval_seed_base))
+    fresh = eval_seed(seed, eval_seed_base)
+    final = assess(config, champion, eval_trials, seed=fresh)
+    step = step_check(config, champion, seed=fresh, base=final) if dt_check else None
     generations = result.history["generation"]
     return SeedResult(
         seed=seed, best_fitness=float(result.best_fitness), best_generation=int(result.best_generation),
         first_success=result.first_success, last_generation=int(generations[-1]) if len(generations) else 0,
-        wall_s=round(wall, 2), final=final, interrupted=result.interrupted,
+        wall_s=round(wall, 2), final=final, interrupted=result.interrupted, step=step,
     )
 
 
@@ -120,6 +135,10 @@ class Summary:
     """Final champions whose verdict is pass."""
     pass_interval: tuple[float, float]
     verdicts: dict[Verdict, int]
+    checked: int = 0
+    """Final champions given the time-step check."""
+    artefacts: int = 0
+    """Final champions the time-step check found to be step artefacts."""
 
     @property
     def seeds(self) -> int:
@@ -145,6 +164,7 @@ class Summary:
             },
             "final_champions_pass": {"k": self.passed, "n": self.seeds, "rate": self.passed / self.seeds,
                                      "interval": list(self.pass_interval), "verdicts": dict(self.verdicts)},
+            "step_artefacts": {"k": self.artefacts, "n": self.checked},
             "runs": [r.to_dict() for r in self.runs],
         }
 
@@ -153,7 +173,9 @@ class Summary:
         ``succeeded`` the fraction of seeds (with ``succeeded_lo``/``_hi``, its Wilson interval),
         ``first_success`` the median (``not reached`` when censored, with ``first_success_lo``/
         ``_hi``, its bootstrap interval), ``final_k``/``final_n`` the final champions passing (with
-        ``final_lo``/``_hi``, its Wilson interval), ``wall_s`` the total."""
+        ``final_lo``/``_hi``, its Wilson interval), ``step_artefact`` the count of step artefacts,
+        ``wall_s`` the total. ``step_change`` is the largest change of a judged rate at a finer
+        step, as a fraction."""
         buf = io.StringIO()
         writer = csv.DictWriter(buf, fieldnames=CSV_COLUMNS, lineterminator="\n", restval="")
         writer.writeheader()
@@ -166,6 +188,8 @@ class Summary:
                 "wall_s": r.wall_s, "eval_seed": r.final.seed, "final_rate": w.name, "final_k": w.k,
                 "final_n": w.n, "final_lo": _round(w.interval[0]), "final_hi": _round(w.interval[1]),
                 "final_verdict": r.final.verdict,
+                "step_change": "" if r.step is None else _round(r.step.max_change),
+                "step_artefact": "" if r.step is None else int(r.step.artefact),
             })
         m = self.first_success
         writer.writerow({
@@ -175,6 +199,7 @@ class Summary:
             "wall_s": round(sum(r.wall_s for r in self.runs), 2), "final_rate": "champions passing",
             "final_k": self.passed, "final_n": self.seeds, "final_lo": _round(self.pass_interval[0]),
             "final_hi": _round(self.pass_interval[1]),
+            "step_artefact": self.artefacts if self.checked else "",
         })
         return buf.getvalue()
 
@@ -208,4 +233,5 @@ def summarize(runs: Sequence[SeedResult]) -> Summary:
         runs=list(runs), succeeded=succeeded, success_interval=stats.wilson(succeeded, n),
         first_success=stats.bootstrap_median([r.censored_at for r in runs]),
         passed=verdicts["pass"], pass_interval=stats.wilson(verdicts["pass"], n), verdicts=verdicts,
+        checked=sum(r.step is not None for r in runs), artefacts=sum(r.artefact for r in runs),
     )

@@ -547,6 +547,24 @@ def test_quick_run_and_evaluate(run, robot_like):
     assert assess.EXIT_STATUS[judged.verdict] == r.returncode
 
 
+def test_the_robust_preset_trains_on_varied_trials_and_runs(tmp_path):
+    config = presets.get("landmark-robust")
+    training = config.task_params["training"]
+    assert training["ideal_trials_per_landmark"] == 2 and training["landmark_shift"] > 0
+    assert not config.task_params.get("train_robot_like", False)  # the test world stays unseen
+    out = tmp_path / "robust"
+    r = run_cli("run", "landmark-robust", "--quick", "--set", "generations=2", "--out", out,
+                "--seed", "0", "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    header, *rows = (out / "log.csv").read_text().splitlines()
+    rate = header.split(",").index("validation_rate")
+    # Every generation's champion is validated (the set's make-up is tested in crates/tasks).
+    rates = [float(row.split(",")[rate]) for row in rows]
+    assert len(rates) == 2 and all(0 <= x <= 1 for x in rates), rates
+    r = run_cli("evaluate", out, "--robot-like", "--trials", "5", "--seed", "1")
+    assert r.returncode in (0, 1, 3), r.stderr
+
+
 def test_quick_run_plot(run):
     r = run_cli("plot", run)
     assert r.returncode == 0, r.stderr

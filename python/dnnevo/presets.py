@@ -119,6 +119,22 @@ PRESETS: dict[str, Preset] = {
                         task_params={"trials_per_landmark": 3}),
         {"population": 30, "generations": 5},
     ),
+    # Not in the paper. Trained with varied trials (Jakobi-style: crates/tasks/src/landmark/
+    # training.rs) so that champions transfer to the robot-like test, which training never sees:
+    # every variation at half the strength first tried, 2 of the 10 trials per landmark ideal, a
+    # larger population with rank selection and elitism, and champions validated on varied trials.
+    "landmark-robust": Preset(
+        "beyond the paper (§3): landmark recognition trained on varied trials, to pass the "
+        "robot-like test; 8 neurons, 400 x 1000, 20 trials",
+        EvolutionConfig(task="landmark", population=400, generations=1000, crossover_rate=0.5,
+                        mutation_rate=0.01, elitism=10, selection="rank", size=8, n_inputs=1,
+                        task_params={"trials_per_landmark": 10, "training": {
+                            "ideal_trials_per_landmark": 2, "landmark_shift": 0.15,
+                            "landmark_turn_deg": 5.0, "landmark_scale": 0.08, "follower_speed": 0.08,
+                            "follower_distance": 0.05, "cone_deg": 8.0, "trial_seconds": 3.0,
+                            "input_gain": 0.15, "input_offset": 0.025, "input_noise_sd": 0.015}}),
+        {"population": 30, "generations": 5},
+    ),
     "sequence-3bit": Preset(
         "paper §5.4: (011)*, (101)*, (110)*; 10 neurons, 1000 x 700, perf_base 2/3",
         _sequence(["011", "101", "110"], 10, 700, 0.002, 2 / 3),

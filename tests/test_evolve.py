@@ -212,3 +212,13 @@ def test_env_thread_count_does_not_change_results(tmp_path: Path) -> None:
         outs.append((out / "best.json").read_bytes())
         assert (out / "log.csv").exists()
     assert outs[0] == outs[1]
+
+
+def test_a_preset_name_with_its_config_runs_the_presets_task() -> None:
+    config = dnnevo.presets.get("nav1d-far", quick=True, overrides=["generations=2"])
+    by_name = dnnevo.evolve("nav1d-far", config, seed=1, progress=False)
+    by_task = dnnevo.evolve("nav1d", config, seed=1, progress=False)
+    assert by_name.best_fitness == by_task.best_fitness
+    assert by_name.history["best"].tolist() == by_task.history["best"].tolist()
+    with pytest.raises(ConfigError, match="does not match config.task"):
+        dnnevo.evolve("landmark", config, seed=1, progress=False)

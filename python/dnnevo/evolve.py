@@ -100,7 +100,8 @@ def _task_config(task: str, config: EvolutionConfig | None) -> EvolutionConfig:
     from dnnevo import presets
 
     if config is not None:
-        if task != config.task and task not in presets.names():
+        named = presets.get(task).task if task in presets.names() else task
+        if named != config.task:
             raise ConfigError(f"task {task!r} does not match config.task {config.task!r}")
         return config
     if task in presets.names():
@@ -143,6 +144,7 @@ def evolve(
     else:
         config = _task_config(task, config)
         _check_layout(config)
+        task = config.task  # a preset name stands for its config's task
     run = RunDir(out) if out is not None else None
     if run is not None:
         run.create(force=force)

@@ -15,9 +15,16 @@ pub(crate) fn config_from_params<C: DeserializeOwned + Default>(
 ) -> Result<C> {
     match params {
         serde_json::Value::Null => Ok(C::default()),
-        serde_json::Value::Object(_) => {
-            C::deserialize(params).map_err(|e| Error::Config(format!("{name}: {e}")))
-        }
+        serde_json::Value::Object(_) => serde_path_to_error::deserialize(params).map_err(|e| {
+            // Name the field (`training.cone_deg`) unless the error is about the whole object.
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            if path == "." {
+                Error::Config(format!("{name}: {inner}"))
+            } else {
+                Error::Config(format!("{name}: {path}: {inner}"))
+            }
+        }),
         other => Err(Error::Config(format!(
             "{name}: the parameters must be a JSON object of config fields; got {other}"
         ))),

@@ -382,7 +382,10 @@ mod tests {
             err(json!({"training": {"landmark_shift": 0.1}, "train_robot_like": true}))
                 .contains("training is either robot-like or varied")
         );
-        assert!(err(json!({"training": {"noise_sd": 0.1}})).contains("unknown field `noise_sd`"));
+        assert!(err(json!({"training": {"noise_sd": 0.1}}))
+            .contains("landmark: training.noise_sd: unknown field `noise_sd`"));
+        assert!(err(json!({"training": {"cone_deg": "wide"}}))
+            .contains("landmark: training.cone_deg: invalid type: string \"wide\""));
         // A landmark moved out of the room is an error when the trial is drawn.
         let far = LandmarkConfig {
             training: Training {

@@ -393,7 +393,13 @@ fn config_errors_name_the_field() {
     use serde_json::json;
     assert!(err(json!({"environments": []})).contains("environments is empty"));
     assert!(err(json!({"environments": ["far", "far"]})).contains("repeats"));
-    assert!(err(json!({"environments": ["middle"]})).contains("unknown variant `middle`"));
+    assert!(err(json!({"environments": ["middle"]}))
+        .contains("nav1d: environments[0]: unknown variant `middle`"));
+    let e = err(json!({"objective": "both"}));
+    assert!(
+        e.contains("nav1d: objective: unknown variant `both`"),
+        "{e}"
+    );
     assert!(err(json!({"left_motor": 7})).contains("left_motor is 7"));
     assert!(
         err(json!({"left_motor": 1})).contains("left_motor is 1, the same neuron as")
@@ -417,7 +423,7 @@ fn config_errors_name_the_field() {
     assert!(err(json!({"landmarks": 1})).contains("unknown field `landmarks`"));
     let e = err(json!({"world": "smooth"}));
     assert!(
-        e.contains("unknown variant `smooth`, expected `continuous` or `stepped`"),
+        e.contains("world: unknown variant `smooth`, expected `continuous` or `stepped`"),
         "{e}"
     );
     let e = err(

@@ -13,8 +13,10 @@
 //!   complex eigenvalues on both sides: a **Hopf point**, where a complex pair crosses the
 //!   imaginary axis. Its input value is refined by bisection along the linked equilibrium.
 //!
+//! Linking is by continuation: Newton's method at the next value from each equilibrium, and back.
 //! Each event is found to within `2^-40` of the step between input values, and reports the state
-//! and the critical eigenvalue there (near 0 for a fold, near `±i omega` for a Hopf point).
+//! and the critical eigenvalue there (near 0 for a fold, near `±i omega` for a Hopf point). An
+//! event whose critical eigenvalue is not within [`CRITICAL`] of the imaginary axis is dropped.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -28,6 +30,10 @@ use crate::Network;
 
 /// Bisection steps that locate an event between two input values.
 const BISECTIONS: usize = 40;
+/// An event is kept only if its critical eigenvalue's real part is within this of 0, relative to
+/// the largest eigenvalue modulus (at least 1): a link between input values that was wrong, or a
+/// search that missed an equilibrium at one value, then reports nothing instead of a false event.
+pub const CRITICAL: f64 = 1e-3;
 
 /// Settings of a bifurcation sweep.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,6 +173,30 @@ impl At<'_> {
         Field::new(self.net, &input)
     }
 
+    /// For each of `from`, the one of `to` (the equilibria at input `value`) that Newton's method
+    /// reaches from it, if any.
+    fn link(
+        &self,
+        value: f64,
+        from: &[Equilibrium],
+        to: &[Equilibrium],
+    ) -> Result<Vec<Option<usize>>> {
+        let field = self.field(value)?;
+        Ok(from
+            .iter()
+            .map(|e| {
+                let r = newton(
+                    &field,
+                    e.state.clone(),
+                    self.search.tolerance,
+                    self.search.max_iterations,
+                )?;
+                let k = nearest(&r, to)?;
+                (distance(&r, &to[k].state) < self.search.distinct).then_some(k)
+            })
+            .collect())
+    }
+
     /// Follows the equilibrium at `v` (input `a`) towards input `b` while `alive` holds;
     /// returns the last value where it did and the equilibrium there.
     fn bisect(
@@ -175,8 +205,9 @@ impl At<'_> {
         b: f64,
         v: &[f64],
         alive: impl Fn(&Field<'_>, &[f64]) -> Result<bool>,
-    ) -> Result<(f64, Vec<f64>)> {
+    ) -> Result<Option<(f64, Vec<f64>)>> {
         let (mut good, mut bad, mut state) = (a, b, v.to_vec());
+        let mut advanced = false;
         for _ in 0..BISECTIONS {
             let mid = 0.5 * (good + bad);
             let field = self.field(mid)?;
@@ -189,14 +220,18 @@ impl At<'_> {
                 Some(r) if alive(&field, &r)? => {
                     good = mid;
                     state = r;
+                    advanced = true;
                 }
                 _ => bad = mid,
             }
         }
-        Ok((good, state))
+        Ok(advanced.then_some((good, state)))
     }
 
-    fn event(&self, kind: EventKind, value: f64, state: Vec<f64>) -> Result<Event> {
+    /// The event at `value` and `state`, if its critical eigenvalue is where the kind puts it:
+    /// a real part within [`CRITICAL`] (relative to the largest eigenvalue modulus, at least 1)
+    /// of 0, and for a Hopf point an imaginary part beyond it.
+    fn event(&self, kind: EventKind, value: f64, state: Vec<f64>) -> Result<Option<Event>> {
         let ev = eigenvalues(self.field(value)?.jacobian(&state))?;
         let pick = |a: &&[f64; 2], b: &&[f64; 2]| a[0].abs().total_cmp(&b[0].abs());
         let eigenvalue = match kind {
@@ -206,16 +241,25 @@ impl At<'_> {
         .or_else(|| ev.iter().min_by(pick))
         .copied()
         .unwrap_or([f64::NAN, 0.0]);
-        Ok(Event {
+        let scale = ev.iter().map(|z| z[0].hypot(z[1])).fold(1.0, f64::max);
+        let critical = eigenvalue[0].abs() <= CRITICAL * scale
+            && (kind == EventKind::Fold || eigenvalue[1] > CRITICAL * scale);
+        Ok(critical.then_some(Event {
             kind,
             value,
             state,
             eigenvalue,
-        })
+        }))
     }
 
     /// The fold where `e` (at input `a`) vanishes on the way to input `b`.
-    fn fold(&self, a: f64, b: f64, e: &Equilibrium, others: &[Equilibrium]) -> Result<Event> {
+    fn fold(
+        &self,
+        a: f64,
+        b: f64,
+        e: &Equilibrium,
+        others: &[Equilibrium],
+    ) -> Result<Option<Event>> {
         let sign = det_sign(&self.field(a)?, &e.state);
         // Newton may not jump to a different equilibrium: it must stay nearer to `e` than half
         // the distance to any other equilibrium at `a` (and keep the sign of det).
@@ -226,20 +270,26 @@ impl At<'_> {
             .fold(f64::INFINITY, f64::min)
             / 2.0;
         let start = e.state.clone();
-        let (value, state) = self.bisect(a, b, &e.state, |field, r| {
+        let found = self.bisect(a, b, &e.state, |field, r| {
             Ok(det_sign(field, r) == sign && distance(r, &start) < reach.max(1e-3))
         })?;
-        self.event(EventKind::Fold, value, state)
+        match found {
+            Some((value, state)) => self.event(EventKind::Fold, value, state),
+            None => Ok(None),
+        }
     }
 
     /// The Hopf point between `e` (at input `a`) and its partner at input `b`.
-    fn hopf(&self, a: f64, b: f64, e: &Equilibrium) -> Result<Event> {
+    fn hopf(&self, a: f64, b: f64, e: &Equilibrium) -> Result<Option<Event>> {
         let count = unstable_complex(e);
-        let (value, state) = self.bisect(a, b, &e.state, |field, r| {
+        let found = self.bisect(a, b, &e.state, |field, r| {
             let eq = Equilibrium::at(field, r.to_vec())?;
             Ok(unstable_complex(&eq) == count)
         })?;
-        self.event(EventKind::Hopf, value, state)
+        match found {
+            Some((value, state)) => self.event(EventKind::Hopf, value, state),
+            None => Ok(None),
+        }
     }
 }
 
@@ -289,8 +339,8 @@ pub fn bifurcation(
     for s in 0..sweep.steps - 1 {
         let (here, next) = (&equilibria[s], &equilibria[s + 1]);
         let (a, b) = (values[s], values[s + 1]);
-        let forward: Vec<Option<usize>> = here.iter().map(|e| nearest(&e.state, next)).collect();
-        let backward: Vec<Option<usize>> = next.iter().map(|e| nearest(&e.state, here)).collect();
+        let forward = at.link(b, here, next)?;
+        let backward = at.link(a, next, here)?;
         for (i, e) in here.iter().enumerate() {
             match forward[i] {
                 Some(j) if backward[j] == Some(i) => {
@@ -299,15 +349,15 @@ pub fn bifurcation(
                         && has_complex(e)
                         && has_complex(f)
                     {
-                        events.push(at.hopf(a, b, e)?);
+                        events.extend(at.hopf(a, b, e)?);
                     }
                 }
-                _ => events.push(at.fold(a, b, e, here)?),
+                _ => events.extend(at.fold(a, b, e, here)?),
             }
         }
         for (j, f) in next.iter().enumerate() {
             if !matches!(backward[j], Some(i) if forward[i] == Some(j)) {
-                events.push(at.fold(b, a, f, next)?);
+                events.extend(at.fold(b, a, f, next)?);
             }
         }
     }

@@ -32,7 +32,7 @@ mod stability;
 #[cfg(test)]
 mod tests;
 
-pub use bifurcation::{bifurcation, Bifurcation, Event, EventKind, Sweep};
+pub use bifurcation::{bifurcation, Bifurcation, Event, EventKind, Sweep, CRITICAL};
 pub use cycles::{limit_cycles, Cycle, CycleSearch};
 pub use equilibria::{equilibria, Equilibrium, EquilibriumSearch};
 pub use field::{jacobian, vector_field};

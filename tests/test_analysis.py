@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -178,3 +179,20 @@ def test_lesioning_a_neuron_without_outgoing_weights_changes_no_score(preset: st
     assert [x.name.split(" at ")[0] for x in table.lesions][: config.size] == [f"clamp {i}" for i in range(config.size)]
     assert table.lesions[config.size - 1].drop == 0.0
     assert len(table.lesions) == config.size + 2
+
+
+DATA = Path(__file__).resolve().parent / "data"
+
+
+def test_every_change_in_the_equilibrium_count_of_a_champion_has_its_fold() -> None:
+    """The champion of ``dnnevo run sequence-1bit --seed 0``: between reinforcement 0.06 and 0.07
+    a pair of equilibria appears so close together that following one by bisection once jumped
+    to its partner and the fold went unreported."""
+    net = dnnevo.Network.load(DATA / "sequence-1bit-seed0-champion.json")
+    b = analysis.bifurcation(net, 1, 0.0, 1.0, steps=101)
+    counts = [len(row) for row in b.equilibria]
+    assert counts[0] == 3 and counts[-1] == 1 and max(counts) == 5
+    for s in range(len(counts) - 1):
+        folds = [e for e in b.events if e.kind == "fold" and b.values[s] <= e.value <= b.values[s + 1]]
+        assert 2 * len(folds) >= abs(counts[s + 1] - counts[s]), (b.values[s], counts[s], counts[s + 1])
+    assert [round(e.value, 3) for e in b.events] == [0.061, 0.401, 0.601]

@@ -213,6 +213,8 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
         stable = sum(e.stable for e in a.equilibria)
         lines.append(f"input {a.label} [{', '.join(f'{x:g}' for x in a.input)}]: {len(a.equilibria)} equilibria "
                      f"({stable} stable), {len(a.cycles)} attracting cycle{'s' * (len(a.cycles) != 1)}")
+        if len(a.equilibria) % 2 == 0:
+            lines.append("    (an even count: at least one equilibrium was missed, see docs/analysis.md)")
         lines += [_eq_line(e) for e in a.equilibria[:12]]
         if len(a.equilibria) > 12:
             lines.append(f"    ... {len(a.equilibria) - 12} more in analysis.json")

@@ -30,6 +30,8 @@ use crate::Network;
 
 /// Bisection steps that locate an event between two input values.
 const BISECTIONS: usize = 40;
+/// Newton continuation steps from the last good input value to each bisection trial value.
+const WALK: usize = 4;
 /// An event is kept only if its critical eigenvalue's real part is within this of 0, relative to
 /// the largest eigenvalue modulus (at least 1): a link between input values that was wrong, or a
 /// search that missed an equilibrium at one value, then reports nothing instead of a false event.
@@ -198,32 +200,41 @@ impl At<'_> {
     }
 
     /// Follows the equilibrium at `v` (input `a`) towards input `b` while `alive` holds;
-    /// returns the last value where it did and the equilibrium there.
+    /// returns the last value where it did and the equilibrium there, or None if it never
+    /// got past `a`. Each bisection trial walks from the last good value in [`WALK`] Newton
+    /// continuation steps, and `alive(field, root, previous root)` judges every step.
     fn bisect(
         &self,
         a: f64,
         b: f64,
         v: &[f64],
-        alive: impl Fn(&Field<'_>, &[f64]) -> Result<bool>,
+        alive: impl Fn(&Field<'_>, &[f64], &[f64]) -> Result<bool>,
     ) -> Result<Option<(f64, Vec<f64>)>> {
         let (mut good, mut bad, mut state) = (a, b, v.to_vec());
         let mut advanced = false;
-        for _ in 0..BISECTIONS {
+        'bisection: for _ in 0..BISECTIONS {
             let mid = 0.5 * (good + bad);
-            let field = self.field(mid)?;
-            match newton(
-                &field,
-                state.clone(),
-                self.search.tolerance,
-                self.search.max_iterations,
-            ) {
-                Some(r) if alive(&field, &r)? => {
-                    good = mid;
-                    state = r;
-                    advanced = true;
+            let mut walked = state.clone();
+            for k in 1..=WALK {
+                let p = good + (mid - good) * k as f64 / WALK as f64;
+                let field = self.field(p)?;
+                let root = newton(
+                    &field,
+                    walked.clone(),
+                    self.search.tolerance,
+                    self.search.max_iterations,
+                );
+                match root {
+                    Some(r) if alive(&field, &r, &walked)? => walked = r,
+                    _ => {
+                        bad = mid;
+                        continue 'bisection;
+                    }
                 }
-                _ => bad = mid,
             }
+            good = mid;
+            state = walked;
+            advanced = true;
         }
         Ok(advanced.then_some((good, state)))
     }
@@ -261,17 +272,17 @@ impl At<'_> {
         others: &[Equilibrium],
     ) -> Result<Option<Event>> {
         let sign = det_sign(&self.field(a)?, &e.state);
-        // Newton may not jump to a different equilibrium: it must stay nearer to `e` than half
-        // the distance to any other equilibrium at `a` (and keep the sign of det).
+        // Newton may not jump to a different equilibrium: each continuation step must move less
+        // than half the distance from `e` to any other equilibrium at `a`, and keep the sign of
+        // det (a fold's partner has the other sign).
         let reach = others
             .iter()
             .map(|o| distance(&o.state, &e.state))
             .filter(|d| *d > 0.0)
             .fold(f64::INFINITY, f64::min)
             / 2.0;
-        let start = e.state.clone();
-        let found = self.bisect(a, b, &e.state, |field, r| {
-            Ok(det_sign(field, r) == sign && distance(r, &start) < reach.max(1e-3))
+        let found = self.bisect(a, b, &e.state, |field, r, previous| {
+            Ok(det_sign(field, r) == sign && distance(r, previous) < reach.max(1e-3))
         })?;
         match found {
             Some((value, state)) => self.event(EventKind::Fold, value, state),
@@ -282,7 +293,7 @@ impl At<'_> {
     /// The Hopf point between `e` (at input `a`) and its partner at input `b`.
     fn hopf(&self, a: f64, b: f64, e: &Equilibrium) -> Result<Option<Event>> {
         let count = unstable_complex(e);
-        let found = self.bisect(a, b, &e.state, |field, r| {
+        let found = self.bisect(a, b, &e.state, |field, r, _| {
             let eq = Equilibrium::at(field, r.to_vec())?;
             Ok(unstable_complex(&eq) == count)
         })?;

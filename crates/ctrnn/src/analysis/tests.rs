@@ -362,3 +362,38 @@ fn bad_arguments_are_typed_errors() {
     ));
     let _ = sigmoid(0.0);
 }
+
+#[test]
+fn every_change_in_the_equilibrium_count_has_its_fold() {
+    let mut changes = 0;
+    for seed in 0..30 {
+        let net = random_net(2 + seed as usize % 2, 100 + seed);
+        let sweep = Sweep {
+            from: -2.0,
+            to: 2.0,
+            steps: 41,
+            ..Sweep::default()
+        };
+        let b = bifurcation(&net, &[0.0], &sweep, None).unwrap();
+        for s in 0..b.values.len() - 1 {
+            let (here, next) = (b.equilibria[s].len(), b.equilibria[s + 1].len());
+            if here == next {
+                continue;
+            }
+            changes += 1;
+            let folds = b
+                .events
+                .iter()
+                .filter(|e| e.kind == EventKind::Fold)
+                .filter(|e| b.values[s] <= e.value && e.value <= b.values[s + 1])
+                .count();
+            assert!(
+                2 * folds >= here.abs_diff(next),
+                "seed {seed}: {here} -> {next} equilibria between {} and {} with {folds} folds",
+                b.values[s],
+                b.values[s + 1]
+            );
+        }
+    }
+    assert!(changes >= 5, "only {changes} changes to check");
+}

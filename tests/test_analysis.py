@@ -196,3 +196,18 @@ def test_every_change_in_the_equilibrium_count_of_a_champion_has_its_fold() -> N
         folds = [e for e in b.events if e.kind == "fold" and b.values[s] <= e.value <= b.values[s + 1]]
         assert 2 * len(folds) >= abs(counts[s + 1] - counts[s]), (b.values[s], counts[s], counts[s + 1])
     assert [round(e.value, 3) for e in b.events] == [0.061, 0.401, 0.601]
+
+
+def test_replay_reproduces_a_recorded_trial_and_settles_to_names_attractors() -> None:
+    config = presets.get("sequence-1bit")
+    net = dnnevo.Network.load(DATA / "sequence-1bit-seed0-champion.json")
+    (out0, in0), (out1, in1) = analysis.recorded_trials(config, net, seed=0)
+    states = analysis.replay(config, net, in1)
+    assert 1 / (1 + np.exp(-(states - net.theta))) == pytest.approx(out1, abs=1e-12)
+    stable = [e for e in analysis.equilibria(net, [0.0, 0.0]) if e.stable]
+    assert len(stable) == 2
+    # Each attractor's own state settles to it; a state far from both settles somewhere valid.
+    assert analysis.settles_to(net, [e.state for e in stable], stable).tolist() == [0, 1]
+    which = analysis.settles_to(net, states[::50], stable)
+    assert set(which.tolist()) <= {0, 1}
+    assert analysis.settles_to(net, [stable[0].state], stable[1:]).tolist() == [-1]

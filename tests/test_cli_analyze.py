@@ -51,7 +51,9 @@ def test_analyze_writes_json_and_figures(runs: dict[str, Path], preset: str) -> 
     assert len(doc["lesions"]["lesions"]) == net.size + 2
     i, j = doc["neurons"]
     assert i != j
-    for name in ("analysis-phase.png", "analysis-bifurcation.png", "analysis-lesions.png"):
+    basins = doc["trial_basins"]
+    assert len(basins["basins"]) > 10 and set(basins["basins"]) <= {-1, *range(len(basins["attractors"]))}
+    for name in ("analysis-phase.png", "analysis-bifurcation.png", "analysis-lesions.png", "analysis-basins.png"):
         assert_png(run / name)
     assert not [p for p in run.iterdir() if p.name.startswith(".")], "temporary files left behind"
 

@@ -34,7 +34,9 @@ and cut the N strongest connections, then judge the champion on the same fresh t
 'dnnevo evaluate'. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
 two neurons, the most active unless --neurons, with a real trial, equilibria by stability, cycles,
 and nullclines for 2 neurons), analysis-bifurcation.png (the firing rate of the neuron whose
-equilibria move most) and analysis-lesions.png."""
+equilibria move most), analysis-basins.png (the recorded trials over time, on a background that
+says which attractor of the first --input the state would settle in if that input were held
+from then on) and analysis-lesions.png."""
 
 TASK_INPUTS: dict[str, dict[str, list[float]]] = {
     "sequence": {"off": [0.0, 0.0], "trigger": [1.0, 0.0], "reinforcement": [0.0, 1.0]},
@@ -131,7 +133,10 @@ def analyze(args: argparse.Namespace) -> int:
             raise InvalidArgumentError(f"--input {name} has {len(v)} values; this network has {m} sensors")
     found = [analysis.attractors(net, v, name) for name, v in conditions.items()]
 
-    outputs, _ = analysis.trial_outputs(config, net, seed=args.seed)
+    trials = analysis.recorded_trials(config, net, seed=args.seed)
+    outputs = np.vstack([o for o, _ in trials])
+    inputs = np.vstack([i for _, i in trials])
+    basins = _basins(config, net, trials, found[0])
     if args.neurons:
         neurons = _pair(args.neurons, net.size)
     else:
@@ -149,17 +154,21 @@ def analyze(args: argparse.Namespace) -> int:
     table = analysis.lesions(config, net, args.trials, seed=args.seed, cuts=args.cuts) if args.lesions else None
     elapsed = time.perf_counter() - started
 
+    stable = [e for e in found[0].equilibria if e.stable]
     doc = {
         "format": "dnnevo-analysis", "version": 1, "run": str(args.dir), "task": config.task,
         "size": net.size, "seed": args.seed, "neurons": list(neurons),
         "conditions": [a.to_dict() for a in found],
         "bifurcation": {"input_name": name, "shown_neuron": _moving_neuron(bif), **bif.to_dict()},
         "lesions": table.to_dict() if table else None,
+        "trial_basins": {"input": found[0].input.tolist(), "attractors": [e.outputs.tolist() for e in stable],
+                         "every": basins[0], "basins": basins[1].tolist()},
         "elapsed_s": elapsed,
     }
     write_atomic(run.path / "analysis.json", json.dumps(doc, indent=1) + "\n")
     written = ["analysis.json", *_figures(run, net, found, bif, table, outputs, neurons, name)]
-    print("\n".join(summary(found, bif, table, name)))
+    written.append(_basin_figure(run, config, trials, basins, found[0]))
+    print("\n".join(summary(found, bif, table, name, basins)))
     print(f"analysed in {elapsed:.1f} s; wrote {', '.join(str(run.path / w) for w in written)}")
     return 0
 
@@ -191,6 +200,46 @@ def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifu
     return written
 
 
+BASIN_STATES = 1500
+"""The most trial steps whose basin is computed; longer recordings are subsampled evenly."""
+
+INPUT_NAMES = {"sequence": ["trigger", "reinforcement"], "landmark": ["sonar input"],
+               "nav1d": ["landmark", "reinforcement"]}
+
+
+def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.ndarray, np.ndarray]],
+            off: Attractors) -> tuple[int, np.ndarray]:
+    """Every ``every``-th step of the recorded trials: which stable equilibrium of the first
+    condition the state would settle in (-1: none)."""
+    states = np.vstack([analysis.replay(config, net, i) for _, i in trials])
+    every = max(1, -(-len(states) // BASIN_STATES))
+    stable = [e for e in off.equilibria if e.stable]
+    return every, analysis.settles_to(net, states[::every], stable, off.input)
+
+
+def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.ndarray, np.ndarray]],
+                  basins: tuple[int, np.ndarray], off: Attractors) -> str:
+    import matplotlib.pyplot as plt
+
+    from dnnevo.plot import plot_basins
+
+    every, which = basins
+    outputs = np.vstack([o for o, _ in trials])[::every]
+    inputs = np.vstack([i for _, i in trials])[::every]
+    names = INPUT_NAMES[config.task]
+    starts = np.cumsum([0] + [len(o) for o, _ in trials])[1:-1] // every
+    stable = [e for e in off.equilibria if e.stable]
+    labels = [f"{chr(65 + k)} (output {e.outputs[0]:.2f})" for k, e in enumerate(stable)]
+    fig, ax = plt.subplots(figsize=(9.0, 3.6), layout="constrained")
+    plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,
+                boundaries=list(starts),
+                title=f"{run.path.name}: recorded trials; background: where the state would settle "
+                      f"with input {off.label}")
+    _savefig(fig, run.path / "analysis-basins.png")
+    plt.close(fig)
+    return "analysis-basins.png"
+
+
 def _moving_neuron(bif: Bifurcation) -> int:
     """The neuron whose equilibrium firing rate spans the widest range over the sweep (the lowest
     index among equals, 0 when nothing moves)."""
@@ -206,7 +255,8 @@ def _eq_line(e: analysis.Equilibrium) -> str:
     return f"    {e.stability.replace('_', ' '):<15} outputs [{rates}]{scale}"
 
 
-def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None, name: str) -> list[str]:
+def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None, name: str,
+            basins: tuple[int, np.ndarray] | None = None) -> list[str]:
     """The printed report."""
     lines = []
     for a in found:
@@ -224,6 +274,12 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
                          f"largest multiplier {c.max_multiplier:.3g}")
     events = ", ".join(f"{e.kind} at {e.value:.4g}" for e in bif.events) or "none"
     lines.append(f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}")
+    if basins is not None:
+        every, which = basins
+        shares = ", ".join(f"{chr(65 + k)} {np.mean(which == k):.0%}" for k in range(int(which.max(initial=-1)) + 1))
+        lines.append(f"recorded trials: the state would settle in {shares}"
+                     + (f", none {np.mean(which < 0):.0%}" if (which < 0).any() else "")
+                     + f" (input {found[0].label} attractors, by stable equilibrium order)")
     if table is not None:
         lines.append(f"lesions ({table.trials} fresh trials, seed {table.seed}): intact score {table.score:.3f} "
                      f"({table.verdict})")

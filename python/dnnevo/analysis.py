@@ -36,7 +36,7 @@ import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -62,6 +62,10 @@ __all__ = [
     "equilibria",
     "lesions",
     "limit_cycles",
+    "recorded_trials",
+    "replay",
+    "settles_to",
+    "trial_outputs",
     "vector_field",
 ]
 
@@ -370,38 +374,77 @@ class LesionTable:
                              "drop": x.drop, "verdict": x.verdict} for x in self.lesions]}
 
 
-def trial_outputs(config: EvolutionConfig, net: _core.Network, *, seed: int) -> tuple[_Array, _Array]:
-    """Firing rates (T, N) and inputs (T, M) of real trials of ``config``'s task, drawn from
-    ``seed``: one trial per target (sequence), one per landmark (landmark), one fresh chain
-    (nav1d)."""
+def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -> list[tuple[_Array, _Array]]:
+    """Real trials of ``config``'s task drawn from ``seed``, each as (firing rates (T, N), inputs
+    (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain of 2
+    trials (nav1d)."""
     nonnegative("seed", seed)
-    outs: list[_Array] = []
-    ins: list[_Array] = []
+    out: list[tuple[_Array, _Array]] = []
     if config.task == "sequence":
         from dnnevo import sequence
 
         for k, target in enumerate(config.task_params.get("targets", ["0", "1"])):
             r = sequence.run_trial(config, net, target, sequence.timings(config, seed, 0, k))
-            outs.append(r.outputs)
-            ins.append(np.column_stack([r.trigger, r.reinforcement]))
+            out.append((r.outputs, np.column_stack([r.trigger, r.reinforcement])))
     elif config.task == "landmark":
         from dnnevo import landmark
 
         for which in (1, 2):
             lr = landmark.record(config, net, which, seed=seed)
-            outs.append(lr.outputs)
-            ins.append(lr.input.reshape(-1, 1))
+            out.append((lr.outputs, lr.input.reshape(-1, 1)))
     elif config.task == "nav1d":
         from dnnevo import nav1d
 
         chain = nav1d.fresh_chains(config, 1, 2, seed)[0]
         nr = nav1d.record(config, net, chain)
-        outs.append(nr.outputs)
-        cols = [nr.landmark, nr.reinforcement][: net.n_inputs]
-        ins.append(np.column_stack(cols))
+        out.append((nr.outputs, np.column_stack([nr.landmark, nr.reinforcement][: net.n_inputs])))
     else:
         raise InvalidArgumentError(f"task {config.task!r} has no recorded trials to analyse")
-    return np.vstack(outs), np.vstack(ins)
+    return out
+
+
+def trial_outputs(config: EvolutionConfig, net: _core.Network, *, seed: int) -> tuple[_Array, _Array]:
+    """The :func:`recorded_trials` of ``seed`` stacked: firing rates (T, N) and inputs (T, M)."""
+    trials = recorded_trials(config, net, seed=seed)
+    return np.vstack([o for o, _ in trials]), np.vstack([i for _, i in trials])
+
+
+def replay(config: EvolutionConfig, net: _core.Network, inputs: npt.ArrayLike) -> _Array:
+    """The states (T, N) of ``net`` from ``v = 0`` driven by recorded ``inputs`` (T, M), one row
+    per time step, with the config's integrator: a recorded sequence or landmark trial exactly;
+    a nav1d trial to within the recording's time step (its landmark input is the fraction of a
+    time step spent on the landmark)."""
+    n = net.copy()
+    n.reset()
+    i = config.integrator
+    method = cast(Literal["euler", "rk4"], i.method)
+    return np.asarray(n.run(np.asarray(inputs, dtype=float), dt=i.dt, substeps=i.substeps, method=method).states)
+
+
+def settles_to(
+    net: _core.Network, states: npt.ArrayLike, targets: Sequence[Equilibrium], input: npt.ArrayLike | None = None,
+    *, duration: float | None = None, tolerance: float = 1e-2,
+) -> npt.NDArray[np.int64]:
+    """For each state (rows of ``states``), the index in ``targets`` of the equilibrium it
+    reaches when the sensors are then held at ``input`` for ``duration`` (default: 30 largest
+    time constants), integrated by RK4 at a step of a fifth of the smallest time constant; -1
+    when it ends farther than ``tolerance`` (in firing rate) from every target. With ``input`` off
+    and the stable equilibria as ``targets``, this says which attractor holds the state."""
+    v = np.asarray(states, dtype=float).reshape(-1, net.size)
+    dt = float(np.min(net.tau)) / 5
+    steps = int(math.ceil((duration if duration is not None else 30 * float(np.max(net.tau))) / dt))
+    u = np.tile(np.asarray(_input(net, input)), (steps, 1))
+    goals = np.array([e.outputs for e in targets]).reshape(len(targets), net.size)
+    out = np.full(len(v), -1, dtype=np.int64)
+    for k, s in enumerate(v):
+        n = net.copy()
+        n.reset(s)
+        end = n.run(u, dt=dt, method="rk4").outputs[-1]
+        if len(goals):
+            d = np.max(np.abs(goals - end), axis=1)
+            if d.min() <= tolerance:
+                out[k] = int(np.argmin(d))
+    return out
 
 
 def _score(a: Any) -> float:

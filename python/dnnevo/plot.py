@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from dnnevo.nav1d import Record as Nav1dRecord
     from dnnevo.sequence import TrialRecord
 
-__all__ = ["plot_bifurcation", "plot_fitness", "plot_landmark_world", "plot_lesions", "plot_nav1d_path",
+__all__ = ["plot_basins", "plot_bifurcation", "plot_fitness", "plot_landmark_world", "plot_lesions", "plot_nav1d_path",
            "plot_nav1d_traces", "plot_phase_portrait", "plot_sequence_trial", "plot_traces"]
 
 
@@ -318,6 +318,44 @@ def plot_lesions(table: LesionTable, ax: Axes | None = None, *, title: str | Non
     ax.invert_yaxis()
     ax.axvline(0.0, color="k", lw=0.6)
     ax.set_xlabel(f"score drop (intact score {table.score:.3f}, {table.trials} fresh trials, seed {table.seed})")
+    if title:
+        ax.set_title(title, fontsize=10)
+    return ax
+
+
+_BASIN_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:olive"]
+
+
+def plot_basins(
+    outputs: npt.ArrayLike, inputs: Mapping[str, npt.ArrayLike], basins: npt.ArrayLike, ax: Axes | None = None, *,
+    labels: Sequence[str], neuron: int = 0, boundaries: Sequence[int] = (), title: str | None = None,
+) -> Axes:
+    """A trial over time: the firing rate of ``neuron`` (red) and each input, on a background
+    coloured by ``basins[t]``, the index into ``labels`` of the attractor the state at step t
+    would settle in if the input were switched off (white where none). ``boundaries`` are the
+    steps where a new trial starts."""
+    ax = _axes(ax)
+    b = np.asarray(basins)
+    t = np.arange(len(b))
+    edges = np.flatnonzero(np.diff(b)) + 1
+    for lo, hi in zip(np.concatenate([[0], edges]), np.concatenate([edges, [len(b)]]), strict=True):
+        k = int(b[lo])
+        if k >= 0:
+            ax.axvspan(lo - 0.5, hi - 0.5, color=_BASIN_COLORS[k % len(_BASIN_COLORS)], alpha=0.18, lw=0)
+    for name, values in inputs.items():
+        ax.plot(t, np.asarray(values, dtype=float), drawstyle="steps-mid", lw=0.9, label=name)
+    ax.plot(t, np.asarray(outputs, dtype=float)[:, neuron], color="tab:red", lw=1.4, label=f"output of neuron {neuron}")
+    for x in boundaries:
+        ax.axvline(x - 0.5, color="k", lw=0.8, ls="--")
+    from matplotlib.patches import Patch
+
+    handles, _ = ax.get_legend_handles_labels()
+    handles += [Patch(color=_BASIN_COLORS[k % len(_BASIN_COLORS)], alpha=0.3, label=f"would settle in {name}")
+                for k, name in enumerate(labels)]
+    ax.legend(handles=handles, loc="center right", fontsize=7)
+    ax.set_xlim(-0.5, len(b) - 0.5)
+    ax.set_ylim(-0.05, 1.1)
+    ax.set_xlabel("time step")
     if title:
         ax.set_title(title, fontsize=10)
     return ax

@@ -278,11 +278,23 @@ class Attractors:
                 "cycles": [c.to_dict(orbit=orbits) for c in self.cycles]}
 
 
+RETRY_STARTS = 8192
+""":func:`attractors` searches again with this many starts when it finds an even number of
+equilibria."""
+
+
 def attractors(net: _core.Network, input: npt.ArrayLike | None = None, label: str = "") -> Attractors:
-    """:func:`equilibria` and :func:`limit_cycles` under ``input``, with the default settings."""
+    """:func:`equilibria` and :func:`limit_cycles` under ``input``, with the default settings.
+
+    A generic network has an odd number of equilibria (their indices add up to 1, since the
+    vector field points inward on a large box), so an even count means some were missed: the
+    search is then repeated with :data:`RETRY_STARTS` starts (0.2 s for 10 neurons)."""
     values = _input(net, input)
-    return Attractors(label or ",".join(f"{x:g}" for x in values), np.array(values),
-                      equilibria(net, values), limit_cycles(net, values))
+    found = equilibria(net, values)
+    if len(found) % 2 == 0:
+        found = equilibria(net, values, starts=RETRY_STARTS)
+    return Attractors(label or ",".join(f"{x:g}" for x in values), np.array(values), found,
+                      limit_cycles(net, values))
 
 
 def vector_field(net: _core.Network, input: npt.ArrayLike | None, states: npt.ArrayLike) -> _Array:

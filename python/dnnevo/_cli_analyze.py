@@ -200,6 +200,16 @@ def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifu
     return written
 
 
+OUTPUT_NEURON = {"sequence": 0, "landmark": 0, "nav1d": 2}
+"""The neuron whose firing rate is the task's answer, by default (``task_params.classifier``
+overrides it for landmark and nav1d, as in ``crates/tasks``)."""
+
+
+def output_neuron(config: EvolutionConfig) -> int:
+    """The neuron whose firing rate is ``config``'s task's answer."""
+    return int(config.task_params.get("classifier", OUTPUT_NEURON[config.task]))
+
+
 BASIN_STATES = 1500
 """The most trial steps whose basin is computed; longer recordings are subsampled evenly."""
 
@@ -229,10 +239,11 @@ def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.nd
     names = INPUT_NAMES[config.task]
     starts = np.cumsum([0] + [len(o) for o, _ in trials])[1:-1] // every
     stable = [e for e in off.equilibria if e.stable]
-    labels = [f"{chr(65 + k)} (output {e.outputs[0]:.2f})" for k, e in enumerate(stable)]
+    neuron = output_neuron(config)
+    labels = [f"{chr(65 + k)} (neuron {neuron} at {e.outputs[neuron]:.2f})" for k, e in enumerate(stable)]
     fig, ax = plt.subplots(figsize=(9.0, 3.6), layout="constrained")
     plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,
-                boundaries=list(starts),
+                neuron=neuron, boundaries=list(starts),
                 title=f"{run.path.name}: recorded trials; background: where the state would settle "
                       f"with input {off.label}")
     _savefig(fig, run.path / "analysis-basins.png")

@@ -211,3 +211,17 @@ def test_replay_reproduces_a_recorded_trial_and_settles_to_names_attractors() ->
     which = analysis.settles_to(net, states[::50], stable)
     assert set(which.tolist()) <= {0, 1}
     assert analysis.settles_to(net, [stable[0].state], stable[1:]).tolist() == [-1]
+
+
+def test_a_sweep_with_cycles_brackets_them_by_its_hopf_points() -> None:
+    net = centre_pair(4.5, 4.0)
+    b = analysis.bifurcation(net, 0, -4.0, 4.0, steps=33, cycle_starts=2)
+    hopf = [e.value for e in b.events if e.kind == "hopf"]
+    assert len(hopf) == 2
+    inside = [len(c) for v, c in zip(b.values, b.cycles, strict=True) if hopf[0] + 0.3 < v < hopf[1] - 0.3]
+    outside = [len(c) for v, c in zip(b.values, b.cycles, strict=True) if v < hopf[0] - 0.3 or v > hopf[1] + 0.3]
+    assert inside and set(inside) == {1} and outside and set(outside) == {0}
+    c = b.cycles[16][0]  # input 0: the centre-crossing oscillator
+    assert c.stable and c.output_range.shape == (2, 2) and c.output_range[0, 0] < 0.5 < c.output_range[0, 1]
+    assert b.to_dict()["cycles"][16][0]["period"] == c.period
+    assert analysis.bifurcation(net, 0, -1.0, 1.0, steps=3).cycles == [[], [], []]

@@ -23,13 +23,13 @@ from dnnevo.rundir import RunDir, write_atomic
 EXAMPLE = """examples:
   dnnevo run sequence-1bit --quick --out runs/demo && dnnevo analyze runs/demo
   dnnevo analyze runs/demo --input 0,0 --input 0,1 --neurons 0,2
-  dnnevo analyze runs/demo --sweep 0:1 --sweep-input 1 --no-lesions
+  dnnevo analyze runs/demo --sweep 0:1 --sweep-input 1 --sweep-cycles --no-lesions
 
 With the sensors held at each --input vector (default: each of the task's inputs on alone, and
 all off), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
 saddle, unstable) and attracting limit cycles are found and printed. --sweep varies one input
 (default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
-points (H: a cycle is born). Lesions clamp each neuron at its mean firing rate over real trials,
+points (H: a cycle is born); --sweep-cycles also finds the cycles along it. Lesions clamp each neuron at its mean firing rate over real trials,
 and cut the N strongest connections, then judge the champion on the same fresh trials as
 'dnnevo evaluate'. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
 two neurons, the most active unless --neurons, with a real trial, equilibria by stability, cycles,
@@ -65,6 +65,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--sweep", metavar="START:STOP", default="0:1", help="the swept input's range (default 0:1)")
     p.add_argument("--sweep-input", type=int, metavar="K", help="which input to sweep (default: the task's main one)")
     p.add_argument("--steps", type=int, default=101, help="input values in the sweep (default 101)")
+    p.add_argument("--sweep-cycles", action="store_true",
+                   help="also search each swept value for limit cycles (4 starts; about 100x slower)")
     p.add_argument("--trials", type=int, default=DEFAULT_LESION_TRIALS,
                    help=f"fresh trials per lesion, in 'dnnevo evaluate --trials' units (default {DEFAULT_LESION_TRIALS})")
     p.add_argument("--cuts", type=int, default=None, help="strongest connections to cut (default N)")
@@ -149,7 +151,7 @@ def analyze(args: argparse.Namespace) -> int:
             raise InvalidArgumentError(f"--sweep-input is {args.sweep_input}; this network's inputs are 0..{m - 1}")
         index, name = args.sweep_input, f"input {args.sweep_input}"
     start, stop = _range(args.sweep)
-    bif = analysis.bifurcation(net, index, start, stop, steps=args.steps)
+    bif = analysis.bifurcation(net, index, start, stop, steps=args.steps, cycle_starts=4 if args.sweep_cycles else 0)
 
     table = analysis.lesions(config, net, args.trials, seed=args.seed, cuts=args.cuts) if args.lesions else None
     elapsed = time.perf_counter() - started

@@ -259,4 +259,5 @@ def analysis_bifurcation(
     distinct: float = 1e-06,
     max_iterations: int = 100,
     seed: int = 0,
+    cycle_starts: int = 0,
 ) -> str: ...

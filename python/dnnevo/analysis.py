@@ -136,6 +136,8 @@ class Cycle:
     amplitude: _Array
     """Per neuron, max minus min of the state over one period."""
     mean_outputs: _Array
+    output_range: _Array
+    """Per neuron, the lowest and highest firing rate over one period, shape (N, 2)."""
     multipliers: npt.NDArray[np.complex128]
     """Floquet multipliers, largest modulus first; one of them is 1 (along the orbit)."""
     max_multiplier: float
@@ -150,14 +152,14 @@ class Cycle:
         """From the JSON form the Rust core returns."""
         return cls(float(d["period"]), int(d["crossings"]), int(d["section_neuron"]),
                    np.array(d["amplitude"], dtype=float), np.array(d["mean_outputs"], dtype=float),
-                   _complex(d["multipliers"]), float(d["max_multiplier"]), bool(d["stable"]),
+                   np.array(d["output_range"], dtype=float).reshape(-1, 2), _complex(d["multipliers"]), float(d["max_multiplier"]), bool(d["stable"]),
                    np.array(d["orbit"], dtype=float))
 
     def to_dict(self, *, orbit: bool = True) -> dict[str, Any]:
         """As plain JSON types; ``orbit=False`` leaves the orbit out."""
         d: dict[str, Any] = {"period": self.period, "crossings": self.crossings,
                              "section_neuron": self.section_neuron, "amplitude": self.amplitude.tolist(),
-                             "mean_outputs": self.mean_outputs.tolist(),
+                             "mean_outputs": self.mean_outputs.tolist(), "output_range": self.output_range.tolist(),
                              "multipliers": _pairs(self.multipliers), "max_multiplier": self.max_multiplier,
                              "stable": self.stable}
         if orbit:
@@ -193,11 +195,14 @@ class Bifurcation:
     values: _Array
     equilibria: list[list[Equilibrium]]
     events: list[Event]
+    cycles: list[list[Cycle]] = field(default_factory=list)
+    """The attracting cycles at each value (empty lists unless the sweep searched for them)."""
 
     def to_dict(self) -> dict[str, Any]:
-        """As plain JSON types."""
+        """As plain JSON types (cycles without their orbits)."""
         return {"index": self.index, "input": self.input.tolist(), "values": self.values.tolist(),
                 "equilibria": [[e.to_dict() for e in row] for row in self.equilibria],
+                "cycles": [[c.to_dict(orbit=False) for c in row] for row in self.cycles],
                 "events": [e.to_dict() for e in self.events]}
 
 
@@ -247,19 +252,23 @@ def limit_cycles(
 
 def bifurcation(
     net: _core.Network, index: int, start: float, stop: float, *, input: npt.ArrayLike | None = None,
-    steps: int = 101, starts: int = 128, seed: int = 0,
+    steps: int = 101, starts: int = 128, seed: int = 0, cycle_starts: int = 0,
 ) -> Bifurcation:
     """Sweeps input ``index`` over ``steps`` values from ``start`` to ``stop`` (the other inputs
     held at ``input``, default 0), following the equilibria (each value's search also starts
-    from the previous value's equilibria) and locating folds and Hopf points by bisection."""
+    from the previous value's equilibria) and locating folds and Hopf points by bisection. With
+    ``cycle_starts > 0`` it also searches each value for attracting cycles (the
+    :func:`limit_cycles` defaults with that many starts, plus the previous value's cycles); that
+    costs about as much as 100 equilibrium searches per value."""
     base = _input(net, input)
     d = json.loads(_core.analysis_bifurcation(net, base, index, start, stop, steps=steps, starts=starts,
-                                              seed=seed))
+                                              seed=seed, cycle_starts=cycle_starts))
     events = [Event(e["kind"], float(e["value"]), np.array(e["state"], dtype=float),
                     complex(*(math.nan if x is None else x for x in e["eigenvalue"])))
               for e in d["events"]]
     return Bifurcation(int(d["input"]), np.array(base), np.array(d["values"], dtype=float),
-                       [[Equilibrium.from_dict(e) for e in row] for row in d["equilibria"]], events)
+                       [[Equilibrium.from_dict(e) for e in row] for row in d["equilibria"]], events,
+                       [[Cycle.from_dict(c) for c in row] for row in d["cycles"]])
 
 
 @dataclass(frozen=True)

@@ -284,7 +284,8 @@ def plot_bifurcation(
     title: str | None = None,
 ) -> Axes:
     """The equilibria's firing rate of ``neuron`` against the swept input, coloured by
-    stability, with the folds (F) and Hopf points (H) marked by dotted lines."""
+    stability, the attracting cycles' range of it (black bars) when the sweep searched for them,
+    and the folds (F) and Hopf points (H) marked by dotted lines."""
     ax = _axes(ax)
     for s, color in STABILITY_COLORS.items():
         pts = [(v, e.outputs[neuron]) for v, row in zip(result.values, result.equilibria, strict=True)
@@ -292,6 +293,14 @@ def plot_bifurcation(
         if pts:
             x, y = np.array(pts).T
             ax.scatter(x, y, s=9, color=color, label=s.replace("_", " "), zorder=3)
+    ranges = [(v, c.output_range[neuron]) for v, row in zip(result.values, result.cycles, strict=False)
+              for c in row]
+    if ranges:
+        x = np.array([v for v, _ in ranges])
+        lo, hi = np.array([r for _, r in ranges]).T
+        ax.vlines(x, lo, hi, color="k", lw=0.8, alpha=0.5, zorder=2)
+        ax.scatter(np.concatenate([x, x]), np.concatenate([lo, hi]), s=9, marker="_", color="k",
+                   label="cycle (min, max)", zorder=3)
     for e in result.events:
         ax.axvline(e.value, color="0.4", lw=0.7, ls=":")
         ax.text(e.value, 1.04, "F" if e.kind == "fold" else "H", ha="center", fontsize=8)

@@ -84,9 +84,10 @@ pub fn analysis_cycles(
     Ok(to_json(&found))
 }
 
-/// A sweep of input `index` from `start` to `stop` with the others held at `input`, as JSON.
+/// A sweep of input `index` from `start` to `stop` with the others held at `input`, as JSON;
+/// with `cycle_starts > 0` it also searches for limit cycles at each value from that many starts.
 #[pyfunction]
-#[pyo3(signature = (net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0))]
+#[pyo3(signature = (net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_bifurcation(
     py: Python<'_>,
@@ -101,7 +102,9 @@ pub fn analysis_bifurcation(
     distinct: f64,
     max_iterations: i64,
     seed: i64,
+    cycle_starts: i64,
 ) -> PyResult<String> {
+    let cycle_starts = count("cycle_starts", cycle_starts, 0)?;
     let sweep = Sweep {
         input: count("index", index, 0)?,
         from: start,
@@ -114,6 +117,10 @@ pub fn analysis_bifurcation(
             max_iterations: count("max_iterations", max_iterations, 1)?,
             seed: self::seed(seed)?,
         },
+        cycles: (cycle_starts > 0).then(|| CycleSearch {
+            starts: cycle_starts,
+            ..CycleSearch::default()
+        }),
     };
     let net = &net.inner;
     let found = detached(py, f64::INFINITY, |cancel| {

@@ -1,5 +1,5 @@
-//! A bifurcation sweep: one input varied from `from` to `to`, the equilibria followed, and the
-//! folds and Hopf points between them located.
+//! A bifurcation sweep: one input varied from `from` to `to`, the equilibria (and, if asked, the
+//! attracting limit cycles) followed, and the folds and Hopf points between them located.
 //!
 //! At each input value the equilibria are searched afresh, with the previous value's equilibria
 //! as extra Newton starts (natural continuation). Consecutive values are linked by mutual
@@ -22,6 +22,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde::Serialize;
 
+use super::cycles::{self, Cycle, CycleSearch};
 use super::equilibria::{max_abs, newton, search, Equilibrium, EquilibriumSearch};
 use super::field::Field;
 use super::stability::eigenvalues;
@@ -51,6 +52,9 @@ pub struct Sweep {
     /// The equilibrium search at each value. Default: [`EquilibriumSearch::default`] with 128
     /// starts (the previous value's equilibria are also starts).
     pub search: EquilibriumSearch,
+    /// The limit-cycle search at each value, if any (the previous value's cycles are also
+    /// starts). Default: None, since it costs about 100 times an equilibrium search.
+    pub cycles: Option<CycleSearch>,
 }
 
 impl Default for Sweep {
@@ -64,6 +68,7 @@ impl Default for Sweep {
                 starts: 128,
                 ..EquilibriumSearch::default()
             },
+            cycles: None,
         }
     }
 }
@@ -89,6 +94,9 @@ impl Sweep {
                 "steps is {}; a sweep needs at least 2 input values",
                 self.steps
             )));
+        }
+        if let Some(c) = &self.cycles {
+            c.validate()?;
         }
         self.search.validate()
     }
@@ -131,6 +139,9 @@ pub struct Bifurcation {
     pub values: Vec<f64>,
     /// The equilibria at each value, sorted by state.
     pub equilibria: Vec<Vec<Equilibrium>>,
+    /// The attracting limit cycles at each value, sorted by period (empty lists unless the
+    /// sweep searched for cycles).
+    pub cycles: Vec<Vec<Cycle>>,
     /// Folds and Hopf points, by input value.
     pub events: Vec<Event>,
 }
@@ -336,6 +347,7 @@ pub fn bifurcation(
     };
     let values: Vec<f64> = (0..sweep.steps).map(|s| sweep.value(s)).collect();
     let mut equilibria: Vec<Vec<Equilibrium>> = Vec::with_capacity(sweep.steps);
+    let mut cycles: Vec<Vec<Cycle>> = Vec::with_capacity(sweep.steps);
     for &p in &values {
         if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return Err(Error::Interrupted);
@@ -345,6 +357,17 @@ pub fn bifurcation(
             .map(|prev| prev.iter().map(|e| e.state.clone()).collect())
             .unwrap_or_default();
         equilibria.push(search(&at.field(p)?, &sweep.search, &extra)?);
+        let found = match &sweep.cycles {
+            None => Vec::new(),
+            Some(settings) => {
+                let extra: Vec<Vec<f64>> = cycles
+                    .last()
+                    .map(|prev: &Vec<Cycle>| prev.iter().map(|c| c.orbit[0].clone()).collect())
+                    .unwrap_or_default();
+                cycles::search(&at.field(p)?, settings, &extra, cancel)?
+            }
+        };
+        cycles.push(found);
     }
     let mut events = Vec::new();
     for s in 0..sweep.steps - 1 {
@@ -394,6 +417,7 @@ pub fn bifurcation(
         input: sweep.input,
         values,
         equilibria,
+        cycles,
         events: merged,
     })
 }

@@ -106,6 +106,8 @@ pub struct Cycle {
     pub amplitude: Vec<f64>,
     /// Per neuron, the mean firing rate over one period.
     pub mean_outputs: Vec<f64>,
+    /// Per neuron, the lowest and highest firing rate over one period.
+    pub output_range: Vec<[f64; 2]>,
     /// Floquet multipliers `[re, im]`, largest modulus first; one of them is 1.
     pub multipliers: Vec<[f64; 2]>,
     /// The largest multiplier modulus other than the trivial one (0 for N = 1).
@@ -268,6 +270,12 @@ fn describe(
         crossings,
         section_neuron,
         amplitude: (0..n).map(|i| hi[i] - lo[i]).collect(),
+        output_range: (0..n)
+            .map(|i| {
+                let f = |v: f64| crate::math::sigmoid(v - theta[i]);
+                [f(lo[i]), f(hi[i])]
+            })
+            .collect(),
         mean_outputs: mean,
         multipliers: moduli.iter().map(|(_, k)| multipliers[*k]).collect(),
         max_multiplier,
@@ -337,10 +345,11 @@ fn from_start(
     Ok(None)
 }
 
-/// The distinct attracting limit cycles reached from the search's starts.
+/// The distinct attracting limit cycles reached from `extra` starts and the search's own.
 pub(crate) fn search(
     field: &Field<'_>,
     settings: &CycleSearch,
+    extra: &[Vec<f64>],
     cancel: Option<&AtomicBool>,
 ) -> Result<Vec<Cycle>> {
     settings.validate()?;
@@ -349,7 +358,8 @@ pub(crate) fn search(
     let tau_min = tau.iter().fold(f64::INFINITY, |m: f64, t| m.min(*t));
     let dt = tau_min / settings.steps_per_tau as f64;
     let mut found: Vec<Cycle> = Vec::new();
-    for start in starting_states(field, settings.starts, settings.seed) {
+    let starts = starting_states(field, settings.starts, settings.seed);
+    for start in extra.iter().cloned().chain(starts) {
         let Some(cycle) = from_start(field, start, dt, settings, tau_max, cancel)? else {
             continue;
         };
@@ -399,5 +409,5 @@ pub fn limit_cycles(
     settings: &CycleSearch,
     cancel: Option<&AtomicBool>,
 ) -> Result<Vec<Cycle>> {
-    search(&Field::new(net, input)?, settings, cancel)
+    search(&Field::new(net, input)?, settings, &[], cancel)
 }

@@ -231,6 +231,7 @@ fn hopf_points_have_a_pair_on_the_imaginary_axis() {
         .filter(|e| e.kind == EventKind::Hopf)
         .collect();
     assert_eq!(hopf.len(), 2, "{:?}", b.events);
+    assert!(b.cycles.iter().all(|c| c.is_empty()));
     for e in hopf {
         // For two neurons the pair's real part is half the trace, here by finite differences.
         let j = fd_jacobian(&net, &[e.value], &e.state);
@@ -396,4 +397,46 @@ fn every_change_in_the_equilibrium_count_has_its_fold() {
         }
     }
     assert!(changes >= 5, "only {changes} changes to check");
+}
+
+#[test]
+fn a_sweep_with_cycles_finds_them_between_its_hopf_points() {
+    let net = centre_pair(4.5, 4.0, 1.0);
+    let sweep = Sweep {
+        from: -4.0,
+        to: 4.0,
+        steps: 33,
+        cycles: Some(CycleSearch {
+            starts: 2,
+            transient: 400.0,
+            ..CycleSearch::default()
+        }),
+        ..Sweep::default()
+    };
+    let b = bifurcation(&net, &[0.0], &sweep, None).unwrap();
+    let hopf: Vec<f64> = b
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::Hopf)
+        .map(|e| e.value)
+        .collect();
+    assert_eq!(hopf.len(), 2, "{:?}", b.events);
+    let mut checked = 0;
+    for (p, (found, eq)) in b.values.iter().zip(b.cycles.iter().zip(&b.equilibria)) {
+        // Between the Hopf points the one equilibrium is unstable and a cycle surrounds it;
+        // outside them the equilibrium is stable and no cycle exists. (Values within 0.3 of a
+        // Hopf point are skipped: the cycle there is too small or too slow to close.)
+        if hopf.iter().any(|h| (p - h).abs() < 0.3) {
+            continue;
+        }
+        let inside = hopf[0] < *p && *p < hopf[1];
+        assert_eq!(found.len(), usize::from(inside), "input {p}: {found:?}");
+        assert_eq!(eq.len(), 1);
+        assert_eq!(eq[0].stability.is_stable(), !inside, "input {p}");
+        checked += usize::from(inside);
+    }
+    assert!(
+        checked >= 2,
+        "only {checked} values between the Hopf points"
+    );
 }

@@ -169,7 +169,7 @@ def analyze(args: argparse.Namespace) -> int:
     }
     write_atomic(run.path / "analysis.json", json.dumps(doc, indent=1) + "\n")
     written = ["analysis.json", *_figures(run, net, found, bif, table, outputs, neurons, name)]
-    written.append(_basin_figure(run, config, trials, basins, found[0]))
+    written.append(_basin_figure(run, config, trials, basins, found[0], bif, name))
     print("\n".join(summary(found, bif, table, name, basins)))
     print(f"analysed in {elapsed:.1f} s; wrote {', '.join(str(run.path / w) for w in written)}")
     return 0
@@ -230,7 +230,7 @@ def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.n
 
 
 def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.ndarray, np.ndarray]],
-                  basins: tuple[int, np.ndarray], off: Attractors) -> str:
+                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str) -> str:
     import matplotlib.pyplot as plt
 
     from dnnevo.plot import plot_basins
@@ -245,7 +245,8 @@ def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.nd
     labels = [f"{chr(65 + k)} (neuron {neuron} at {e.outputs[neuron]:.2f})" for k, e in enumerate(stable)]
     fig, ax = plt.subplots(figsize=(9.0, 3.6), layout="constrained")
     plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,
-                neuron=neuron, boundaries=list(starts),
+                neuron=neuron, boundaries=list(starts), levels=[e.value for e in bif.events if e.kind == "fold"],
+                level_label=f"folds of the {name} sweep",
                 title=f"{run.path.name}: recorded trials; background: where the state would settle "
                       f"with input {off.label}")
     _savefig(fig, run.path / "analysis-basins.png")

@@ -337,12 +337,14 @@ _BASIN_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown
 
 def plot_basins(
     outputs: npt.ArrayLike, inputs: Mapping[str, npt.ArrayLike], basins: npt.ArrayLike, ax: Axes | None = None, *,
-    labels: Sequence[str], neuron: int = 0, boundaries: Sequence[int] = (), title: str | None = None,
+    labels: Sequence[str], neuron: int = 0, boundaries: Sequence[int] = (), levels: Sequence[float] = (),
+    level_label: str = "fold", title: str | None = None,
 ) -> Axes:
     """A trial over time: the firing rate of ``neuron`` (red) and each input, on a background
     coloured by ``basins[t]``, the index into ``labels`` of the attractor the state at step t
     would settle in if the input were switched off (white where none). ``boundaries`` are the
-    steps where a new trial starts."""
+    steps where a new trial starts; ``levels`` are input values drawn as dotted lines (for example
+    the folds of a sweep), labelled ``level_label``."""
     ax = _axes(ax)
     b = np.asarray(basins)
     t = np.arange(len(b))
@@ -356,6 +358,8 @@ def plot_basins(
     ax.plot(t, np.asarray(outputs, dtype=float)[:, neuron], color="tab:red", lw=1.4, label=f"output of neuron {neuron}")
     for x in boundaries:
         ax.axvline(x - 0.5, color="k", lw=0.8, ls="--")
+    for k, y in enumerate(levels):
+        ax.axhline(y, color="0.3", lw=0.7, ls=":", label=level_label if k == 0 else None)
     from matplotlib.patches import Patch
 
     handles, _ = ax.get_legend_handles_labels()

@@ -25,14 +25,14 @@ EXAMPLE = """examples:
   dnnevo analyze runs/demo --input 0,0 --input 0,1 --neurons 0,2
   dnnevo analyze runs/demo --sweep 0:1 --sweep-input 1 --sweep-cycles --no-lesions
 
-With the sensors held at each --input vector (default: each of the task's inputs on alone, and
-all off), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
+With the sensors held at each --input vector (default: all off, then each of the task's inputs
+on alone), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
 saddle, unstable) and attracting limit cycles are found and printed. --sweep varies one input
 (default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
-points (H: a cycle is born); --sweep-cycles also finds the cycles along it. Lesions clamp each neuron at its mean firing rate over real trials,
-and cut the N strongest connections, then judge the champion on the same fresh trials as
-'dnnevo evaluate'. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
-two neurons, the most active unless --neurons, with a real trial, equilibria by stability, cycles,
+points (H: a cycle is born); --sweep-cycles also finds the cycles along it. Lesions clamp each
+neuron at its mean firing rate over real trials, and cut the N strongest connections, then judge
+the champion on the same fresh trials as 'dnnevo evaluate'. See docs/analysis.md. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
+two neurons, those that vary most unless --neurons, with a real trial, equilibria by stability, cycles,
 and nullclines for 2 neurons), analysis-bifurcation.png (the firing rate of the neuron whose
 equilibria move most), analysis-basins.png (the recorded trials over time, on a background that
 says which attractor of the first --input the state would settle in if that input were held

@@ -177,8 +177,9 @@ impl Rk4 {
         let (mut ga, mut gb) = (from[k] - level, at_dt - level);
         let mut x = from.to_vec();
         let mut side = 0;
+        let mut h = dt;
         for _ in 0..60 {
-            let h = if gb - ga > 0.0 {
+            h = if gb - ga > 0.0 {
                 a - ga * (b - a) / (gb - ga)
             } else {
                 0.5 * (a + b)
@@ -203,7 +204,7 @@ impl Rk4 {
                 side = 1;
             }
         }
-        (b, x)
+        (h, x)
     }
 }
 

@@ -4,7 +4,6 @@ use nalgebra::DMatrix;
 
 use super::stability::eigenvalues;
 use super::*;
-use crate::math::sigmoid;
 use crate::{Integrator, Method, Network};
 
 fn logit(p: f64) -> f64 {
@@ -361,7 +360,6 @@ fn bad_arguments_are_typed_errors() {
         limit_cycles(&osc, &[0.0], &CycleSearch::default(), Some(&cancel)),
         Err(crate::Error::Interrupted)
     ));
-    let _ = sigmoid(0.0);
 }
 
 #[test]

@@ -13,6 +13,9 @@ __all__ = [
     "Network",
     "Trace",
     "__version__",
+    "analysis_bifurcation",
+    "analysis_cycles",
+    "analysis_equilibria",
     "compose",
     "decode",
     "encode",
@@ -220,3 +223,41 @@ def sim2d_cast_rays(
     world: str, origins: npt.ArrayLike, directions: npt.ArrayLike, max_distance: float
 ) -> npt.NDArray[np.float64]: ...
 def sim2d_landmark_world(n: int) -> str: ...
+def analysis_equilibria(
+    net: Network,
+    input: Sequence[float],
+    *,
+    starts: int = 512,
+    tolerance: float = 1e-10,
+    distinct: float = 1e-06,
+    max_iterations: int = 100,
+    seed: int = 0,
+) -> str: ...
+def analysis_cycles(
+    net: Network,
+    input: Sequence[float],
+    *,
+    starts: int = 8,
+    steps_per_tau: int = 20,
+    transient: float = 100.0,
+    window: float = 100.0,
+    at_rest: float = 1e-06,
+    tolerance: float = 1e-05,
+    orbit_points: int = 200,
+    seed: int = 1,
+) -> str: ...
+def analysis_bifurcation(
+    net: Network,
+    input: Sequence[float],
+    index: int,
+    start: float,
+    stop: float,
+    *,
+    steps: int = 101,
+    starts: int = 128,
+    tolerance: float = 1e-10,
+    distinct: float = 1e-06,
+    max_iterations: int = 100,
+    seed: int = 0,
+    cycle_starts: int = 0,
+) -> str: ...

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 import dnnevo
-from dnnevo import _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, sweep
+from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, sweep
 from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError
@@ -29,6 +29,7 @@ EXAMPLES = """examples:
   dnnevo evaluate runs/demo                        judge the champion on fresh conditions
   dnnevo evaluate runs/demo --json                 ... as JSON; exit 0 pass, 1 fail, 3 undecided
   dnnevo plot runs/demo                            fitness curve and the paper's figures
+  dnnevo analyze runs/demo                         attractors, bifurcations, lesions
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
   dnnevo run nav1d-classifier --out runs/cls       the paper's navigation classifier (6 s)
   dnnevo nav1d-system --classifier runs/cls --far runs/far --near runs/near
@@ -161,6 +162,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--animate", action="store_true",
                    help="landmark runs: also write a GIF of a trial (slower)")
 
+    _cli_analyze.add_parser(sub)
     _cli_nav1d.add_system_parser(sub)
     return parser
 
@@ -264,6 +266,7 @@ COMMANDS = {
     "sweep": _cli_sweep.sweep_command,
     "evaluate": _cli_evaluate.evaluate,
     "plot": _cmd_plot,
+    "analyze": _cli_analyze.analyze,
     "nav1d-system": _cli_nav1d.system,
 }
 

@@ -14,6 +14,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod error;
 pub mod evolve;
 pub mod ga;

@@ -3,6 +3,7 @@
 //! This is the only crate that knows Python. It converts arguments, maps errors to the exception
 //! tree of `dnnevo.errors`, and runs long calls with the GIL released (see [`detach`]).
 
+mod analysis;
 mod arrays;
 mod detach;
 mod errors;
@@ -25,6 +26,8 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 /// The native core of dnnevo.
 #[pymodule]
 mod _core {
+    #[pymodule_export]
+    use super::analysis::{analysis_bifurcation, analysis_cycles, analysis_equilibria};
     #[pymodule_export]
     use super::evolution::{
         decode, encode, evaluate, task_layout, task_names, task_success, PyEvolution,

@@ -1,0 +1,302 @@
+"""The ``dnnevo analyze`` command: a run's champion explained by its attractors (see
+:mod:`dnnevo.analysis`). It writes ``analysis.json`` and three figures into the run folder, each
+atomically, and prints a summary."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dnnevo import _core, analysis
+from dnnevo.analysis import Attractors, Bifurcation, LesionTable
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import ConfigError, InvalidArgumentError
+from dnnevo.rundir import RunDir, write_atomic
+
+EXAMPLE = """examples:
+  dnnevo run sequence-1bit --quick --out runs/demo && dnnevo analyze runs/demo
+  dnnevo analyze runs/demo --input 0,0 --input 0,1 --neurons 0,2
+  dnnevo analyze runs/demo --sweep 0:1 --sweep-input 1 --sweep-cycles --no-lesions
+
+With the sensors held at each --input vector (default: all off, then each of the task's inputs
+on alone), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
+saddle, unstable) and attracting limit cycles are found and printed. --sweep varies one input
+(default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
+points (H: a cycle is born); --sweep-cycles also finds the cycles along it. Lesions clamp each
+neuron at its mean firing rate over real trials, and cut the N strongest connections, then judge
+the champion on the same fresh trials as 'dnnevo evaluate'. See docs/analysis.md. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
+two neurons, those that vary most unless --neurons, with a real trial, equilibria by stability, cycles,
+and nullclines for 2 neurons), analysis-bifurcation.png (the firing rate of the neuron whose
+equilibria move most), analysis-basins.png (the recorded trials over time, on a background that
+says which attractor of the first --input the state would settle in if that input were held
+from then on) and analysis-lesions.png."""
+
+TASK_INPUTS: dict[str, dict[str, list[float]]] = {
+    "sequence": {"off": [0.0, 0.0], "trigger": [1.0, 0.0], "reinforcement": [0.0, 1.0]},
+    "landmark": {"off": [0.0], "sonar 1": [1.0]},
+    "nav1d": {"off": [0.0, 0.0], "landmark": [1.0, 0.0], "reinforcement": [0.0, 1.0]},
+}
+"""The default input conditions per task (nav1d networks without a reinforcement input use the
+first value of each)."""
+
+MAIN_INPUT = {"sequence": (1, "reinforcement"), "landmark": (0, "sonar input"), "nav1d": (0, "landmark")}
+"""The input a sweep varies by default, per task: the one the task's behaviour turns on."""
+
+DEFAULT_LESION_TRIALS = 200
+
+
+def add_parser(sub: Any) -> None:
+    """Adds ``analyze`` to the subcommands."""
+    p = sub.add_parser("analyze", help="explain a champion by its attractors; write analysis.json and figures",
+                       description="Explain a run's champion by its dynamics: equilibria, limit cycles, a "
+                                   "bifurcation sweep of one input, and lesions.",
+                       epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("dir", type=Path)
+    p.add_argument("--input", action="append", default=[], metavar="V,V",
+                   help="a constant input vector to analyse under (repeatable), e.g. 0,1")
+    p.add_argument("--neurons", metavar="I,J", help="the two neurons of the phase portrait")
+    p.add_argument("--sweep", metavar="START:STOP", default="0:1", help="the swept input's range (default 0:1)")
+    p.add_argument("--sweep-input", type=int, metavar="K", help="which input to sweep (default: the task's main one)")
+    p.add_argument("--steps", type=int, default=101, help="input values in the sweep (default 101)")
+    p.add_argument("--sweep-cycles", action="store_true",
+                   help="also search each swept value for limit cycles (4 starts; about 100x slower)")
+    p.add_argument("--trials", type=int, default=DEFAULT_LESION_TRIALS,
+                   help=f"fresh trials per lesion, in 'dnnevo evaluate --trials' units (default {DEFAULT_LESION_TRIALS})")
+    p.add_argument("--cuts", type=int, default=None, help="strongest connections to cut (default N)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the trials shown and judged (default 0)")
+    p.add_argument("--no-lesions", dest="lesions", action="store_false", help="skip the lesions")
+
+
+def _vector(text: str, what: str) -> list[float]:
+    try:
+        return [float(x) for x in text.split(",")]
+    except ValueError:
+        raise InvalidArgumentError(f"{what} {text!r} is not a comma-separated list of numbers") from None
+
+
+def _pair(text: str, n: int) -> tuple[int, int]:
+    try:
+        i, j = (int(x) for x in text.split(","))
+    except ValueError:
+        raise InvalidArgumentError(f"--neurons {text!r} is not two neuron indices such as 0,2") from None
+    if not (0 <= i < n and 0 <= j < n and i != j):
+        raise InvalidArgumentError(f"--neurons {text!r}: need two different neurons in 0..{n - 1}")
+    return i, j
+
+
+def _range(text: str) -> tuple[float, float]:
+    try:
+        a, b = (float(x) for x in text.split(":"))
+    except ValueError:
+        raise InvalidArgumentError(f"--sweep {text!r} is not a range such as 0:1") from None
+    return a, b
+
+
+def _savefig(fig: Any, path: Path) -> None:
+    """Saves ``fig`` to a temporary file beside ``path`` and renames it into place."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=120)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def analyze(args: argparse.Namespace) -> int:
+    """``dnnevo analyze``."""
+    started = time.perf_counter()
+    run = RunDir(args.dir)
+    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
+    net = _core.Network.load(run.best)
+    m = net.n_inputs
+    if config.task not in TASK_INPUTS:
+        raise ConfigError(f"task {config.task!r} has no analysis defaults; tasks with one: {', '.join(TASK_INPUTS)}")
+    if args.steps < 2:
+        raise InvalidArgumentError(f"--steps is {args.steps}; a sweep needs at least 2 input values")
+    if args.trials < 1:
+        raise InvalidArgumentError(f"--trials is {args.trials}; it must be >= 1")
+    if args.seed < 0:
+        raise InvalidArgumentError(f"--seed is {args.seed}; it must be >= 0")
+    if args.input:
+        conditions = {text: _vector(text, "--input") for text in args.input}
+    else:
+        conditions = {name: v[:m] for name, v in TASK_INPUTS[config.task].items()}
+    for name, v in conditions.items():
+        if len(v) != m:
+            raise InvalidArgumentError(f"--input {name} has {len(v)} values; this network has {m} sensors")
+    found = [analysis.attractors(net, v, name) for name, v in conditions.items()]
+
+    trials = analysis.recorded_trials(config, net, seed=args.seed)
+    outputs = np.vstack([o for o, _ in trials])
+    inputs = np.vstack([i for _, i in trials])
+    basins = _basins(config, net, trials, found[0])
+    if args.neurons:
+        neurons = _pair(args.neurons, net.size)
+    else:
+        order = np.argsort(-outputs.var(axis=0), kind="stable")
+        neurons = (int(order[0]), int(order[1])) if net.size > 1 else (0, 0)
+
+    index, name = MAIN_INPUT[config.task]
+    if args.sweep_input is not None:
+        if not 0 <= args.sweep_input < m:
+            raise InvalidArgumentError(f"--sweep-input is {args.sweep_input}; this network's inputs are 0..{m - 1}")
+        index, name = args.sweep_input, f"input {args.sweep_input}"
+    start, stop = _range(args.sweep)
+    bif = analysis.bifurcation(net, index, start, stop, steps=args.steps, cycle_starts=4 if args.sweep_cycles else 0)
+
+    table = analysis.lesions(config, net, args.trials, seed=args.seed, cuts=args.cuts) if args.lesions else None
+    elapsed = time.perf_counter() - started
+
+    stable = [e for e in found[0].equilibria if e.stable]
+    doc = {
+        "format": "dnnevo-analysis", "version": 1, "run": str(args.dir), "task": config.task,
+        "size": net.size, "seed": args.seed, "neurons": list(neurons),
+        "conditions": [a.to_dict() for a in found],
+        "bifurcation": {"input_name": name, "shown_neuron": _moving_neuron(bif), **bif.to_dict()},
+        "lesions": table.to_dict() if table else None,
+        "trial_basins": {"input": found[0].input.tolist(), "attractors": [e.outputs.tolist() for e in stable],
+                         "every": basins[0], "basins": basins[1].tolist()},
+        "elapsed_s": elapsed,
+    }
+    write_atomic(run.path / "analysis.json", json.dumps(doc, indent=1) + "\n")
+    written = ["analysis.json", *_figures(run, net, found, bif, table, outputs, neurons, name)]
+    written.append(_basin_figure(run, config, trials, basins, found[0], bif, name))
+    print("\n".join(summary(found, bif, table, name, basins)))
+    print(f"analysed in {elapsed:.1f} s; wrote {', '.join(str(run.path / w) for w in written)}")
+    return 0
+
+
+def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifurcation,
+             table: LesionTable | None, outputs: np.ndarray, neurons: tuple[int, int], label: str) -> list[str]:
+    import matplotlib.pyplot as plt
+
+    from dnnevo.plot import plot_bifurcation, plot_lesions, plot_phase_portrait
+
+    written = []
+    n_lesions = len(table.lesions) if table is not None else 0
+    for name, size in (("analysis-phase.png", (7.0, 5.5)), ("analysis-bifurcation.png", (7.0, 4.0)),
+                       ("analysis-lesions.png", (7.0, 1.5 + 0.22 * n_lesions))):
+        if name == "analysis-lesions.png" and table is None:
+            continue
+        fig, ax = plt.subplots(figsize=size, layout="constrained")
+        if name == "analysis-phase.png":
+            plot_phase_portrait(found, ax, net=net, neurons=neurons, trajectory=outputs,
+                                title=f"{run.path.name}: attractors under each input, and a real trial")
+        elif name == "analysis-bifurcation.png":
+            plot_bifurcation(bif, ax, neuron=_moving_neuron(bif), xlabel=label,
+                             title=f"{run.path.name}: equilibria as {label} varies")
+        elif table is not None:
+            plot_lesions(table, ax, title=f"{run.path.name}: lesions")
+        _savefig(fig, run.path / name)
+        plt.close(fig)
+        written.append(name)
+    return written
+
+
+OUTPUT_NEURON = {"sequence": 0, "landmark": 0, "nav1d": 2}
+"""The neuron whose firing rate is the task's answer, by default (``task_params.classifier``
+overrides it for landmark and nav1d, as in ``crates/tasks``)."""
+
+
+def output_neuron(config: EvolutionConfig) -> int:
+    """The neuron whose firing rate is ``config``'s task's answer."""
+    return int(config.task_params.get("classifier", OUTPUT_NEURON[config.task]))
+
+
+BASIN_STATES = 1500
+"""The most trial steps whose basin is computed; longer recordings are subsampled evenly."""
+
+INPUT_NAMES = {"sequence": ["trigger", "reinforcement"], "landmark": ["sonar input"],
+               "nav1d": ["landmark", "reinforcement"]}
+
+
+def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.ndarray, np.ndarray]],
+            off: Attractors) -> tuple[int, np.ndarray]:
+    """Every ``every``-th step of the recorded trials: which stable equilibrium of the first
+    condition the state would settle in (-1: none)."""
+    states = np.vstack([analysis.replay(config, net, i) for _, i in trials])
+    every = max(1, -(-len(states) // BASIN_STATES))
+    stable = [e for e in off.equilibria if e.stable]
+    return every, analysis.settles_to(net, states[::every], stable, off.input)
+
+
+def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.ndarray, np.ndarray]],
+                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str) -> str:
+    import matplotlib.pyplot as plt
+
+    from dnnevo.plot import plot_basins
+
+    every, which = basins
+    outputs = np.vstack([o for o, _ in trials])[::every]
+    inputs = np.vstack([i for _, i in trials])[::every]
+    names = INPUT_NAMES[config.task]
+    starts = np.cumsum([0] + [len(o) for o, _ in trials])[1:-1] // every
+    stable = [e for e in off.equilibria if e.stable]
+    neuron = output_neuron(config)
+    labels = [f"{chr(65 + k)} (neuron {neuron} at {e.outputs[neuron]:.2f})" for k, e in enumerate(stable)]
+    fig, ax = plt.subplots(figsize=(9.0, 3.6), layout="constrained")
+    plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,
+                neuron=neuron, boundaries=list(starts), levels=[e.value for e in bif.events if e.kind == "fold"],
+                level_label=f"folds of the {name} sweep",
+                title=f"{run.path.name}: recorded trials; background: where the state would settle "
+                      f"with input {off.label}")
+    _savefig(fig, run.path / "analysis-basins.png")
+    plt.close(fig)
+    return "analysis-basins.png"
+
+
+def _moving_neuron(bif: Bifurcation) -> int:
+    """The neuron whose equilibrium firing rate spans the widest range over the sweep (the lowest
+    index among equals, 0 when nothing moves)."""
+    rates = np.array([e.outputs for row in bif.equilibria for e in row])
+    if rates.size == 0:
+        return 0
+    return int(np.argmax(np.ptp(rates, axis=0)))
+
+
+def _eq_line(e: analysis.Equilibrium) -> str:
+    rates = " ".join(f"{o:.2f}" for o in e.outputs)
+    scale = f", time scale {e.time_scale:.3g}" if e.time_scale is not None else ""
+    return f"    {e.stability.replace('_', ' '):<15} outputs [{rates}]{scale}"
+
+
+def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None, name: str,
+            basins: tuple[int, np.ndarray] | None = None) -> list[str]:
+    """The printed report."""
+    lines = []
+    for a in found:
+        stable = sum(e.stable for e in a.equilibria)
+        lines.append(f"input {a.label} [{', '.join(f'{x:g}' for x in a.input)}]: {len(a.equilibria)} equilibria "
+                     f"({stable} stable), {len(a.cycles)} attracting cycle{'s' * (len(a.cycles) != 1)}")
+        if len(a.equilibria) % 2 == 0:
+            lines.append("    (an even count: at least one equilibrium was missed, see docs/analysis.md)")
+        lines += [_eq_line(e) for e in a.equilibria[:12]]
+        if len(a.equilibria) > 12:
+            lines.append(f"    ... {len(a.equilibria) - 12} more in analysis.json")
+        for c in a.cycles:
+            lines.append(f"    cycle: period {c.period:.3g}, output 0 between "
+                         f"{np.min(c.orbit[:, 0]):.3g} and {np.max(c.orbit[:, 0]):.3g} (state), "
+                         f"largest multiplier {c.max_multiplier:.3g}")
+    events = ", ".join(f"{e.kind} at {e.value:.4g}" for e in bif.events) or "none"
+    lines.append(f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}")
+    if basins is not None:
+        every, which = basins
+        shares = ", ".join(f"{chr(65 + k)} {np.mean(which == k):.0%}" for k in range(int(which.max(initial=-1)) + 1))
+        lines.append(f"recorded trials: the state would settle in {shares}"
+                     + (f", none {np.mean(which < 0):.0%}" if (which < 0).any() else "")
+                     + f" (input {found[0].label} attractors, by stable equilibrium order)")
+    if table is not None:
+        lines.append(f"lesions ({table.trials} fresh trials, seed {table.seed}): intact score {table.score:.3f} "
+                     f"({table.verdict})")
+        for x in sorted(table.lesions, key=lambda x: -x.drop)[:8]:
+            lines.append(f"    {x.name:<22} score {x.score:.3f}  drop {x.drop:+.3f}  {x.verdict}")
+    return lines

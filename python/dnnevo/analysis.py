@@ -1,0 +1,507 @@
+"""Dynamical analysis of a network: how it works, not only what it does.
+
+With its sensors held at a constant input vector, a network is an autonomous dynamical system
+``tau_i dv_i/dt = -v_i + sum_j w_ij f(v_j - theta_j) + c_i`` (``c = sensor_weights @ input``). Its
+behaviour is organised by its attractors, and an input that changes moves, creates or destroys
+them (Beer 1995, "On the dynamics of small continuous-time recurrent neural networks"):
+
+- :func:`equilibria`: every equilibrium Newton's method reaches from many starts, with its
+  eigenvalues, :data:`STABILITIES` class and slowest time scale;
+- :func:`limit_cycles`: attracting limit cycles by long RK4 integration and a Poincaré section,
+  with period, amplitude per neuron and Floquet multipliers;
+- :func:`bifurcation`: one input swept from ``start`` to ``stop``, the equilibria followed, and
+  the folds (an equilibrium pair appears or vanishes) and Hopf points (a complex pair crosses the
+  imaginary axis) located;
+- :func:`clamp`, :func:`cut` and :func:`lesions`: a neuron held at a constant output, or a
+  connection removed, and the champion re-scored on fresh trials by :func:`dnnevo.assess.assess`.
+
+The numerical work is in Rust (``ctrnn::analysis``); this module turns its results into
+dataclasses. The analysis is of the continuous-time system; tasks integrate it with Euler steps
+(``dnnevo evaluate --dt-check`` tells whether a champion's behaviour depends on the step).
+
+>>> import dnnevo
+>>> from dnnevo import analysis
+>>> # One self-exciting neuron (w = 8) with its threshold at the centre (theta = w / 2): bistable.
+>>> net = dnnevo.Network(tau=[1.0], theta=[4.0], weights=[[8.0]], sensor_weights=[[1.0]])
+>>> [e.stability for e in analysis.equilibria(net, [0.0])]
+['stable_node', 'unstable_node', 'stable_node']
+>>> b = analysis.bifurcation(net, 0, -4.0, 4.0, steps=41)
+>>> [(e.kind, round(e.value, 4)) for e in b.events]
+[('fold', -1.0657), ('fold', 1.0657)]
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal, cast
+
+import numpy as np
+import numpy.typing as npt
+
+from dnnevo import _core
+from dnnevo._checks import nonnegative
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import InvalidArgumentError
+
+__all__ = [
+    "STABILITIES",
+    "Attractors",
+    "Bifurcation",
+    "Cycle",
+    "Equilibrium",
+    "Event",
+    "Lesion",
+    "LesionTable",
+    "attractors",
+    "clamp",
+    "cut",
+    "bifurcation",
+    "equilibria",
+    "lesions",
+    "limit_cycles",
+    "recorded_trials",
+    "replay",
+    "settles_to",
+    "trial_outputs",
+    "vector_field",
+]
+
+STABILITIES = ("stable_node", "stable_focus", "saddle", "unstable_node", "unstable_focus", "non_hyperbolic")
+"""The stability classes, from the eigenvalues of the Jacobian: every real part negative (a node
+if every eigenvalue is real, else a focus), mixed signs (saddle), every real part positive, or
+some real part 0 within 1e-9 relative (non-hyperbolic: linearisation does not decide)."""
+
+_Array = npt.NDArray[np.float64]
+
+
+def _complex(pairs: Sequence[Sequence[float | None]]) -> npt.NDArray[np.complex128]:
+    return np.array([complex(math.nan if re is None else re, im or 0.0) for re, im in pairs], dtype=complex)
+
+
+def _pairs(z: npt.NDArray[np.complex128]) -> list[list[float]]:
+    return [[float(c.real), float(c.imag)] for c in z]
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """One equilibrium and its linear stability."""
+
+    state: _Array
+    """The state v (length N)."""
+    outputs: _Array
+    """The firing rates ``f(v - theta)`` there."""
+    eigenvalues: npt.NDArray[np.complex128]
+    """Eigenvalues of the Jacobian of ``dv/dt``, largest real part first."""
+    stability: str
+    """One of :data:`STABILITIES`."""
+    unstable_dimensions: int
+    """How many eigenvalues have a positive real part."""
+    time_scale: float | None
+    """``1 / min |Re lambda|``: how long the slowest direction takes to approach (or leave) by a
+    factor e. None when non-hyperbolic."""
+    residual: float
+    """``max_i tau_i |dv_i/dt|`` there (at most the search's tolerance)."""
+
+    @property
+    def stable(self) -> bool:
+        """Whether nearby states approach it (a stable node or focus)."""
+        return self.stability in ("stable_node", "stable_focus")
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Equilibrium:
+        """From the JSON form the Rust core returns."""
+        return cls(np.array(d["state"], dtype=float), np.array(d["outputs"], dtype=float),
+                   _complex(d["eigenvalues"]), d["stability"], int(d["unstable_dimensions"]),
+                   d["time_scale"], float(d["residual"]))
+
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types (eigenvalues as ``[re, im]`` pairs)."""
+        return {"state": self.state.tolist(), "outputs": self.outputs.tolist(),
+                "eigenvalues": _pairs(self.eigenvalues), "stability": self.stability,
+                "unstable_dimensions": self.unstable_dimensions, "time_scale": self.time_scale,
+                "residual": self.residual}
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """One attracting limit cycle."""
+
+    period: float
+    crossings: int
+    """Upward crossings of the Poincaré section per period (1 for a simple loop)."""
+    section_neuron: int
+    amplitude: _Array
+    """Per neuron, max minus min of the state over one period."""
+    mean_outputs: _Array
+    output_range: _Array
+    """Per neuron, the lowest and highest firing rate over one period, shape (N, 2)."""
+    multipliers: npt.NDArray[np.complex128]
+    """Floquet multipliers, largest modulus first; one of them is 1 (along the orbit)."""
+    max_multiplier: float
+    """The largest modulus other than the trivial multiplier: below 1 for a stable cycle, and the
+    factor by which a perturbation shrinks per period."""
+    stable: bool
+    orbit: _Array
+    """States along one period, shape (K, N)."""
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Cycle:
+        """From the JSON form the Rust core returns."""
+        return cls(float(d["period"]), int(d["crossings"]), int(d["section_neuron"]),
+                   np.array(d["amplitude"], dtype=float), np.array(d["mean_outputs"], dtype=float),
+                   np.array(d["output_range"], dtype=float).reshape(-1, 2), _complex(d["multipliers"]), float(d["max_multiplier"]), bool(d["stable"]),
+                   np.array(d["orbit"], dtype=float))
+
+    def to_dict(self, *, orbit: bool = True) -> dict[str, Any]:
+        """As plain JSON types; ``orbit=False`` leaves the orbit out."""
+        d: dict[str, Any] = {"period": self.period, "crossings": self.crossings,
+                             "section_neuron": self.section_neuron, "amplitude": self.amplitude.tolist(),
+                             "mean_outputs": self.mean_outputs.tolist(), "output_range": self.output_range.tolist(),
+                             "multipliers": _pairs(self.multipliers), "max_multiplier": self.max_multiplier,
+                             "stable": self.stable}
+        if orbit:
+            d["orbit"] = self.orbit.tolist()
+        return d
+
+
+@dataclass(frozen=True)
+class Event:
+    """A fold or Hopf point of a sweep."""
+
+    kind: str
+    """``"fold"`` or ``"hopf"``."""
+    value: float
+    """The input value where it happens."""
+    state: _Array
+    eigenvalue: complex
+    """The critical eigenvalue: real and near 0 (fold), or near ``i omega`` (Hopf)."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types."""
+        return {"kind": self.kind, "value": self.value, "state": self.state.tolist(),
+                "eigenvalue": [self.eigenvalue.real, self.eigenvalue.imag]}
+
+
+@dataclass(frozen=True)
+class Bifurcation:
+    """A sweep of input ``index``: the equilibria at each value and the events between them."""
+
+    index: int
+    input: _Array
+    """The other inputs' values (entry ``index`` is swept)."""
+    values: _Array
+    equilibria: list[list[Equilibrium]]
+    events: list[Event]
+    cycles: list[list[Cycle]] = field(default_factory=list)
+    """The attracting cycles at each value (empty lists unless the sweep searched for them)."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types (cycles without their orbits)."""
+        return {"index": self.index, "input": self.input.tolist(), "values": self.values.tolist(),
+                "equilibria": [[e.to_dict() for e in row] for row in self.equilibria],
+                "cycles": [[c.to_dict(orbit=False) for c in row] for row in self.cycles],
+                "events": [e.to_dict() for e in self.events]}
+
+
+def _input(net: _core.Network, value: npt.ArrayLike | None) -> list[float]:
+    if value is None:
+        return [0.0] * net.n_inputs
+    arr = np.asarray(value, dtype=float).reshape(-1)
+    if arr.shape != (net.n_inputs,):
+        raise InvalidArgumentError(f"input has {arr.size} values; this network has {net.n_inputs} sensors, "
+                                   f"so it needs {net.n_inputs}")
+    return arr.tolist()
+
+
+def equilibria(
+    net: _core.Network, input: npt.ArrayLike | None = None, *, starts: int = 512, tolerance: float = 1e-10,
+    distinct: float = 1e-6, max_iterations: int = 100, seed: int = 0,
+) -> list[Equilibrium]:
+    """Every equilibrium of ``net`` with its sensors held at ``input`` (default: all 0) that damped
+    Newton's method reaches from ``starts`` starting points, sorted by state.
+
+    Starts are output vectors in (0, 1)^N mapped to ``v = weights o + c`` (the box every
+    equilibrium lies in), half near the cube's corners. An equilibrium is accepted when
+    ``max_i tau_i |dv_i/dt| <= tolerance``; two closer than ``distinct`` in every coordinate are
+    one. None is guaranteed for large N: raise ``starts`` to check."""
+    text = _core.analysis_equilibria(net, _input(net, input), starts=starts, tolerance=tolerance,
+                                     distinct=distinct, max_iterations=max_iterations, seed=seed)
+    return [Equilibrium.from_dict(d) for d in json.loads(text)]
+
+
+def limit_cycles(
+    net: _core.Network, input: npt.ArrayLike | None = None, *, starts: int = 8, steps_per_tau: int = 20,
+    transient: float = 100.0, window: float = 100.0, tolerance: float = 1e-5, orbit_points: int = 200,
+    seed: int = 1,
+) -> list[Cycle]:
+    """The attracting limit cycles of ``net`` with its sensors held at ``input``, sorted by period.
+
+    From each of ``starts`` states the network is integrated by RK4 (``steps_per_tau`` steps per
+    smallest time constant) for ``transient`` largest time constants, then for up to ``window``
+    more while watching the upward crossings of the level halfway between the extremes of the
+    neuron that moves most. The orbit is closed when a crossing comes within ``tolerance`` of one
+    of the 4 before it. Forward integration finds attracting cycles only."""
+    text = _core.analysis_cycles(net, _input(net, input), starts=starts, steps_per_tau=steps_per_tau,
+                                 transient=transient, window=window, tolerance=tolerance,
+                                 orbit_points=orbit_points, seed=seed)
+    return [Cycle.from_dict(d) for d in json.loads(text)]
+
+
+def bifurcation(
+    net: _core.Network, index: int, start: float, stop: float, *, input: npt.ArrayLike | None = None,
+    steps: int = 101, starts: int = 128, seed: int = 0, cycle_starts: int = 0,
+) -> Bifurcation:
+    """Sweeps input ``index`` over ``steps`` values from ``start`` to ``stop`` (the other inputs
+    held at ``input``, default 0), following the equilibria (each value's search also starts
+    from the previous value's equilibria) and locating folds and Hopf points by bisection. With
+    ``cycle_starts > 0`` it also searches each value for attracting cycles (the
+    :func:`limit_cycles` defaults with that many starts, plus the previous value's cycles); that
+    costs about as much as 100 equilibrium searches per value."""
+    base = _input(net, input)
+    d = json.loads(_core.analysis_bifurcation(net, base, index, start, stop, steps=steps, starts=starts,
+                                              seed=seed, cycle_starts=cycle_starts))
+    events = [Event(e["kind"], float(e["value"]), np.array(e["state"], dtype=float),
+                    complex(*(math.nan if x is None else x for x in e["eigenvalue"])))
+              for e in d["events"]]
+    return Bifurcation(int(d["input"]), np.array(base), np.array(d["values"], dtype=float),
+                       [[Equilibrium.from_dict(e) for e in row] for row in d["equilibria"]], events,
+                       [[Cycle.from_dict(c) for c in row] for row in d["cycles"]])
+
+
+@dataclass(frozen=True)
+class Attractors:
+    """The equilibria and attracting cycles of a network under one constant input."""
+
+    label: str
+    input: _Array
+    equilibria: list[Equilibrium]
+    cycles: list[Cycle]
+
+    def to_dict(self, *, orbits: bool = False) -> dict[str, Any]:
+        """As plain JSON types; orbits are left out unless ``orbits``."""
+        return {"label": self.label, "input": self.input.tolist(),
+                "equilibria": [e.to_dict() for e in self.equilibria],
+                "cycles": [c.to_dict(orbit=orbits) for c in self.cycles]}
+
+
+RETRY_STARTS = 8192
+""":func:`attractors` searches again with this many starts when it finds an even number of
+equilibria."""
+
+
+def attractors(net: _core.Network, input: npt.ArrayLike | None = None, label: str = "") -> Attractors:
+    """:func:`equilibria` and :func:`limit_cycles` under ``input``, with the default settings.
+
+    A generic network has an odd number of equilibria (their indices add up to 1, since the
+    vector field points inward on a large box), so an even count means some were missed: the
+    search is then repeated with :data:`RETRY_STARTS` starts (0.2 s for 10 neurons)."""
+    values = _input(net, input)
+    found = equilibria(net, values)
+    if len(found) % 2 == 0:
+        found = equilibria(net, values, starts=RETRY_STARTS)
+    return Attractors(label or ",".join(f"{x:g}" for x in values), np.array(values), found,
+                      limit_cycles(net, values))
+
+
+def vector_field(net: _core.Network, input: npt.ArrayLike | None, states: npt.ArrayLike) -> _Array:
+    """``dv/dt`` at each state (shape (..., N)) with the sensors held at ``input``, in NumPy (with
+    NumPy's exponential; the Rust core's agrees to about 1e-15)."""
+    v = np.asarray(states, dtype=float)
+    if v.shape[-1:] != (net.size,):
+        raise InvalidArgumentError(f"states have shape {v.shape}; the last axis must be N = {net.size}")
+    c = net.sensor_weights @ np.asarray(_input(net, input))
+    f = 1.0 / (1.0 + np.exp(-(v - net.theta)))
+    return np.asarray((-v + f @ net.weights.T + c) / net.tau)
+
+
+# --- lesions -------------------------------------------------------------------------------------
+
+CLAMP_LIMIT = 1e-9
+"""A clamped output is kept this far inside (0, 1), so that its threshold stays finite."""
+
+
+def clamp(net: _core.Network, neuron: int, output: float) -> _core.Network:
+    """``net`` with ``neuron``'s firing rate held at ``output`` for every trial.
+
+    This is exact for the tasks, which start every trial from ``v = 0``: the neuron's incoming
+    weights, self-weight and sensor weights become 0, so ``tau dv/dt = -v`` keeps ``v = 0``, and its
+    threshold becomes ``-logit(output)``, so ``f(0 - theta) = output``. Every other neuron then
+    receives ``w_ij * output`` from it, as the clamp means. ``output`` is moved
+    :data:`CLAMP_LIMIT` inside (0, 1) if it lies closer to 0 or 1."""
+    n = net.size
+    if not isinstance(neuron, int) or isinstance(neuron, bool) or not 0 <= neuron < n:
+        raise InvalidArgumentError(f"neuron is {neuron!r}; it must be an integer in 0..{n - 1}")
+    if not math.isfinite(output) or not 0.0 <= output <= 1.0:
+        raise InvalidArgumentError(f"output is {output!r}; a firing rate must be in [0, 1]")
+    o = min(max(output, CLAMP_LIMIT), 1.0 - CLAMP_LIMIT)
+    weights, sensors, theta = net.weights.copy(), net.sensor_weights.copy(), net.theta.copy()
+    weights[neuron, :] = 0.0
+    sensors[neuron, :] = 0.0
+    theta[neuron] = -math.log(o / (1.0 - o))
+    return _core.Network(net.tau, theta, weights, sensors)
+
+
+def cut(net: _core.Network, source: int, target: int) -> _core.Network:
+    """``net`` without the connection from neuron ``source`` to neuron ``target``."""
+    n = net.size
+    for name, k in (("source", source), ("target", target)):
+        if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k < n:
+            raise InvalidArgumentError(f"{name} is {k!r}; it must be an integer in 0..{n - 1}")
+    weights = net.weights.copy()
+    weights[target, source] = 0.0
+    return _core.Network(net.tau, net.theta, weights, net.sensor_weights)
+
+
+@dataclass(frozen=True)
+class Lesion:
+    """One lesion and the score it leaves."""
+
+    name: str
+    """E.g. ``"clamp 3 at 0.12"`` or ``"cut 2->0"``."""
+    kind: str
+    """``"clamp"`` or ``"cut"``."""
+    neurons: tuple[int, ...]
+    """The clamped neuron, or (source, target) of the cut."""
+    score: float
+    """The lesioned network's score (see :attr:`LesionTable.score`)."""
+    drop: float
+    """The intact score minus this one: how much the part matters."""
+    verdict: str
+
+
+@dataclass(frozen=True)
+class LesionTable:
+    """Scores after each lesion, on the same fresh trials as the intact network."""
+
+    task: str
+    trials: int
+    seed: int
+    score: float
+    """The intact network's score: its lowest judged success rate (the weakest target for
+    sequence, the overall rate for landmark and nav1d)."""
+    verdict: str
+    mean_outputs: _Array
+    """Each neuron's mean firing rate over the recorded trials; a clamp holds it there."""
+    lesions: list[Lesion] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types."""
+        return {"task": self.task, "trials": self.trials, "seed": self.seed, "score": self.score,
+                "verdict": self.verdict, "mean_outputs": self.mean_outputs.tolist(),
+                "lesions": [{"name": x.name, "kind": x.kind, "neurons": list(x.neurons), "score": x.score,
+                             "drop": x.drop, "verdict": x.verdict} for x in self.lesions]}
+
+
+def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -> list[tuple[_Array, _Array]]:
+    """Real trials of ``config``'s task drawn from ``seed``, each as (firing rates (T, N), inputs
+    (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain of 2
+    trials (nav1d)."""
+    nonnegative("seed", seed)
+    out: list[tuple[_Array, _Array]] = []
+    if config.task == "sequence":
+        from dnnevo import sequence
+
+        for k, target in enumerate(config.task_params.get("targets", ["0", "1"])):
+            r = sequence.run_trial(config, net, target, sequence.timings(config, seed, 0, k))
+            out.append((r.outputs, np.column_stack([r.trigger, r.reinforcement])))
+    elif config.task == "landmark":
+        from dnnevo import landmark
+
+        for which in (1, 2):
+            lr = landmark.record(config, net, which, seed=seed)
+            out.append((lr.outputs, lr.input.reshape(-1, 1)))
+    elif config.task == "nav1d":
+        from dnnevo import nav1d
+
+        chain = nav1d.fresh_chains(config, 1, 2, seed)[0]
+        nr = nav1d.record(config, net, chain)
+        out.append((nr.outputs, np.column_stack([nr.landmark, nr.reinforcement][: net.n_inputs])))
+    else:
+        raise InvalidArgumentError(f"task {config.task!r} has no recorded trials to analyse")
+    return out
+
+
+def trial_outputs(config: EvolutionConfig, net: _core.Network, *, seed: int) -> tuple[_Array, _Array]:
+    """The :func:`recorded_trials` of ``seed`` stacked: firing rates (T, N) and inputs (T, M)."""
+    trials = recorded_trials(config, net, seed=seed)
+    return np.vstack([o for o, _ in trials]), np.vstack([i for _, i in trials])
+
+
+def replay(config: EvolutionConfig, net: _core.Network, inputs: npt.ArrayLike) -> _Array:
+    """The states (T, N) of ``net`` from ``v = 0`` driven by recorded ``inputs`` (T, M), one row
+    per time step, with the config's integrator: a recorded sequence or landmark trial exactly;
+    a nav1d trial to within the recording's time step (its landmark input is the fraction of a
+    time step spent on the landmark)."""
+    n = net.copy()
+    n.reset()
+    i = config.integrator
+    method = cast(Literal["euler", "rk4"], i.method)
+    return np.asarray(n.run(np.asarray(inputs, dtype=float), dt=i.dt, substeps=i.substeps, method=method).states)
+
+
+def settles_to(
+    net: _core.Network, states: npt.ArrayLike, targets: Sequence[Equilibrium], input: npt.ArrayLike | None = None,
+    *, duration: float | None = None, tolerance: float = 1e-2,
+) -> npt.NDArray[np.int64]:
+    """For each state (rows of ``states``), the index in ``targets`` of the equilibrium it
+    reaches when the sensors are then held at ``input`` for ``duration`` (default: 30 largest
+    time constants), integrated by RK4 at a step of a fifth of the smallest time constant; -1
+    when it ends farther than ``tolerance`` (in firing rate) from every target. With ``input`` off
+    and the stable equilibria as ``targets``, this says which attractor holds the state."""
+    v = np.asarray(states, dtype=float).reshape(-1, net.size)
+    dt = float(np.min(net.tau)) / 5
+    steps = int(math.ceil((duration if duration is not None else 30 * float(np.max(net.tau))) / dt))
+    u = np.tile(np.asarray(_input(net, input)), (steps, 1))
+    goals = np.array([e.outputs for e in targets]).reshape(len(targets), net.size)
+    out = np.full(len(v), -1, dtype=np.int64)
+    for k, s in enumerate(v):
+        n = net.copy()
+        n.reset(s)
+        end = n.run(u, dt=dt, method="rk4").outputs[-1]
+        if len(goals):
+            d = np.max(np.abs(goals - end), axis=1)
+            if d.min() <= tolerance:
+                out[k] = int(np.argmin(d))
+    return out
+
+
+def _score(a: Any) -> float:
+    return float(min(r.rate for r in a.judged))
+
+
+def lesions(
+    config: EvolutionConfig, net: _core.Network, trials: int, *, seed: int, cuts: int | None = None,
+    mean_outputs: npt.ArrayLike | None = None,
+) -> LesionTable:
+    """Re-scores ``net`` with each neuron clamped at its mean output, and with each of its
+    ``cuts`` strongest connections (by ``|w|``; default N, 0 for none) cut, on ``trials`` fresh
+    trials from ``seed`` (the trials :func:`dnnevo.assess.assess` draws, the same for every
+    lesion). ``mean_outputs`` defaults to the mean over :func:`trial_outputs` of ``seed``."""
+    from dnnevo import assess
+
+    base = assess.assess(config, net, trials, seed=seed)
+    if mean_outputs is None:
+        mean = trial_outputs(config, net, seed=seed)[0].mean(axis=0)
+    else:
+        mean = np.asarray(mean_outputs, dtype=float).reshape(-1)
+        if mean.shape != (net.size,):
+            raise InvalidArgumentError(f"mean_outputs has {mean.size} values; expected N = {net.size}")
+    score = _score(base)
+    out: list[Lesion] = []
+
+    def add(name: str, kind: str, neurons: tuple[int, ...], lesioned: _core.Network) -> None:
+        a = assess.assess(config, lesioned, trials, seed=seed)
+        out.append(Lesion(name, kind, neurons, _score(a), score - _score(a), a.verdict))
+
+    for i in range(net.size):
+        add(f"clamp {i} at {mean[i]:.3g}", "clamp", (i,), clamp(net, i, float(mean[i])))
+    w = net.weights
+    count = net.size if cuts is None else nonnegative("cuts", cuts)
+    order = sorted(((abs(w[t, s]), s, t) for t in range(net.size) for s in range(net.size) if w[t, s] != 0.0),
+                   reverse=True)[:count]
+    for _, s, t in order:
+        add(f"cut {s}->{t}", "cut", (s, t), cut(net, s, t))
+    return LesionTable(config.task, trials, seed, score, base.verdict, mean, out)

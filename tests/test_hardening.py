@@ -333,3 +333,49 @@ def test_ctrl_c_during_start_up_is_one_line(tmp_path: Path) -> None:
         _, err = p.communicate(timeout=60)
         lines = [line for line in err.splitlines() if line and not line.startswith("[")]  # progress
         assert "Traceback" not in err and len(lines) <= 1, err
+
+
+LIMITS_SCRIPT = r"""
+import resource, sys
+resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))  # 2 GiB: a regression cannot take the machine
+import dnnevo
+from dnnevo import ConfigError, FormatError
+
+def refused(call, kind, fragment):
+    try:
+        call()
+    except kind as e:
+        assert fragment in str(e), (fragment, str(e))
+    else:
+        raise AssertionError(f"no {kind.__name__}: {call}")
+
+refused(lambda: dnnevo.Network.random(10**6, 1, seed=0), ConfigError, "the limit is")
+refused(lambda: dnnevo.Network.random(2**62, 2**62, seed=0), ConfigError, "the limit is")
+small = dnnevo.EvolutionConfig(population=10**12, size=5, n_inputs=2)
+refused(lambda: dnnevo.GeneticAlgorithm(small), ConfigError, "TiB")
+wide = dnnevo.EvolutionConfig(population=10, size=100_000, n_inputs=2)
+refused(lambda: dnnevo.GeneticAlgorithm(wide), ConfigError, "the limit is")
+refused(lambda: dnnevo.GeneticAlgorithm.from_state_dict({}), ConfigError, "'config' and 'evolution'")
+deep = []
+for _ in range(100_000):
+    deep = [deep]
+net = dnnevo.Network.random(2, 1, seed=0)
+refused(lambda: net.save(sys.argv[1], meta={"x": deep}), FormatError, "deeper than 128")
+d = net.to_dict()
+d["meta"] = {"x": deep}
+refused(lambda: dnnevo.Network.from_dict(d), FormatError, "deeper than 128")
+print("ok")
+"""
+
+
+def test_api_limits_are_typed_errors_in_a_memory_limited_child(tmp_path: Path) -> None:
+    r = subprocess.run([sys.executable, "-c", LIMITS_SCRIPT, str(tmp_path / "n.json")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr[-2000:]
+
+
+def test_cli_sizes_past_the_limit_are_one_line(tmp_path: Path) -> None:
+    for setting in ("population=1000000000000", "size=100000"):
+        r = run_cli("run", "sequence-1bit", "--quick", "--set", setting, "--out", tmp_path / "x",
+                    "--force")
+        assert_one_line_error(r)

@@ -356,6 +356,14 @@ refused(lambda: dnnevo.GeneticAlgorithm(small), ConfigError, "TiB")
 wide = dnnevo.EvolutionConfig(population=10, size=100_000, n_inputs=2)
 refused(lambda: dnnevo.GeneticAlgorithm(wide), ConfigError, "the limit is")
 refused(lambda: dnnevo.GeneticAlgorithm.from_state_dict({}), ConfigError, "'config' and 'evolution'")
+from dnnevo import InvalidArgumentError
+refused(lambda: dnnevo.Network.random(3, -1, seed=0), InvalidArgumentError, "n_inputs is -1")
+refused(lambda: dnnevo.Network.random(3, 1, seed=2**64), InvalidArgumentError, "seed is 18446744073709551616")
+refused(lambda: dnnevo.Network.random(3, 1, seed=-1), InvalidArgumentError, "seed is -1")
+nets = [dnnevo.Network.random(5, 2, seed=0)]
+refused(lambda: dnnevo.evaluate("sequence", nets, generation=-1, seed=0), InvalidArgumentError, "generation is -1")
+refused(lambda: dnnevo.evaluate("sequence", nets, generation=0, seed=0, threads=-2), InvalidArgumentError, "threads is -2")
+refused(lambda: dnnevo.EvolutionConfig(task_params={"perf_base": float("nan")}), ConfigError, "task_params.perf_base is nan")
 deep = []
 for _ in range(100_000):
     deep = [deep]

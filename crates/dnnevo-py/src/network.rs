@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict, PyTuple};
 use serde_json::{Map, Value};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, Dense};
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint, Dense};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FormatError, IntoPy, InvalidNetworkError};
 
@@ -255,11 +255,14 @@ impl PyNetwork {
     #[staticmethod]
     #[pyo3(signature = (size, n_inputs, *, seed, ranges=None))]
     fn random(
-        size: usize,
-        n_inputs: usize,
-        seed: u64,
+        size: &Bound<'_, PyAny>,
+        n_inputs: &Bound<'_, PyAny>,
+        seed: &Bound<'_, PyAny>,
         ranges: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let size: usize = uint(size, "size", "[1, 2**64)")?;
+        let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
+        let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
         let ranges = ranges_from(ranges)?;
         let layout = Layout { size, n_inputs };
         layout.validate().py_err()?;

@@ -370,6 +370,11 @@ nets = [dnnevo.Network.random(5, 2, seed=0)]
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=-1, seed=0), InvalidArgumentError, "generation is -1")
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=0, seed=0, threads=-2), InvalidArgumentError, "threads is -2")
 refused(lambda: dnnevo.EvolutionConfig(task_params={"perf_base": float("nan")}), ConfigError, "task_params.perf_base is nan")
+import numpy as np
+from dnnevo import InvalidNetworkError
+stack = {"tau": np.ones((2, 3)), "theta": np.zeros((2, 3)), "weights": np.zeros((2, 3, 3)),
+         "sensor_weights": np.zeros((2, 3, 1)), "states": np.zeros((2, 3))}
+refused(lambda: dnnevo.run_population(stack, np.zeros((4, 1))), InvalidNetworkError, "unknown key 'states'")
 deep = []
 for _ in range(100_000):
     deep = [deep]

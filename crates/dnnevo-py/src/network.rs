@@ -542,6 +542,17 @@ fn network_objects<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Vec<PyRef<'py, PyNe
 /// A population from stacked arrays: tau (P, N), theta (P, N), weights (P, N, N),
 /// sensor_weights (P, N, M) and optionally state (P, N).
 fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
+    const KEYS: [&str; 5] = ["tau", "theta", "weights", "sensor_weights", "state"];
+    for key in d.keys() {
+        let name = key.str()?.to_string();
+        if !key.is_instance_of::<pyo3::types::PyString>() || !KEYS.contains(&name.as_str()) {
+            return Err(net_err(format!(
+                "the dict has an unknown key {}; expected {}",
+                key.repr()?,
+                KEYS.join(", ")
+            )));
+        }
+    }
     let get = |key: &str, ndim: usize, shape: &str| -> PyResult<Option<Dense>> {
         match d.get_item(key)? {
             None => Ok(None),

@@ -394,7 +394,14 @@ def test_api_limits_are_typed_errors_in_a_memory_limited_child(tmp_path: Path) -
 
 
 def test_cli_sizes_past_the_limit_are_one_line(tmp_path: Path) -> None:
-    for setting in ("population=1000000000000", "size=100000"):
-        r = run_cli("run", "sequence-1bit", "--quick", "--set", setting, "--out", tmp_path / "x",
-                    "--force")
+    import resource
+
+    def limit() -> None:  # 2 GiB of address space: a regression cannot take the machine down
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    for setting in ("population=1000000000000", "size=100000",
+                    "task_params.trials_per_target=1000000000000", "task_params.perf_base=nan"):
+        r = subprocess.run([sys.executable, "-m", "dnnevo", "run", "sequence-1bit", "--quick", "--set",
+                            setting, "--out", str(tmp_path / "x"), "--force"],
+                           capture_output=True, text=True, timeout=120, preexec_fn=limit)
         assert_one_line_error(r)

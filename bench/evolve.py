@@ -121,7 +121,8 @@ def part_a(cfg, args):
         rows = [{k: float(v[i % args.generations]) for k, v in result.history.items()}
                 for i in range(GENERATIONS)]
         t_log, _ = median_time(lambda _: run.write_log(rows), 5)
-        t_ckpt, _ = median_time(lambda _: run.write_checkpoint(ga.state_dict(), rows), 3)
+        t_ckpt, _ = median_time(lambda _: run.write_checkpoint(ga.state_dict(), rows, {"seed": ga.seed},
+                                                               ga.seed), 3)
     h = result.history
     per_gen = float(h["elapsed_s"][-1]) / args.generations  # the loop, without the run's setup
     step = cfg.population / h["evals_per_s"]  # seconds of each generation's Rust step

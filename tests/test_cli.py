@@ -50,8 +50,8 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
         (["run", "sequence-1bit", "--seed", "-1"], "-1 is negative"),
         (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
         (["resume", "/no/such/dir"], "has no checkpoint.json"),
-        (["show", "/no/such/dir"], "has no log.csv"),
-        (["evaluate", "/no/such/dir"], "No such file"),
+        (["show", "/no/such/dir"], "has no config.toml"),
+        (["evaluate", "/no/such/dir"], "has no config.toml"),
         (["evaluate", "x", "--trials", "0"], "must be >= 1"),
         (["sweep", "sequence-1bit", "--out", "x", "--eval-trials", "0"], "must be >= 1"),
         (["sweep", "sequence-1bit", "--out", "x", "--eval-seed", "-3"], "-3 is negative"),
@@ -117,7 +117,7 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     from dnnevo.rundir import RunDir
 
     def population(run: Path) -> list[dn.Network]:
-        state = RunDir(run).read_checkpoint()[0]
+        state = RunDir(run).read_checkpoint().state
         return dn.GeneticAlgorithm.from_state_dict(state).ask().networks
 
     from dnnevo.cli import _seed_networks

@@ -11,7 +11,7 @@ import pytest
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 import dnnevo
-from dnnevo import analysis
+from dnnevo import analysis, rundir
 from dnnevo.config import EvolutionConfig
 from dnnevo.rundir import RunDir
 
@@ -55,7 +55,8 @@ def test_analyze_writes_json_and_figures(runs: dict[str, Path], preset: str) -> 
     assert len(basins["basins"]) > 10 and set(basins["basins"]) <= {-1, *range(len(basins["attractors"]))}
     for name in ("analysis-phase.png", "analysis-bifurcation.png", "analysis-lesions.png", "analysis-basins.png"):
         assert_png(run / name)
-    assert not [p for p in run.iterdir() if p.name.startswith(".")], "temporary files left behind"
+    hidden = [p for p in run.iterdir() if p.name.startswith(".") and p.name != rundir.LOCK_NAME]
+    assert not hidden, "temporary files left behind"
 
 
 def test_analyze_options_and_a_two_neuron_portrait(tmp_path: Path, runs: dict[str, Path]) -> None:

@@ -10,6 +10,7 @@ import subprocess
 import sys
 import textwrap
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -111,7 +112,7 @@ def test_run_folder_contents(tmp_path: Path) -> None:
     out = tmp_path / "run"
     result = dnnevo.evolve(follow_square, SMALL, seed=2, out=out, progress=False)
     assert sorted(p.name for p in out.iterdir()) == [
-        "best.json", "checkpoint.json", "config.toml", "log.csv"]
+        ".dnnevo.lock", "best.json", "checkpoint.json", "config.toml", "log.csv"]
     saved = EvolutionConfig.from_toml((out / "config.toml").read_text())
     assert saved.task == "python:test_evolve.follow_square"
     assert dataclasses.replace(saved, task=SMALL.task) == SMALL
@@ -171,7 +172,12 @@ def test_signal_checkpoints_and_resume_is_identical(tmp_path: Path, sig: int) ->
     assert "checkpoint saved" in err and f"dnnevo resume {out}" in err, err
     assert "Traceback" not in err
     cfg = EvolutionConfig.from_dict({**SMALL.to_dict(), "generations": 40})
-    resumed = dnnevo.resume(out, follow_square, progress=False)
+    with pytest.raises(ConfigError, match="was evolved with python:__main__.slow"):
+        dnnevo.resume(out, follow_square, progress=False)
+    # slow is follow_square made slower: the same fitness under another name.
+    resumed = dnnevo.resume(out, follow_square, progress=False, new_fitness=True)
+    changes = tomllib.loads((out / "config.toml").read_text())["run"]["fitness_changes"]
+    assert [c["task"] for c in changes] == ["python:test_evolve.follow_square"]
     full = dnnevo.evolve(follow_square, cfg, seed=8, progress=False)
     for key in ("best", "mean", "std", "min"):
         np.testing.assert_array_equal(full.history[key], resumed.history[key])

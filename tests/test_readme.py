@@ -19,4 +19,4 @@ def test_python_example_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
         exec(compile(code, str(README), "exec"), {"__name__": "readme"})
     assert (tmp_path / "net.json").is_file()
     assert sorted(os.listdir(tmp_path / "runs" / "py")) == [
-        "best.json", "checkpoint.json", "config.toml", "log.csv"]
+        ".dnnevo.lock", "best.json", "checkpoint.json", "config.toml", "log.csv"]

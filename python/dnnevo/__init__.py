@@ -10,7 +10,24 @@
 
 from __future__ import annotations
 
-from dnnevo import plot, presets
+import sys as _sys
+from types import TracebackType as _TracebackType
+
+
+def _interrupted_import(kind: type[BaseException], value: BaseException,
+                        tb: _TracebackType | None) -> None:
+    """While dnnevo imports (e.g. the ``dnnevo`` command starting up), Ctrl-C is one line."""
+    _sys.excepthook = _sys.__excepthook__
+    if issubclass(kind, KeyboardInterrupt):
+        _sys.stderr.write("dnnevo: interrupted\n")
+    else:
+        _sys.__excepthook__(kind, value, tb)
+
+
+if _sys.excepthook is _sys.__excepthook__:
+    _sys.excepthook = _interrupted_import
+
+from dnnevo import plot, presets  # noqa: E402
 from dnnevo._core import LANES, Network, Trace, __version__, compose, run_population
 from dnnevo.config import EvolutionConfig, IntegratorConfig, Ranges
 from dnnevo.errors import (
@@ -23,6 +40,9 @@ from dnnevo.errors import (
 )
 from dnnevo.evolve import EvolutionResult, evaluate, evolve, resume
 from dnnevo.ga import GeneticAlgorithm
+
+if _sys.excepthook is _interrupted_import:
+    _sys.excepthook = _sys.__excepthook__
 
 __all__ = [
     "LANES",

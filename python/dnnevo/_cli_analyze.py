@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -18,7 +16,7 @@ from dnnevo import _core, analysis
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
-from dnnevo.rundir import RunDir, write_atomic
+from dnnevo.rundir import RunDir, save_figure, write_atomic
 
 EXAMPLE = """examples:
   dnnevo run sequence-1bit --quick --out runs/demo && dnnevo analyze runs/demo
@@ -99,24 +97,12 @@ def _range(text: str) -> tuple[float, float]:
     return a, b
 
 
-def _savefig(fig: Any, path: Path) -> None:
-    """Saves ``fig`` to a temporary file beside ``path`` and renames it into place."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=120)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def analyze(args: argparse.Namespace) -> int:
     """``dnnevo analyze``."""
     started = time.perf_counter()
     run = RunDir(args.dir)
-    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
-    net = _core.Network.load(run.best)
+    config, table = run.read_config()
+    net = run.read_best(config, table)
     m = net.n_inputs
     if config.task not in TASK_INPUTS:
         raise ConfigError(f"task {config.task!r} has no analysis defaults; tasks with one: {', '.join(TASK_INPUTS)}")
@@ -196,7 +182,7 @@ def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifu
                              title=f"{run.path.name}: equilibria as {label} varies")
         elif table is not None:
             plot_lesions(table, ax, title=f"{run.path.name}: lesions")
-        _savefig(fig, run.path / name)
+        save_figure(fig, run.path / name)
         plt.close(fig)
         written.append(name)
     return written
@@ -249,7 +235,7 @@ def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.nd
                 level_label=f"folds of the {name} sweep",
                 title=f"{run.path.name}: recorded trials; background: where the state would settle "
                       f"with input {off.label}")
-    _savefig(fig, run.path / "analysis-basins.png")
+    save_figure(fig, run.path / "analysis-basins.png")
     plt.close(fig)
     return "analysis-basins.png"
 

@@ -43,8 +43,8 @@ Exit status: 0 pass, 1 fail, 3 undecided, 2 error."""
 def evaluate(args: argparse.Namespace) -> int:
     """``dnnevo evaluate``."""
     run = RunDir(args.dir)
-    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
-    champion = _core.Network.load(run.best)
+    config, table = run.read_config()
+    champion = run.read_best(config, table)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     if args.robot_like and config.task != "landmark":
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")

@@ -9,7 +9,7 @@ from typing import Any
 from dnnevo import landmark
 from dnnevo.assess import Assessment
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir
+from dnnevo.rundir import RunDir, save_figure, write_atomic_with
 
 
 def preface(where: Path, a: Assessment) -> list[str]:
@@ -31,10 +31,9 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = Fal
     GIF of the landmark-2 trial."""
     import matplotlib.pyplot as plt
 
-    from dnnevo import _core
     from dnnevo.plot import plot_landmark_world, plot_traces
 
-    champion = _core.Network.load(run.best)
+    champion = run.read_best(config, run.read_config()[1])
     classifier = int(config.task_json().get("classifier", 0))
     records = [landmark.record(config, champion, n, seed=seed, trial=n) for n in (1, 2)]
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.5), layout="constrained")
@@ -44,12 +43,12 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = Fal
         plot_traces({"sonar": rec.input}, rec.outputs, ax, labels=labels, highlight=classifier,
                     title=f"landmark {rec.landmark}: said {1 if rec.classification < 0.5 else 2} "
                           f"(f = {rec.classification:.2f})")
-    fig.savefig(run.path / "fig1-traces.png", dpi=120)
+    save_figure(fig, run.path / "fig1-traces.png")
     plt.close(fig)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), layout="constrained")
     for ax, rec in zip(axes, records, strict=True):
         plot_landmark_world(rec, ax, title=f"landmark {rec.landmark}: path and sonar echoes")
-    fig.savefig(run.path / "world.png", dpi=120)
+    save_figure(fig, run.path / "world.png")
     plt.close(fig)
     written = ["fig1-traces.png", "world.png"]
     if animate:
@@ -91,5 +90,6 @@ def _animate(rec: landmark.Record, classifier: int, path: Any) -> None:
         line.set_data(range(k + 1), out[: k + 1])
 
     frames = len(out) // FRAME_STEPS
-    FuncAnimation(fig, draw, frames=frames).save(path, writer=PillowWriter(fps=10))
+    animation = FuncAnimation(fig, draw, frames=frames)
+    write_atomic_with(path, lambda tmp: animation.save(tmp, writer=PillowWriter(fps=10)), suffix=".gif")
     plt.close(fig)

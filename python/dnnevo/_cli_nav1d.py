@@ -15,7 +15,7 @@ import numpy as np
 from dnnevo import nav1d
 from dnnevo.assess import Assessment
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir, write_atomic
+from dnnevo.rundir import RunDir, save_figure, write_atomic
 
 SYSTEM_EXAMPLE = (
     "example: dnnevo nav1d-system --classifier runs/nav1d-classifier-seed0 "
@@ -65,10 +65,9 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
     a classifier, Fig. 3 (its traces in a landmark-near and a landmark-far trial)."""
     import matplotlib.pyplot as plt
 
-    from dnnevo import _core
     from dnnevo.plot import plot_nav1d_traces
 
-    champion = _core.Network.load(run.best)
+    champion = run.read_best(config, run.read_config()[1])
     params = config.task_json()
     k = params.get("trials_per_environment", 5) if params.get("objective") == "single" else 1
     records = [nav1d.record(config, champion, [c] * k) for c in nav1d.cases(config)]
@@ -84,7 +83,7 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
             plot_nav1d_traces(rec, ax, classifier=classifier, motors=motors, title=(
                 f"landmark-{env}, goal {goal}: "
                 f"{'reached' if rec.reached[0] else 'missed'}, f(v_C) = {rec.classification[0]:.2f}"))
-        fig.savefig(run.path / "fig3-classifier.png", dpi=120)
+        save_figure(fig, run.path / "fig3-classifier.png")
         plt.close(fig)
         written.append("fig3-classifier.png")
     return written
@@ -102,7 +101,7 @@ def _fig2(records: Sequence[nav1d.Record], params: dict[str, Any], title: str, p
                         landmark_width=float(params.get("landmark_width", 4.0)),
                         title=f"{letter}: landmark-{c.environment}, goal {c.goal}")
     fig.suptitle(title)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     plt.close(fig)
 
 

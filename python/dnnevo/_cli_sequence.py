@@ -9,7 +9,7 @@ from typing import Any
 from dnnevo import _core, sequence
 from dnnevo.assess import Assessment
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir
+from dnnevo.rundir import RunDir, save_figure
 
 
 def _targets(config: EvolutionConfig) -> list[str]:
@@ -54,14 +54,14 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
 
     from dnnevo.plot import plot_sequence_trial
 
-    champion = _core.Network.load(run.best)
+    champion = run.read_best(config, run.read_config()[1])
     targets = _targets(config)
     fig, axes = plt.subplots(len(targets), 1, figsize=(9, 2.6 * len(targets)),
                              layout="constrained", squeeze=False)
     for k, (target, ax) in enumerate(zip(targets, axes[:, 0], strict=True)):
         record = sequence.run_trial(config, champion, target, sequence.timings(config, seed, 0, k))
         plot_sequence_trial(record, ax=ax, title=f"{target}* positive trial")
-    fig.savefig(run.path / "fig4-trials.png", dpi=120)
+    save_figure(fig, run.path / "fig4-trials.png")
     plt.close(fig)
     written = ["fig4-trials.png"]
     if len(targets) >= 2:
@@ -71,7 +71,7 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
         plot_sequence_trial(a, ax=ax, follow=b, title=(
             f"{targets[-1]}* for 8 triggers, then {targets[0]}* without reset "
             f"({'settled after ' + str(needed) + ' trigger(s)' if needed is not None else 'never settled'})"))
-        fig.savefig(run.path / "fig5-switch.png", dpi=120)
+        save_figure(fig, run.path / "fig5-switch.png")
         plt.close(fig)
         written.append("fig5-switch.png")
     return written

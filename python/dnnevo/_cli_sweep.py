@@ -9,6 +9,7 @@ import argparse
 from dnnevo import presets, sweep
 from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
+from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.rundir import RunDir
 
@@ -33,7 +34,12 @@ def sweep_command(args: argparse.Namespace) -> int:
         raise ConfigError(f"task {config.task!r} has no success rule, so a sweep cannot judge it")
     for seed in args.seeds:  # before any run, so a bad --eval-seed costs nothing
         nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
-    RunDir(args.out).create(force=args.force)
+    with RunDir(args.out).writing(create=True) as folder:
+        folder.create(force=args.force, extra=sweep.SUMMARY_FILES)
+        return _sweep(args, config)
+
+
+def _sweep(args: argparse.Namespace, config: EvolutionConfig) -> int:
     trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
     runs = []
     for seed in args.seeds:

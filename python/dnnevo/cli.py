@@ -3,21 +3,27 @@
 
 from __future__ import annotations
 
+import sys
+
+import dnnevo
+
+# Ctrl-C while the rest of the command's modules load is one line too (see dnnevo/__init__.py).
+if sys.excepthook is sys.__excepthook__:
+    sys.excepthook = dnnevo._interrupted_import
+
 import argparse
 import functools
 import os
-import sys
 import traceback
 from pathlib import Path
 
 import numpy as np
 
-import dnnevo
 from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, sweep
 from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.rundir import RunDir
+from dnnevo.rundir import RunDir, save_figure
 
 EXAMPLES = """examples:
   dnnevo presets                                   list the experiments
@@ -99,7 +105,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("preset", help="preset name (see 'dnnevo presets')")
     p.add_argument("--seed", type=_nonnegative, default=0, help="random seed (default 0)")
     p.add_argument("--out", type=Path, help="run folder (default runs/PRESET-seedN)")
-    p.add_argument("--force", action="store_true", help="overwrite a non-empty run folder")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite a non-empty run folder (its run files and figures are removed)")
     p.add_argument("--seed-from", action="append", default=[], type=Path, metavar="RUN",
                    help="seed the initial population with RUN's champion (repeatable); "
                         "champions whose sizes add up to the preset's size are composed")
@@ -108,9 +115,18 @@ def build_parser() -> argparse.ArgumentParser:
                         "the i-th members of the runs are composed into the i-th seed")
     run_options(p)
 
-    p = sub.add_parser("resume", help="continue a stopped run", epilog="example: dnnevo resume runs/demo")
+    p = sub.add_parser("resume", help="continue a stopped run",
+                       description="Continue a stopped run from its checkpoint, bit for bit. Every "
+                                   "file of the folder is checked first; an edited config.toml is "
+                                   "refused, naming the first setting that differs.",
+                       epilog="examples:\n  dnnevo resume runs/demo\n"
+                              "  dnnevo resume runs/demo --generations 500   extend a finished run",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("dir", type=Path)
     p.add_argument("--threads", type=_positive)
+    p.add_argument("--generations", type=_positive, metavar="N",
+                   help="run until generation N (extends a finished run; config.toml and the "
+                        "checkpoint are updated to say so)")
 
     p = sub.add_parser("show", help="summarise a run and write fitness.png", epilog="example: dnnevo show runs/demo")
     p.add_argument("dir", type=Path)
@@ -187,10 +203,10 @@ def _seed_networks(runs: list[Path], size: int, *, populations: bool = False) ->
     member); when their sizes add up to ``size`` they are composed in order (the first run's
     output neuron stays the output), as in the paper's incremental route."""
     if populations:
-        groups = [dnnevo.GeneticAlgorithm.from_state_dict(RunDir(r).read_checkpoint()[0]).ask().networks
+        groups = [dnnevo.GeneticAlgorithm.from_state_dict(RunDir(r).read_checkpoint().state).ask().networks
                   for r in runs]
     else:
-        groups = [[dnnevo.Network.load(RunDir(r).best)] for r in runs]
+        groups = [[_champion(RunDir(r))] for r in runs]
     if len(groups) > 1 and sum(g[0].size for g in groups) == size:
         return [functools.reduce(dnnevo.compose, members) for members in zip(*groups)]
     return [net for group in groups for net in group]
@@ -204,14 +220,20 @@ def _report(result: dnnevo.EvolutionResult) -> int:
     return 130 if result.interrupted else 0
 
 
+def _champion(run: RunDir) -> dnnevo.Network:
+    """The run's best.json, checked against its config.toml."""
+    config, table = run.read_config()
+    return run.read_best(config, table)
+
+
 def _cmd_resume(args: argparse.Namespace) -> int:
-    return _report(dnnevo.resume(args.dir, threads=args.threads))
+    return _report(dnnevo.resume(args.dir, threads=args.threads, generations=args.generations))
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
     run = RunDir(args.dir)
-    history = run.read_log()
-    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
+    config, _ = run.read_config()
+    history = run.read_log(config)
     last = history[-1]
     best = max(history, key=lambda r: r["best"])
     print(f"{args.dir}: task {config.task}, population {config.population}, "
@@ -222,7 +244,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
     arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
     ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
-    ax.figure.savefig(run.path / "fitness.png", dpi=120)
+    save_figure(ax.figure, run.path / "fitness.png")
     print(f"wrote {run.path / 'fitness.png'}")
     return 0
 
@@ -240,12 +262,14 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from dnnevo.plot import plot_fitness
 
     run = RunDir(args.dir)
-    config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
-    history = run.read_log()
+    config, table = run.read_config()
+    history = run.read_log(config)
+    if config.task in ("sequence", "nav1d", "landmark"):
+        run.read_best(config, table)  # checked before any figure is written
     arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
     written = []
     ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
-    ax.figure.savefig(run.path / "fitness.png", dpi=120)
+    save_figure(ax.figure, run.path / "fitness.png")
     plt.close(ax.figure)
     written.append("fitness.png")
     if config.task == "sequence":
@@ -273,8 +297,14 @@ COMMANDS = {
 
 def main(argv: list[str] | None = None) -> int:
     """Runs the command line; returns the exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    if sys.excepthook is dnnevo._interrupted_import:
+        sys.excepthook = sys.__excepthook__
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:
+        sys.stderr.write("dnnevo: interrupted\n")
+        return 130
     if args.command is None:
         parser.print_help()
         return 0

@@ -132,6 +132,7 @@ class EvolutionConfig:
         if not isinstance(self.task_params, Mapping):
             raise ConfigError(f"task_params is {self.task_params!r}; expected a table")
         object.__setattr__(self, "task_params", dict(self.task_params))
+        _check_finite(self.task_params, "task_params")
 
     # -- conversions -------------------------------------------------------------------------
 
@@ -182,6 +183,20 @@ class EvolutionConfig:
             "integrator": dataclasses.asdict(self.integrator),
             **self.task_params,
         }
+
+
+def _check_finite(value: Any, where: str) -> None:
+    """Every number in ``value`` (nested tables and arrays, walked without recursion) is finite:
+    the tasks read JSON, which has no NaN or infinity."""
+    stack = [(value, where)]
+    while stack:
+        v, at = stack.pop()
+        if isinstance(v, float) and not math.isfinite(v):
+            raise ConfigError(f"{at} is {v}; every number must be finite")
+        if isinstance(v, Mapping):
+            stack.extend((x, f"{at}.{k}") for k, x in v.items())
+        elif isinstance(v, list | tuple):
+            stack.extend((x, f"{at}[{i}]") for i, x in enumerate(v))
 
 
 def _build(cls: type, d: Mapping[str, Any], where: str) -> Any:

@@ -23,11 +23,12 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
+from dnnevo._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError
 from dnnevo.ga import GeneticAlgorithm
 from dnnevo.progress import Progress
-from dnnevo.rundir import RunDir
+from dnnevo.rundir import RunDir, RunFileError, first_difference, short
 
 __all__ = ["EvolutionResult", "evaluate", "evolve", "resume"]
 
@@ -138,20 +139,24 @@ def evolve(
     came from.
     """
     if callable(task):
-        name = getattr(task, "__qualname__", type(task).__qualname__)
-        module = getattr(task, "__module__", None) or "?"
-        config = dataclasses.replace(config or EvolutionConfig(), task=f"{PYTHON_TASK}{module}.{name}")
+        config = dataclasses.replace(config or EvolutionConfig(), task=_python_task_name(task))
     else:
         config = _task_config(task, config)
         _check_layout(config)
         task = config.task  # a preset name stands for its config's task
-    run = RunDir(out) if out is not None else None
-    if run is not None:
-        run.create(force=force)
-        table = {**_run_table(seed), **(run_info or {})}
-        run.config.write_text(config.to_toml(run=table), encoding="utf-8")
     ga = GeneticAlgorithm(config, seed=seed, seeds=seeds)
-    return _loop(ga, task, [], run, progress=progress, callback=callback, threads=threads)
+    if out is None:
+        return _loop(ga, task, [], None, progress=progress, callback=callback, threads=threads)
+    run = RunDir(out)
+    table = {**_run_table(seed), **(run_info or {})}
+    with run.writing(create=True):
+        run.create(force=force)
+        # The checkpoint first: from here on the folder can be resumed.
+        run.write_checkpoint(ga.state_dict(), [], table, ga.seed)
+        run.write_config(config, table)
+        run.write_log([])
+        return _loop(ga, task, [], run, progress=progress, callback=callback, threads=threads,
+                     table=table)
 
 
 def resume(
@@ -161,19 +166,124 @@ def resume(
     progress: bool = True,
     callback: Callback | None = None,
     threads: int | None = None,
+    generations: int | None = None,
+    new_fitness: bool = False,
 ) -> EvolutionResult:
     """Continues a stopped run from its checkpoint; the result is identical to a run that was
-    never stopped. A run with a Python fitness function needs it passed again as ``task``."""
+    never stopped. A run with a Python fitness function needs it passed again as ``task``.
+
+    Every file of the folder is checked first: config.toml, the checkpoint's config (against
+    the digest it carries) and the GA state must agree, or a :class:`DnnevoError` names the
+    first field that differs. ``generations`` extends (or shortens, down to the generations
+    already done) the run; config.toml and the checkpoint are rewritten to say so. A ``task``
+    other than the run's own fitness function is refused unless ``new_fitness``, which records
+    the change in the ``[run]`` table of config.toml and of the checkpoint. A folder whose run
+    stopped before its first checkpoint is started from its config.toml. Temporary files left
+    by a killed write are removed, and a successful resume leaves best.json, log.csv, config.toml
+    and the checkpoint in agreement.
+    """
     run = RunDir(run_dir)
-    state, history = run.read_checkpoint()
-    ga = GeneticAlgorithm.from_state_dict(state)
-    if task is None and ga.config.task.startswith(PYTHON_TASK):
-        raise DnnevoError(
-            f"{run.path} was evolved with a Python fitness function ({ga.config.task}); resume it "
-            "from Python: dnnevo.resume(dir, task=fitness)"
-        )
-    fitness: str | FitnessFn = task if task is not None else ga.config.task
-    return _loop(ga, fitness, history, run, progress=progress, callback=callback, threads=threads)
+    with run.writing(create=False):
+        run.remove_stale()
+        if not run.checkpoint.exists() and not run.checkpoint.is_symlink():
+            ga, history, table = _restart(run)
+        else:
+            ga, history, table = _restored(run)
+        if generations is not None:
+            nonnegative("generations", generations)
+            if generations < max(ga.generation, 1):
+                raise ConfigError(f"generations is {generations}; the run has done {ga.generation}")
+            ga.config = dataclasses.replace(ga.config, generations=generations)
+        elif ga.generation > ga.config.generations:
+            raise RunFileError(f"{run.checkpoint}: generation {ga.generation} is beyond the run's "
+                               f"{ga.config.generations} generations")
+        fitness: str | FitnessFn = ga.config.task
+        if task is not None:
+            fitness = task
+            name = task if isinstance(task, str) else _python_task_name(task)
+            if name != ga.config.task:
+                if not new_fitness:
+                    raise ConfigError(
+                        f"{run.path} was evolved with {ga.config.task}, not {name}; pass "
+                        "new_fitness=True to continue it with another fitness function")
+                changes = [*table.get("fitness_changes", []),
+                           {"generation": ga.generation, "task": name}]
+                table = {**table, "fitness_changes": changes}
+                print(f"{run.path}: continuing at generation {ga.generation} with {name} "
+                      f"(the run was evolved with {ga.config.task}); recorded in config.toml",
+                      file=sys.stderr)
+        elif ga.config.task.startswith(PYTHON_TASK):
+            raise DnnevoError(
+                f"{run.path} was evolved with a Python fitness function ({ga.config.task}); resume it "
+                "from Python: dnnevo.resume(dir, task=fitness)"
+            )
+        # Every file rewritten from the state about to continue, so they agree from here on.
+        run.write_checkpoint(ga.state_dict(), history, table, ga.seed)
+        run.write_config(ga.config, table)
+        run.write_log(history)
+        _write_best(run, ga)
+        return _loop(ga, fitness, history, run, progress=progress, callback=callback,
+                     threads=threads, table=table)
+
+
+def _python_task_name(task: FitnessFn) -> str:
+    name = getattr(task, "__qualname__", type(task).__qualname__)
+    module = getattr(task, "__module__", None) or "?"
+    return f"{PYTHON_TASK}{module}.{name}"
+
+
+def _restart(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], dict[str, Any]]:
+    """A folder with a config.toml and no checkpoint: its run stopped before its first
+    checkpoint, so it starts again from generation 0 (identical to a run never stopped)."""
+    if not run.config.exists():
+        raise RunFileError(f"{run.path} has no checkpoint.json and no config.toml; nothing to resume "
+                           "(start the run again)")
+    config, table = run.read_config()
+    if "seed" not in table:
+        raise RunFileError(f"{run.config}: has no [run] table with the run's seed")
+    if "seeded_from" in table:
+        raise RunFileError(f"{run.path} stopped before its first checkpoint and was seeded from other "
+                           "runs; start it again with --force")
+    if not config.task.startswith(PYTHON_TASK):
+        _check_layout(config)
+    return GeneticAlgorithm(config, seed=table["seed"]), [], table
+
+
+def _restored(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], dict[str, Any]]:
+    """The checkpoint's GA and history, checked against each other and against config.toml."""
+    cp = run.read_checkpoint()
+    try:
+        ga = GeneticAlgorithm.from_state_dict(cp.state)
+    except DnnevoError as e:
+        raise RunFileError(f"{run.checkpoint}: state.evolution: {e}") from None
+    where = run.checkpoint
+    evo = json.loads(ga._evo.to_json())
+    expected = {"config": ga.config.ga_json(),
+                "layout": {"size": ga.config.size, "n_inputs": ga.config.n_inputs}}
+    found = {"config": evo["config"], "layout": evo["layout"]}
+    diff = first_difference(expected, found)
+    if diff is not None:
+        raise RunFileError(f"{where}: the GA state disagrees with state.config at {diff[0]} "
+                           f"({short(diff[2])} in the GA state, {short(diff[1])} in the config)")
+    if len(cp.history) != ga.generation:
+        raise RunFileError(f"{where}: the history has {len(cp.history)} generations; the GA state "
+                           f"is at generation {ga.generation}")
+    table = dict(cp.run) if cp.run is not None else _run_table(ga.seed)
+    if table["seed"] != ga.seed:
+        raise RunFileError(f"{where}: run.seed is {table['seed']}; the GA state's seed is {ga.seed}")
+    if run.config.exists() or run.config.is_symlink():
+        config, toml_table = run.read_config()
+        diff = first_difference(config.to_dict(), ga.config.to_dict())
+        if diff is None and toml_table.get("seed") != ga.seed:
+            diff = ("run.seed", toml_table.get("seed", "(missing)"), ga.seed)
+        if diff is not None:
+            raise RunFileError(
+                f"{run.config} disagrees with checkpoint.json at {diff[0]}: {short(diff[1])} in "
+                f"config.toml, {short(diff[2])} in the checkpoint (to run longer, use "
+                f"'dnnevo resume {run.path} --generations N')")
+        if cp.run is None:
+            table = toml_table
+    return ga, cp.history, table
 
 
 def _run_table(seed: int) -> dict[str, Any]:
@@ -224,6 +334,7 @@ def _loop(
     progress: bool,
     callback: Callback | None,
     threads: int | None,
+    table: Mapping[str, Any] | None = None,
 ) -> EvolutionResult:
     config = ga.config
     bar = Progress(config.generations, start=ga.generation) if progress else None
@@ -238,7 +349,8 @@ def _loop(
     def save_state() -> None:
         if run is not None:
             run.write_log(history)
-            run.write_checkpoint(ga.state_dict(), history)
+            run.write_checkpoint(ga.state_dict(), history, table or _run_table(ga.seed), ga.seed)
+            _write_best(run, ga)
 
     try:
         with _StopRequest().installed() as stop:
@@ -326,8 +438,11 @@ def _champion_success(ga: GeneticAlgorithm, task_json: str | None) -> float:
 
 
 def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
+    """Writes the champion as best.json; before the first generation there is none."""
     champ = ga._evo.champion()
-    assert champ is not None
+    if champ is None:
+        run.best.unlink(missing_ok=True)
+        return
     net, fitness, generation = champ
     meta: dict[str, Any] = {
         "task": ga.config.task,

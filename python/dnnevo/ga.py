@@ -100,7 +100,12 @@ class GeneticAlgorithm:
         return {"config": self.config.to_dict(), "evolution": self._evo.to_json()}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restores a state from :meth:`state_dict`."""
+        """Restores a state from :meth:`state_dict`; anything else is a :class:`ConfigError`."""
+        if not isinstance(state, dict) or set(state) != {"config", "evolution"}:
+            got = sorted(state) if isinstance(state, dict) else type(state).__name__
+            raise ConfigError(f"a GA state is a dict with 'config' and 'evolution'; got {got}")
+        if not isinstance(state["evolution"], str):
+            raise ConfigError("the GA state's 'evolution' must be JSON text from state_dict()")
         self.config = EvolutionConfig.from_dict(state["config"])
         self._evo = _core.Evolution.from_json(state["evolution"])
 

@@ -174,12 +174,12 @@ def load_part(run_dir: str | Path, role: str | None = None) -> Part:
 
     where = f"{role} {run_dir}" if role else str(run_dir)
     run = RunDir(Path(run_dir))
+    config, table = run.read_config()
     try:
-        config = EvolutionConfig.from_toml(run.config.read_text(encoding="utf-8"))
         _params(config)
     except ConfigError as e:
         raise ConfigError(f"{where}: {e}") from None
-    return Part(config, _core.Network.load(run.best))
+    return Part(config, run.read_best(config, table))
 
 
 def _parts(classifier: Part, far: Part, near: Part) -> list[tuple[str, _core.Network]]:

@@ -1,4 +1,5 @@
-"""Run folders: config, per-generation log, champion and checkpoint, each written atomically.
+"""Run folders: config, per-generation log, champion and checkpoint, each written atomically,
+each validated when read.
 
 A run folder holds:
 
@@ -9,21 +10,51 @@ A run folder holds:
   the task has none); the champion's validation rate and score (``nan`` when it was chosen by
   training fitness); evaluations per second and elapsed seconds;
 - ``best.json``: the champion in the ``dnnevo-network`` format, with meta;
-- ``checkpoint.json``: the GA state and the history, enough to continue bit for bit.
+- ``checkpoint.json``: the GA state, the history and a digest of the complete run config, enough
+  to continue bit for bit (written at generation 0, before anything else, so a folder is
+  resumable from the moment it holds a run);
+- ``.dnnevo.lock``: the lock of the one process that writes the folder (``run``, ``resume``,
+  ``sweep``). It is an ``flock`` lock, so it dies with its process; the file itself stays and
+  holds the last writer's PID.
+
+Every file is checked when read: its type, shape, ranges and finiteness, and its agreement with
+the other files. Whatever is wrong raises :class:`~dnnevo.errors.DnnevoError` (or a subclass)
+with one line naming the file and the problem.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import fcntl
+import hashlib
+import io
 import json
+import math
 import os
+import re
 import tempfile
+import tomllib
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from dnnevo.errors import DnnevoError
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import ConfigError, DnnevoError, FormatError
 
-__all__ = ["LOG_COLUMNS", "RunDir", "write_atomic"]
+if TYPE_CHECKING:
+    from dnnevo._core import Network
+
+__all__ = [
+    "LOG_COLUMNS",
+    "RunDir",
+    "RunFileError",
+    "config_digest",
+    "first_difference",
+    "save_figure",
+    "short",
+    "write_atomic",
+]
 
 LOG_COLUMNS = (
     "generation",
@@ -37,17 +68,66 @@ LOG_COLUMNS = (
     "evals_per_s",
     "elapsed_s",
 )
+#: Columns a history from before they existed may lack (those generations have no value).
+OPTIONAL_COLUMNS = ("champion_success", "validation_rate", "validation_score")
 CHECKPOINT_FORMAT = "dnnevo-checkpoint"
-CHECKPOINT_VERSION = 1
+#: Version 2 added the run table and the config digest; version 1 is still read.
+CHECKPOINT_VERSION = 2
+LOCK_NAME = ".dnnevo.lock"
+RUN_FILES = ("config.toml", "log.csv", "best.json", "checkpoint.json")
+#: Every file ``show``, ``plot`` and ``analyze`` derive from a run; ``--force`` removes them with
+#: the run's files.
+FIGURES = (
+    "fitness.png",
+    "fig1-traces.png",
+    "world.png",
+    "trial-landmark2.gif",
+    "fig2-paths.png",
+    "fig3-classifier.png",
+    "fig4-trials.png",
+    "fig5-switch.png",
+    "analysis-phase.png",
+    "analysis-bifurcation.png",
+    "analysis-basins.png",
+    "analysis-lesions.png",
+    "analysis.json",
+)
+#: Temporary files of atomic writes: ``.NAME.RANDOM.tmp`` (Python, Rust), optionally with the
+#: final name's extension after it, and ``.NAME.tmpPID`` (Rust before version 0.1.1).
+_TEMP = re.compile(r"^\.(?P<name>.+)\.(?:[A-Za-z0-9_]{8,16}\.tmp(?:\.[a-z]+)?|tmp\d+)$")
 
 
-def write_atomic(path: Path, text: str) -> None:
-    """Writes ``text`` to a temporary file beside ``path``, syncs it, and renames it into place."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+#: Files are created with mode 0666 & ~umask, as ``open()`` and Rust's ``File::create`` do.
+FILE_MODE = 0o666 & ~_umask()
+
+
+class RunFileError(DnnevoError):
+    """A file of a run folder is missing, damaged or disagrees with the others."""
+
+
+def _fail(path: Path, problem: str) -> RunFileError:
+    return RunFileError(f"{path}: {problem}")
+
+
+# -- writing --------------------------------------------------------------------------------
+
+
+def write_atomic_with(path: Path, write: Callable[[str], None], *, suffix: str = "") -> None:
+    """Calls ``write(tmp)`` on a new, exclusively created temporary file beside ``path`` (named
+    ``.NAME.RANDOM.tmp`` + ``suffix``), syncs it and renames it over ``path``. The rename replaces
+    a symlink at ``path``; it never writes through one."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{suffix}")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
+        os.fchmod(fd, FILE_MODE)
+        os.close(fd)
+        write(tmp)
+        with open(tmp, "rb+") as f:
             os.fsync(f.fileno())
         os.replace(tmp, path)
     except BaseException:
@@ -55,63 +135,390 @@ def write_atomic(path: Path, text: str) -> None:
         raise
 
 
+def write_atomic(path: Path, text: str) -> None:
+    """Writes ``text`` to a temporary file beside ``path``, syncs it, and renames it into place."""
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+
+    write_atomic_with(path, write)
+
+
+def save_figure(fig: Any, path: Path, *, dpi: int = 120) -> None:
+    """Saves a matplotlib figure as ``path`` (PNG) atomically."""
+    write_atomic_with(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png"))
+
+
+def config_digest(config: EvolutionConfig, seed: int) -> str:
+    """SHA-256 of the complete run config (every setting and the seed), as canonical JSON."""
+    doc = {"config": config.to_dict(), "seed": seed}
+    text = json.dumps(doc, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def first_difference(a: Any, b: Any, prefix: str = "") -> tuple[str, Any, Any] | None:
+    """The first field (dotted name) where two config dicts differ, with both values; numbers
+    compare by value (1 equals 1.0), and ``None`` means they agree."""
+    if isinstance(a, Mapping) and isinstance(b, Mapping):
+        for key in [*a, *(k for k in b if k not in a)]:
+            name = f"{prefix}.{key}" if prefix else str(key)
+            if key not in a or key not in b:
+                return name, a.get(key, "(missing)"), b.get(key, "(missing)")
+            found = first_difference(a[key], b[key], name)
+            if found is not None:
+                return found
+        return None
+    same = a == b and isinstance(a, bool) == isinstance(b, bool)
+    return None if same else (prefix, a, b)
+
+
+#: The deepest nesting of tables and arrays accepted in config.toml (a run's own is 3 deep).
+MAX_CONFIG_DEPTH = 16
+
+
+def _depth(value: Any) -> int:
+    """How deeply ``value`` nests lists and dicts, without recursion."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, dict | list):
+            deepest = max(deepest, d + 1)
+            if deepest > MAX_CONFIG_DEPTH:
+                return deepest
+            stack.extend((x, d + 1) for x in (v.values() if isinstance(v, dict) else v))
+    return deepest
+
+
+# -- reading --------------------------------------------------------------------------------
+
+
+def _read_text(path: Path) -> str:
+    if path.is_symlink() or not path.is_file():
+        problem = "is a symlink" if path.is_symlink() else "is missing or not a file"
+        raise _fail(path, problem)
+    data = path.read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise _fail(path, f"is not UTF-8 text (byte {e.start})") from None
+
+
+def _load_json(path: Path, text: str) -> Any:
+    try:
+        return json.loads(text)
+    except RecursionError:
+        raise _fail(path, "JSON nested too deeply") from None
+    except ValueError as e:
+        raise _fail(path, f"not valid JSON: {e}") from None
+
+
+def _number(path: Path, where: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise _fail(path, f"{where} is {short(value)}; expected a number")
+    return float(value)
+
+
+def short(value: Any) -> str:
+    """``repr(value)``, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def check_history(path: Path, rows: list[dict[str, float]], *, what: str = "generation") -> None:
+    """The rules every history obeys, in checkpoint.json and log.csv alike: rows of generations
+    0, 1, 2, ... in order; finite fitness statistics, std >= 0, min <= best; success 0, 1 or NaN;
+    a validation rate in [0, 1] and a finite score, or both NaN; evaluations per second finite
+    and >= 0; elapsed seconds finite, >= 0 and never decreasing."""
+    elapsed = 0.0
+    for i, row in enumerate(rows):
+        at = f"{what} row {i + 1}"
+        if row["generation"] != i:
+            raise _fail(path, f"{at} has generation {row['generation']:g}; expected {i}")
+        for k in ("best", "mean", "std", "min", "evals_per_s", "elapsed_s"):
+            if not math.isfinite(row[k]):
+                raise _fail(path, f"{at}: {k} is {row[k]}; expected a finite number")
+        if row["std"] < 0 or row["evals_per_s"] < 0 or row["elapsed_s"] < 0:
+            raise _fail(path, f"{at}: std, evals_per_s and elapsed_s must be >= 0")
+        if row["min"] > row["best"]:
+            raise _fail(path, f"{at}: min {row['min']} exceeds best {row['best']}")
+        success = row["champion_success"]
+        if not (math.isnan(success) or success in (0.0, 1.0)):
+            raise _fail(path, f"{at}: champion_success is {success}; expected 0, 1 or nan")
+        rate, score = row["validation_rate"], row["validation_score"]
+        if math.isnan(rate) != math.isnan(score) or not (
+                math.isnan(rate) or (0.0 <= rate <= 1.0 and math.isfinite(score))):
+            raise _fail(path, f"{at}: validation_rate {rate} and validation_score {score} "
+                              "must be a rate in [0, 1] and a finite score, or both nan")
+        if row["elapsed_s"] < elapsed:
+            raise _fail(path, f"{at}: elapsed_s goes back in time ({row['elapsed_s']} < {elapsed})")
+        elapsed = row["elapsed_s"]
+
+
+def _history_rows(path: Path, history: Any) -> list[dict[str, float]]:
+    if not isinstance(history, list):
+        raise _fail(path, f"history is {type(history).__name__}; expected a list")
+    rows = []
+    for i, raw in enumerate(history):
+        if not isinstance(raw, dict):
+            raise _fail(path, f"history[{i}] is {type(raw).__name__}; expected an object")
+        unknown = sorted(set(raw) - set(LOG_COLUMNS))
+        if unknown:
+            raise _fail(path, f"history[{i}] has unknown key {unknown[0]!r}")
+        row = {}
+        for k in LOG_COLUMNS:
+            if k not in raw and k not in OPTIONAL_COLUMNS:
+                raise _fail(path, f"history[{i}] has no {k!r}")
+            row[k] = _number(path, f"history[{i}].{k}", raw.get(k, math.nan))
+        rows.append(row)
+    check_history(path, rows, what="history")
+    return rows
+
+
+class Checkpoint:
+    """A validated checkpoint: the GA state, the history and the run table."""
+
+    def __init__(self, state: dict[str, Any], history: list[dict[str, float]],
+                 run: dict[str, Any] | None, config: EvolutionConfig) -> None:
+        self.state = state
+        self.history = history
+        self.run = run
+        """The ``[run]`` table (seed, version, ...); None in a version-1 checkpoint."""
+        self.config = config
+
+
 class RunDir:
     """The files of one run."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
+        self._lock_fd: int | None = None
 
     config = property(lambda self: self.path / "config.toml")
     log = property(lambda self: self.path / "log.csv")
     best = property(lambda self: self.path / "best.json")
     checkpoint = property(lambda self: self.path / "checkpoint.json")
+    lock_file = property(lambda self: self.path / LOCK_NAME)
 
-    def create(self, *, force: bool) -> None:
-        """Makes the folder; a non-empty one is refused unless ``force``."""
+    # -- the writer's lock --------------------------------------------------------------------
+
+    @contextlib.contextmanager
+    def writing(self, *, create: bool) -> Iterator[RunDir]:
+        """Holds the folder's exclusive lock (making the folder first when ``create``); another
+        writer gets a :class:`DnnevoError` naming the holder's PID. The lock dies with the
+        process, so a killed run never leaves a stale lock."""
         if self.path.exists() and not self.path.is_dir():
             raise DnnevoError(f"{self.path} exists and is not a folder")
-        if self.path.is_dir() and any(self.path.iterdir()) and not force:
+        if create:
+            self.path.mkdir(parents=True, exist_ok=True)
+        elif not self.path.is_dir():
+            raise RunFileError(f"{self.path} has no checkpoint.json; is it a dnnevo run folder?")
+        flags = os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC
+        try:
+            fd = os.open(self.lock_file, flags, FILE_MODE)
+        except OSError as e:
+            raise DnnevoError(f"cannot open the lock file {self.lock_file}: {e.strerror}") from None
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "unknown"
+                raise DnnevoError(
+                    f"{self.path} is in use by another dnnevo process (PID {holder}); "
+                    "wait for it to finish or stop it first") from None
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            self._lock_fd = fd
+            yield self
+        finally:
+            self._lock_fd = None
+            os.close(fd)
+
+    def stale_files(self) -> list[Path]:
+        """Temporary files of this folder's own atomic writes (the run's four files); stale when
+        the lock is held, as only the lock's holder writes them."""
+        out = []
+        for p in self.path.iterdir():
+            m = _TEMP.match(p.name)
+            if m and m["name"] in RUN_FILES:
+                out.append(p)
+        return out
+
+    def remove_stale(self) -> None:
+        """Removes temporary files left by a writer that was killed inside a write."""
+        for p in self.stale_files():
+            p.unlink(missing_ok=True)
+
+    def _leftover(self, p: Path) -> bool:
+        """A file that holds no run: the lock file, or a temporary file of a killed write."""
+        return p.name == LOCK_NAME or (_TEMP.match(p.name) is not None and p.is_file())
+
+    def create(self, *, force: bool, extra: tuple[str, ...] = ()) -> None:
+        """Readies the locked folder for a new run: one that holds more than a lock file and
+        temporary files is refused unless ``force``, which removes the old run's files, figures
+        and ``extra`` files (other files are kept)."""
+        assert self._lock_fd is not None, "create() needs the lock"
+        contents = [p for p in self.path.iterdir() if not self._leftover(p)]
+        if contents and not force:
             raise DnnevoError(
                 f"{self.path} is not empty; choose another --out, resume it with "
                 f"'dnnevo resume {self.path}', or pass --force to overwrite"
             )
-        self.path.mkdir(parents=True, exist_ok=True)
-        if force:
-            for name in (self.config, self.log, self.best, self.checkpoint):
-                name.unlink(missing_ok=True)
+        self.clear(extra)
+
+    def clear(self, extra: tuple[str, ...] = ()) -> None:
+        """Removes the run's files, its figures, ``extra`` files and every temporary file of a
+        killed write."""
+        for name in (*RUN_FILES, *FIGURES, *extra):
+            (self.path / name).unlink(missing_ok=True)
+        for p in self.path.iterdir():
+            if _TEMP.match(p.name) and p.is_file():
+                p.unlink(missing_ok=True)
+
+    # -- writing ------------------------------------------------------------------------------
+
+    def write_config(self, config: EvolutionConfig, run: Mapping[str, Any]) -> None:
+        """Writes ``config.toml`` with its ``[run]`` table."""
+        write_atomic(self.config, config.to_toml(run=run))
 
     def write_log(self, history: list[dict[str, float]]) -> None:
         """Rewrites ``log.csv`` from the whole history (atomic, so never torn)."""
         lines = [",".join(LOG_COLUMNS)]
-        # Histories from before a column existed lack it: those generations have no value.
         lines += [",".join(repr(float(row.get(k, "nan"))) for k in LOG_COLUMNS) for row in history]
         write_atomic(self.log, "\n".join(lines) + "\n")
 
-    def write_checkpoint(self, state: dict[str, Any], history: list[dict[str, float]]) -> None:
-        """Writes the GA state and the history."""
+    def write_checkpoint(self, state: dict[str, Any], history: list[dict[str, float]],
+                         run: Mapping[str, Any], seed: int) -> None:
+        """Writes the GA state, the history, the run table and the config's digest."""
+        config = EvolutionConfig.from_dict(state["config"])
         doc = {
             "format": CHECKPOINT_FORMAT,
             "version": CHECKPOINT_VERSION,
+            "config_sha256": config_digest(config, seed),
+            "run": dict(run),
             "state": state,
             "history": history,
         }
-        write_atomic(self.checkpoint, json.dumps(doc))
+        write_atomic(self.checkpoint, json.dumps(doc, allow_nan=True))
 
-    def read_checkpoint(self) -> tuple[dict[str, Any], list[dict[str, float]]]:
-        """The GA state and history saved by :meth:`write_checkpoint`."""
-        if not self.checkpoint.is_file():
-            raise DnnevoError(f"{self.path} has no checkpoint.json; is it a dnnevo run folder?")
+    # -- reading ------------------------------------------------------------------------------
+
+    def read_config(self) -> tuple[EvolutionConfig, dict[str, Any]]:
+        """``config.toml``: the config (which must name its task) and its ``[run]`` table (empty
+        in a config written by hand; its seed, if any, checked)."""
+        path = self.config
+        if not path.exists() and not path.is_symlink():
+            raise RunFileError(f"{self.path} has no config.toml; is it a dnnevo run folder?")
+        text = _read_text(path)
         try:
-            doc = json.loads(self.checkpoint.read_text(encoding="utf-8"))
-            if doc.get("format") != CHECKPOINT_FORMAT or doc.get("version") != CHECKPOINT_VERSION:
-                raise ValueError("wrong format or version")
-            return doc["state"], doc["history"]
-        except (ValueError, KeyError, TypeError) as e:
-            raise DnnevoError(f"{self.checkpoint} is not a valid checkpoint: {e}") from None
+            doc = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise _fail(path, f"not valid TOML: {e}") from None
+        except RecursionError:
+            raise _fail(path, "TOML nested too deeply") from None
+        if _depth(doc) > MAX_CONFIG_DEPTH:
+            raise _fail(path, f"tables and arrays nested deeper than {MAX_CONFIG_DEPTH}")
+        run = doc.pop("run", {})
+        if not isinstance(run, dict):
+            raise _fail(path, f"run is {short(run)}; expected a table")
+        seed = run.get("seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
+            raise _fail(path, f"run.seed is {short(seed)}; expected an integer in [0, 2**64)")
+        if "task" not in doc:
+            raise _fail(path, "has no task")
+        try:
+            config = EvolutionConfig.from_dict(doc)
+        except ConfigError as e:
+            raise _fail(path, str(e)) from None
+        return config, run
 
-    def read_log(self) -> list[dict[str, float]]:
-        """The rows of ``log.csv`` as floats."""
-        if not self.log.is_file():
-            raise DnnevoError(f"{self.path} has no log.csv; is it a dnnevo run folder?")
-        with self.log.open(encoding="utf-8") as f:
-            return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    def read_checkpoint(self) -> Checkpoint:
+        """The validated checkpoint: its structure, its history (the same rules as log.csv),
+        and its config against the digest it carries."""
+        path = self.checkpoint
+        if not path.exists() and not path.is_symlink():
+            raise RunFileError(f"{self.path} has no checkpoint.json; is it a dnnevo run folder?")
+        doc = _load_json(path, _read_text(path))
+        if not isinstance(doc, dict):
+            raise _fail(path, f"is a JSON {type(doc).__name__}; expected an object")
+        if doc.get("format") != CHECKPOINT_FORMAT or doc.get("version") not in (1, CHECKPOINT_VERSION):
+            raise _fail(path, f"format/version is {short(doc.get('format'))}/"
+                              f"{short(doc.get('version'))}; expected {CHECKPOINT_FORMAT}/1 or 2")
+        state = doc.get("state")
+        if not isinstance(state, dict) or set(state) != {"config", "evolution"}:
+            raise _fail(path, "state must be an object with 'config' and 'evolution'")
+        if not isinstance(state["evolution"], str):
+            raise _fail(path, "state.evolution must be the GA state as JSON text")
+        if _depth(state["config"]) > MAX_CONFIG_DEPTH:
+            raise _fail(path, f"state.config nests deeper than {MAX_CONFIG_DEPTH}")
+        try:
+            config = EvolutionConfig.from_dict(state["config"])
+        except ConfigError as e:
+            raise _fail(path, f"state.config: {e}") from None
+        history = _history_rows(path, doc.get("history"))
+        run = None
+        if doc["version"] >= 2:
+            run = doc.get("run")
+            seed = run.get("seed") if isinstance(run, dict) else None
+            if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
+                raise _fail(path, "run.seed must be an integer in [0, 2**64)")
+            if doc.get("config_sha256") != config_digest(config, seed):
+                raise _fail(path, "its config does not match the digest it carries (was it edited?)")
+        return Checkpoint(state, history, run, config)
+
+    def read_log(self, config: EvolutionConfig | None = None) -> list[dict[str, float]]:
+        """The rows of ``log.csv`` as floats, checked by the rules of the checkpoint's history,
+        and no more generations than ``config`` has."""
+        path = self.log
+        if not path.exists() and not path.is_symlink():
+            raise RunFileError(f"{self.path} has no log.csv; is it a dnnevo run folder?")
+        text = _read_text(path)
+        try:
+            table = list(csv.reader(io.StringIO(text, newline=""), strict=True))
+        except csv.Error as e:
+            raise _fail(path, f"not valid CSV: {e}") from None
+        if not table:
+            raise _fail(path, "is empty")
+        header = table[0]
+        required = [c for c in LOG_COLUMNS if c not in OPTIONAL_COLUMNS]
+        if len(set(header)) != len(header) or not set(required) <= set(header) <= set(LOG_COLUMNS):
+            raise _fail(path, f"has columns {','.join(header)[:80]}; expected {','.join(LOG_COLUMNS)}")
+        rows = []
+        for i, cells in enumerate(table[1:]):
+            if len(cells) != len(header):
+                raise _fail(path, f"row {i + 1} has {len(cells)} values; expected {len(header)}")
+            row = dict.fromkeys(LOG_COLUMNS, math.nan)
+            for k, cell in zip(header, cells, strict=True):
+                try:
+                    row[k] = float(cell)
+                except ValueError:
+                    raise _fail(path, f"row {i + 1}: {k} is {short(cell)}; expected a number") from None
+            rows.append(row)
+        check_history(path, rows)
+        if not rows:
+            raise _fail(path, "has no generations yet")
+        if config is not None and len(rows) > config.generations:
+            raise _fail(path, f"has {len(rows)} generations; config.toml has {config.generations}")
+        return rows
+
+    def read_best(self, config: EvolutionConfig, run: Mapping[str, Any] | None = None) -> Network:
+        """``best.json``, which must be a network of the run's size and inputs, and, when its
+        meta says, of the run's task and seed."""
+        from dnnevo._core import Network
+
+        path = self.best
+        if not path.exists() and not path.is_symlink():
+            raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")
+        try:
+            net = Network.load(path)
+        except FormatError as e:
+            raise RunFileError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
+        if (net.size, net.n_inputs) != (config.size, config.n_inputs):
+            raise _fail(path, f"is a network of size {net.size} with {net.n_inputs} inputs; the run "
+                              f"has size {config.size} with {config.n_inputs} inputs")
+        meta = net.meta
+        if "task" in meta and meta["task"] != config.task:
+            raise _fail(path, f"meta.task is {short(meta['task'])}; the run's task is {config.task!r}")
+        if run is not None and "seed" in meta and "seed" in run and meta["seed"] != run["seed"]:
+            raise _fail(path, f"meta.seed is {short(meta.get('seed'))}; the run's seed is {run.get('seed')}")
+        return net

@@ -38,7 +38,7 @@ from dnnevo.rundir import RunDir, write_atomic
 from dnnevo.stats import Verdict
 from dnnevo.stepcheck import StepCheck, step_check
 
-__all__ = ["EVAL_SEED_BASE", "CSV_COLUMNS", "SeedResult", "Summary", "eval_seed", "run_seed", "summarize"]
+__all__ = ["EVAL_SEED_BASE", "CSV_COLUMNS", "SUMMARY_FILES", "SeedResult", "Summary", "eval_seed", "run_seed", "summarize"]
 
 EVAL_SEED_BASE = 1_000_003
 """The fresh conditions of seed s's final champion come from seed ``EVAL_SEED_BASE + s``."""
@@ -51,6 +51,10 @@ CSV_COLUMNS = (
 )
 """The columns of ``summary.csv``: one row per seed, then a row ``all`` whose cells aggregate
 their column (see :meth:`Summary.csv_text`)."""
+
+
+SUMMARY_FILES = ("summary.csv", "summary.json")
+"""The files a sweep writes into its folder, beside a run folder per seed."""
 
 
 def eval_seed(seed: int, base: int = EVAL_SEED_BASE) -> int:
@@ -109,7 +113,7 @@ def run_seed(
     t0 = time.perf_counter()
     result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force)
     wall = time.perf_counter() - t0
-    champion = _core.Network.load(RunDir(out).best)
+    champion = RunDir(out).read_best(config, {"seed": seed})
     fresh = eval_seed(seed, eval_seed_base)
     final = assess(config, champion, eval_trials, seed=fresh)
     step = step_check(config, champion, seed=fresh, base=final) if dt_check else None
@@ -206,7 +210,7 @@ class Summary:
     def write(self, out: Path, info: dict[str, Any] | None = None) -> list[Path]:
         """Writes ``summary.csv`` and ``summary.json`` (with ``info``, e.g. the preset, first)
         into ``out``; returns their paths."""
-        paths = [out / "summary.csv", out / "summary.json"]
+        paths = [out / name for name in SUMMARY_FILES]
         write_atomic(paths[0], self.csv_text())
         write_atomic(paths[1], json.dumps({**(info or {}), **self.to_dict()}, indent=1) + "\n")
         return paths

@@ -180,6 +180,7 @@ impl Evolution {
     ) -> Result<Self> {
         config.validate()?;
         layout.validate()?;
+        check_population_size(layout, &config)?;
         let g = layout.len();
         let mut population = ga::initial_population(layout, &config, seed)?;
         if seeds.len() > config.population {
@@ -416,6 +417,7 @@ impl Evolution {
             .map_err(|e| Error::Format(format!("not a valid checkpoint: {e}")))?;
         evo.config.validate()?;
         evo.layout.validate()?;
+        check_population_size(evo.layout, &evo.config)?;
         if evo.population.len() != evo.config.population * evo.layout.len() {
             return Err(Error::Format(format!(
                 "checkpoint population has {} genes; expected {} x {}",
@@ -428,9 +430,66 @@ impl Evolution {
     }
 }
 
+/// The most genes a population may hold: 2^27, 1 GiB of `f64` (the breeding step holds two
+/// such arrays).
+pub const MAX_POPULATION_GENES: usize = 1 << 27;
+
+/// Refuses a population too large to allocate, saying what it would need.
+fn check_population_size(layout: Layout, config: &GaConfig) -> Result<()> {
+    let genes = config.population.checked_mul(layout.len());
+    match genes {
+        Some(g) if g <= MAX_POPULATION_GENES => Ok(()),
+        _ => Err(Error::Config(format!(
+            "a population of {} networks of {} parameters needs {}; the limit is \
+             {MAX_POPULATION_GENES} parameters (1 GiB)",
+            config.population,
+            layout.len(),
+            genome::bytes(genes.map(|g| g as f64 * 8.0)),
+        ))),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_layouts_and_populations_are_errors_not_aborts() {
+        let config = GaConfig::default();
+        for (size, n_inputs) in [
+            (1_000_000, 1),
+            (usize::MAX / 2, usize::MAX / 2),
+            (3, usize::MAX),
+        ] {
+            let e = Evolution::new(
+                Layout { size, n_inputs },
+                config.clone(),
+                0,
+                &[],
+                Fill::Mutants,
+            )
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("the limit is"), "{e}");
+        }
+        let big = GaConfig {
+            population: 1_000_000_000_000,
+            ..GaConfig::default()
+        };
+        let e = Evolution::new(
+            Layout {
+                size: 5,
+                n_inputs: 2,
+            },
+            big,
+            0,
+            &[],
+            Fill::Mutants,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("TiB") && e.contains("the limit is"), "{e}");
+    }
 
     /// Fitness: how close neuron 0's firing rate is to 1 after a short run from rest.
     struct Excite;

@@ -96,6 +96,26 @@ impl Ranges {
     }
 }
 
+/// The most parameters (genes) one network may have: 2^26, 512 MiB of `f64`, so a size of up to
+/// about 8,000 neurons. A 1 GB network file holds about 2^26 numbers as text; larger requests
+/// are typing errors, refused before any allocation.
+pub const MAX_GENES: usize = 1 << 26;
+
+/// `bytes` in readable units (`None` is beyond any machine).
+pub fn bytes(bytes: Option<f64>) -> String {
+    let Some(b) = bytes else {
+        return "more than 16 EiB".into();
+    };
+    let units = ["bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
+    let mut x = b;
+    let mut u = 0;
+    while x >= 1024.0 && u + 1 < units.len() {
+        x /= 1024.0;
+        u += 1;
+    }
+    format!("{x:.1} {}", units[u])
+}
+
 /// The shape of a genome: N neurons and M sensors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -126,14 +146,30 @@ impl Layout {
         self.size * self.genes_per_neuron()
     }
 
-    /// Checks that the layout has at least one neuron.
+    /// Checks that the layout has at least one neuron and at most [`MAX_GENES`] genes, before
+    /// anything is allocated (so a huge size is an error, never an abort).
     pub fn validate(&self) -> Result<()> {
         if self.size == 0 {
             return Err(Error::Config(
                 "layout.size is 0; a network needs at least 1 neuron".into(),
             ));
         }
-        Ok(())
+        let genes = self
+            .n_inputs
+            .checked_add(self.size)
+            .and_then(|n| n.checked_add(2))
+            .and_then(|n| n.checked_mul(self.size));
+        match genes {
+            Some(g) if g <= MAX_GENES => Ok(()),
+            _ => Err(Error::Config(format!(
+                "a network of size {} with {} inputs has {} parameters ({}); the limit is {MAX_GENES} \
+                 parameters (512 MiB)",
+                self.size,
+                self.n_inputs,
+                genes.map_or("more than 2^64".to_string(), |g| g.to_string()),
+                bytes(genes.map(|g| g as f64 * 8.0)),
+            ))),
+        }
     }
 
     /// A readable name for gene `g`, such as `"gene 9 (neuron 1, weights[1][2])"`.

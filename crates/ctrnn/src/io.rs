@@ -204,6 +204,10 @@ pub fn load(path: &Path) -> Result<NetworkFile> {
 
 /// Writes `bytes` to a temporary file beside `path`, flushes it to disk, then renames it over
 /// `path`, so a reader sees the old file or the new one, never a torn one.
+///
+/// The temporary file is `.NAME.RANDOM.tmp`, created exclusively (`O_EXCL`): a file or symlink
+/// planted under that name makes the attempt fail and another name is tried, so the write never
+/// goes through a symlink. It gets mode 0666 & ~umask, like any new file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io_err = |what: &str, source| Error::Io {
         context: format!("cannot {what} {}", path.display()),
@@ -212,14 +216,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let name = path
         .file_name()
         .ok_or_else(|| Error::InvalidArgument(format!("{} is not a file path", path.display())))?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(name);
-    tmp_name.push(format!(".tmp{}", std::process::id()));
-    let tmp: PathBuf = path.with_file_name(tmp_name);
+    let (tmp, mut f) = create_temp(path, name).map_err(|e| io_err("write", e))?;
     let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
+        drop(f);
         fs::rename(&tmp, path)
     })();
     if let Err(e) = result {
@@ -227,6 +228,32 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         return Err(io_err("write", e));
     }
     Ok(())
+}
+
+/// A new temporary file beside `path`, created exclusively under a random name.
+fn create_temp(path: &Path, name: &std::ffi::OsStr) -> std::io::Result<(PathBuf, fs::File)> {
+    use std::hash::{BuildHasher, Hasher};
+    let mut last = None;
+    for attempt in 0..16u32 {
+        // RandomState is keyed from the operating system's randomness.
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u32(std::process::id());
+        h.write_u32(attempt);
+        let mut tmp_name = std::ffi::OsString::from(".");
+        tmp_name.push(name);
+        tmp_name.push(format!(".{:016x}.tmp", h.finish()));
+        let tmp = path.with_file_name(tmp_name);
+        match fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(f) => return Ok((tmp, f)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => last = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last.unwrap_or_else(|| std::io::Error::other("no free temporary name")))
 }
 
 #[cfg(test)]
@@ -277,6 +304,31 @@ mod tests {
         assert_eq!(load(&path).unwrap(), sample());
         let leftovers = fs::read_dir(&dir).unwrap().count();
         assert_eq!(leftovers, 1, "no temporary file is left behind");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn atomic_write_never_follows_a_planted_symlink() {
+        let dir = std::env::temp_dir().join(format!("ctrnn-io-link-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let target = dir.join("important");
+        fs::write(&target, b"keep").unwrap();
+        let path = dir.join("net.json");
+        // Every name the old scheme used, and the final name itself, point at the target.
+        std::os::unix::fs::symlink(
+            &target,
+            dir.join(format!(".net.json.tmp{}", std::process::id())),
+        )
+        .unwrap();
+        std::os::unix::fs::symlink(&target, &path).unwrap();
+        save(&path, &sample()).unwrap();
+        assert_eq!(fs::read(&target).unwrap(), b"keep");
+        assert!(!fs::symlink_metadata(&path)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(load(&path).unwrap(), sample());
         fs::remove_dir_all(&dir).unwrap();
     }
 

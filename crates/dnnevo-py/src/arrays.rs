@@ -80,3 +80,29 @@ pub fn to_numpy<'py>(
 pub fn arg_err(msg: String) -> PyErr {
     InvalidArgumentError::new_err(msg)
 }
+
+/// An integer argument in `T`'s range (e.g. `[0, 2**64)` for `u64`): a negative or too large
+/// value is an `InvalidArgumentError` naming the argument, never an `OverflowError`.
+pub fn uint<T: TryFrom<i128>>(obj: &Bound<'_, PyAny>, name: &str, max: &str) -> PyResult<T> {
+    let what = || {
+        obj.repr()
+            .map(|r| r.to_string())
+            .unwrap_or_else(|_| "?".into())
+    };
+    let is_bool = obj.is_instance_of::<pyo3::types::PyBool>();
+    if is_bool || !(obj.is_instance_of::<pyo3::types::PyInt>() || obj.hasattr("__index__")?) {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "{name} is {}; expected an integer",
+            what()
+        )));
+    }
+    obj.extract::<i128>()
+        .ok()
+        .and_then(|v| T::try_from(v).ok())
+        .ok_or_else(|| {
+            arg_err(format!(
+                "{name} is {}; it must be an integer in {max}",
+                what()
+            ))
+        })
+}

@@ -11,7 +11,7 @@ use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy};
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FitnessError, IntoPy};
 use crate::network::{networks_from, PyNetwork};
@@ -88,12 +88,15 @@ impl PyEvolution {
     #[pyo3(signature = (config, size, n_inputs, seed, seeds=None, fill="mutants"))]
     fn new(
         config: &str,
-        size: usize,
-        n_inputs: usize,
-        seed: u64,
+        size: &Bound<'_, PyAny>,
+        n_inputs: &Bound<'_, PyAny>,
+        seed: &Bound<'_, PyAny>,
         seeds: Option<&Bound<'_, PyAny>>,
         fill: &str,
     ) -> PyResult<Self> {
+        let size: usize = uint(size, "size", "[1, 2**64)")?;
+        let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
+        let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
         let config = config_from_json(config)?;
         let fill = match fill {
             "mutants" => Fill::Mutants,
@@ -239,10 +242,16 @@ pub fn evaluate<'py>(
     task: &str,
     params: &str,
     population: &Bound<'py, PyAny>,
-    generation: u64,
-    seed: u64,
-    threads: Option<usize>,
+    generation: &Bound<'py, PyAny>,
+    seed: &Bound<'py, PyAny>,
+    threads: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let generation: u64 = uint(generation, "generation", "[0, 2**64)")?;
+    let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
+    let threads: Option<usize> = match threads.filter(|t| !t.is_none()) {
+        Some(t) => Some(uint(t, "threads", "[1, 2**64)")?),
+        None => None,
+    };
     let task = build_task(task, params)?;
     let layout = task.layout();
     let nets = if population.cast::<PyDict>().is_err() && population.hasattr("shape")? {
@@ -290,8 +299,9 @@ pub fn task_success(
     task: &str,
     params: &str,
     net: &PyNetwork,
-    seed: u64,
+    seed: &Bound<'_, PyAny>,
 ) -> PyResult<Option<bool>> {
+    let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
     let task = build_task(task, params)?;
     let net = &net.inner;
     py.detach(|| task.succeeds(net, seed)).py_err()

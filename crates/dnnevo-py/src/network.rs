@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict, PyTuple};
 use serde_json::{Map, Value};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, Dense};
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint, Dense};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FormatError, IntoPy, InvalidNetworkError};
 
@@ -108,14 +108,18 @@ fn json_module(py: Python<'_>) -> PyResult<Bound<'_, PyModule>> {
 /// Converts a Python dict (JSON-compatible) to a JSON object; the error for a value JSON cannot
 /// hold (NaN, infinity, an object) names where it is, e.g. `theta[0]`.
 fn dict_to_map(d: &Bound<'_, PyAny>, what: &str) -> PyResult<Map<String, Value>> {
-    match to_value(d, String::new()).map_err(|e| FormatError::new_err(format!("{what}: {e}")))? {
+    match to_value(d, String::new(), 0).map_err(|e| FormatError::new_err(format!("{what}: {e}")))? {
         Value::Object(m) => Ok(m),
         _ => Err(FormatError::new_err(format!("{what} must be a dict"))),
     }
 }
 
+/// The deepest nesting of lists and dicts accepted in meta and network dicts: serde_json's own
+/// limit when it reads a file back, so whatever is saved can be loaded.
+pub const MAX_JSON_DEPTH: usize = 128;
+
 /// A Python value as JSON; the error says where the first unrepresentable value is.
-fn to_value(obj: &Bound<'_, PyAny>, path: String) -> Result<Value, String> {
+fn to_value(obj: &Bound<'_, PyAny>, path: String, depth: usize) -> Result<Value, String> {
     use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString, PyTuple};
     let at = |p: &str| {
         if p.is_empty() {
@@ -124,6 +128,12 @@ fn to_value(obj: &Bound<'_, PyAny>, path: String) -> Result<Value, String> {
             p.to_string()
         }
     };
+    if depth > MAX_JSON_DEPTH {
+        return Err(format!(
+            "{} nests lists and dicts deeper than {MAX_JSON_DEPTH}",
+            at(&path)
+        ));
+    }
     if obj.is_none() {
         Ok(Value::Null)
     } else if let Ok(b) = obj.cast::<PyBool>() {
@@ -151,7 +161,7 @@ fn to_value(obj: &Bound<'_, PyAny>, path: String) -> Result<Value, String> {
             } else {
                 format!("{path}.{key}")
             };
-            map.insert(key, to_value(&v, sub)?);
+            map.insert(key, to_value(&v, sub, depth + 1)?);
         }
         Ok(Value::Object(map))
     } else if obj.is_instance_of::<PyList>()
@@ -164,12 +174,12 @@ fn to_value(obj: &Bound<'_, PyAny>, path: String) -> Result<Value, String> {
             obj.clone()
         };
         if !(seq.is_instance_of::<PyList>() || seq.is_instance_of::<PyTuple>()) {
-            return to_value(&seq, path);
+            return to_value(&seq, path, depth + 1);
         }
         let mut items = Vec::new();
         for (k, item) in seq.try_iter().map_err(|e| e.to_string())?.enumerate() {
             let item = item.map_err(|e| e.to_string())?;
-            items.push(to_value(&item, format!("{path}[{k}]"))?);
+            items.push(to_value(&item, format!("{path}[{k}]"), depth + 1)?);
         }
         Ok(Value::Array(items))
     } else {
@@ -245,11 +255,14 @@ impl PyNetwork {
     #[staticmethod]
     #[pyo3(signature = (size, n_inputs, *, seed, ranges=None))]
     fn random(
-        size: usize,
-        n_inputs: usize,
-        seed: u64,
+        size: &Bound<'_, PyAny>,
+        n_inputs: &Bound<'_, PyAny>,
+        seed: &Bound<'_, PyAny>,
         ranges: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let size: usize = uint(size, "size", "[1, 2**64)")?;
+        let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
+        let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
         let ranges = ranges_from(ranges)?;
         let layout = Layout { size, n_inputs };
         layout.validate().py_err()?;
@@ -529,6 +542,17 @@ fn network_objects<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Vec<PyRef<'py, PyNe
 /// A population from stacked arrays: tau (P, N), theta (P, N), weights (P, N, N),
 /// sensor_weights (P, N, M) and optionally state (P, N).
 fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
+    const KEYS: [&str; 5] = ["tau", "theta", "weights", "sensor_weights", "state"];
+    for key in d.keys() {
+        let name = key.str()?.to_string();
+        if !key.is_instance_of::<pyo3::types::PyString>() || !KEYS.contains(&name.as_str()) {
+            return Err(net_err(format!(
+                "the dict has an unknown key {}; expected {}",
+                key.repr()?,
+                KEYS.join(", ")
+            )));
+        }
+    }
     let get = |key: &str, ndim: usize, shape: &str| -> PyResult<Option<Dense>> {
         match d.get_item(key)? {
             None => Ok(None),

@@ -126,3 +126,22 @@ impl<K, V> std::fmt::Debug for Memo<K, V> {
         f.write_str("Memo")
     }
 }
+
+/// The largest count (trials, triggers, steps, chains, neurons) a task setting may hold: 2^20.
+/// The paper's counts are in the tens to thousands; a count past this is a typing error that
+/// would otherwise make a task allocate terabytes and abort the process.
+pub const MAX_COUNT: usize = 1 << 20;
+
+/// Checks a count setting is in `1..=MAX_COUNT`, naming it.
+pub fn check_count(name: &str, value: usize) -> Result<()> {
+    if value == 0 {
+        return Err(Error::Config(format!("{name} is 0; it must be >= 1")));
+    }
+    if value > MAX_COUNT {
+        return Err(Error::Config(format!(
+            "{name} is {value}; the limit is {MAX_COUNT} (2^20), as larger counts would need more \
+             memory or time than any run can use"
+        )));
+    }
+    Ok(())
+}

@@ -250,9 +250,7 @@ impl SequenceConfig {
             ("trigger_steps", self.trigger_steps),
             ("validation_trials", self.validation_trials),
         ] {
-            if value == 0 {
-                return config(format!("{name} is 0; it must be >= 1"));
-            }
+            crate::common::check_count(name, value)?;
         }
         for (name, (lo, hi)) in [("delay", self.delay), ("gap", self.gap)] {
             if lo > hi {

@@ -119,9 +119,7 @@ impl LandmarkConfig {
             ("trials_per_landmark", self.trials_per_landmark),
             ("validation_trials", self.validation_trials),
         ] {
-            if value == 0 {
-                return config(format!("{name} is 0; it must be >= 1"));
-            }
+            crate::common::check_count(name, value)?;
         }
         if self.classifier >= self.size {
             return config(format!(

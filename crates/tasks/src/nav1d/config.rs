@@ -182,9 +182,7 @@ impl Nav1dConfig {
             ("chains_per_environment", self.chains_per_environment),
             ("validation_chains", self.validation_chains),
         ] {
-            if value == 0 {
-                return config(format!("{name} is 0; it must be >= 1"));
-            }
+            crate::common::check_count(name, value)?;
         }
         let mut neurons = vec![
             ("left_motor", self.left_motor),

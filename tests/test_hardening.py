@@ -1,0 +1,408 @@
+"""Run folders under damage, kills and concurrent writers (issue #17).
+
+Every command on a damaged folder either fails with exit status 2 and one line naming the
+problem, or succeeds and leaves a folder whose files agree. A kill at any moment leaves a folder
+that resumes to the end of an uninterrupted run, bit for bit, with no temporary file left.
+
+CI runs a reduced version; ``DNNEVO_FULL_HARDENING=1 python -m pytest tests/test_hardening.py``
+runs the full one (more damage examples, 30 kills).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from cli_helpers import assert_one_line_error, run_cli
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from dnnevo.rundir import RunDir
+
+FULL = os.environ.get("DNNEVO_FULL_HARDENING") == "1"
+SMALL = ["--set", "population=12", "--set", "generations=6"]
+LEFTOVER = {".dnnevo.lock"}
+
+
+@pytest.fixture(scope="module")
+def pristine(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A finished small sequence run, copied by each test that damages it."""
+    out = tmp_path_factory.mktemp("pristine") / "run"
+    r = run_cli("run", "sequence-1bit", "--quick", *SMALL, "--seed", "3", "--out", out)
+    assert r.returncode == 0, r.stderr
+    return out
+
+
+def copy(pristine: Path, where: Path) -> Path:
+    shutil.copytree(pristine, where)
+    return where
+
+
+def assert_consistent(run: Path) -> None:
+    """The four files agree: resume and show accept them and no temporary file is left."""
+    rd = RunDir(run)
+    config, table = rd.read_config()
+    cp = rd.read_checkpoint()
+    assert cp.run is not None and cp.run["seed"] == table["seed"]
+    assert len(rd.read_log(config)) == len(cp.history)
+    rd.read_best(config, table)
+    assert {p.name for p in run.iterdir() if p.name.startswith(".")} <= LEFTOVER
+
+
+def text_damage(text: str) -> list[tuple[str, str]]:
+    """Named ways to damage a text file."""
+    return [
+        ("empty", ""),
+        ("truncated", text[: len(text) // 2]),
+        ("invalid utf-8", text[:10] + "\udcff" + text[10:]),
+        ("null", "null"),
+        ("list", "[]"),
+        ("string", '"x"'),
+        ("number", "3"),
+        ("nested", "[" * 100_000 + "]" * 100_000),
+    ]
+
+
+def write(path: Path, text: str) -> None:
+    path.write_bytes(text.encode("utf-8", "surrogateescape"))
+
+
+def checkpoint_edits(doc: dict) -> list[tuple[str, Callable[[dict], None]]]:
+    def set_(path: str, value: object) -> Callable[[dict], None]:
+        def edit(d: dict) -> None:
+            *head, last = path.split(".")
+            for k in head:
+                d = d[int(k)] if isinstance(d, list) else d[k]
+            if isinstance(d, list):
+                d[int(last)] = value
+            else:
+                d[last] = value
+        return edit
+
+    def evolution(key: str, value: object) -> Callable[[dict], None]:
+        def edit(d: dict) -> None:
+            evo = json.loads(d["state"]["evolution"])
+            evo[key] = value
+            d["state"]["evolution"] = json.dumps(evo)
+        return edit
+
+    return [
+        ("state list", set_("state", [])),
+        ("history dict", set_("history", {})),
+        ("history string value", set_("history.0.best", "0.5")),
+        ("history nan", set_("history.2.mean", float("nan"))),
+        ("history short", lambda d: d["history"].pop()),
+        ("no state.config", lambda d: d["state"].pop("config")),
+        ("config edited", set_("state.config.population", 13)),
+        ("targets edited", set_("state.config.task_params", {"targets": ["1"]})),
+        ("generation beyond end", evolution("generation", 99)),
+        ("seed edited", evolution("seed", 4)),
+        ("evolution not json", set_("state.evolution", "{")),
+        ("digest edited", set_("config_sha256", "0" * 64)),
+        ("version 3", set_("version", 3)),
+    ]
+
+
+COMMANDS = [["resume"], ["show"], ["evaluate", "--trials", "2", "--seed", "0"], ["plot"],
+            ["analyze", "--no-lesions", "--steps", "5"]]
+
+
+def check_outcome(r: subprocess.CompletedProcess[str], run: Path, command: str) -> None:
+    """Exit 2 with one line, or success (evaluate: any verdict) with a consistent folder."""
+    if r.returncode == 2:
+        assert_one_line_error(r)
+    else:
+        assert r.returncode in ((0, 1, 3) if command == "evaluate" else (0,)), r.stderr
+        assert "Traceback" not in r.stderr
+        if command == "resume":
+            assert_consistent(run)
+
+
+@pytest.mark.parametrize("name", ["checkpoint.json", "log.csv", "config.toml", "best.json"])
+def test_damaged_files_are_one_line_or_repaired(pristine: Path, tmp_path: Path, name: str) -> None:
+    damages = text_damage((pristine / name).read_text())
+    if not FULL:
+        damages = [d for d in damages if d[0] in ("empty", "invalid utf-8", "nested", "list")]
+    for label, text in damages:
+        for command in COMMANDS:
+            run = copy(pristine, tmp_path / f"{label}-{command[0]}".replace(" ", "_"))
+            write(run / name, text)
+            r = run_cli(command[0], run, *command[1:])
+            check_outcome(r, run, command[0])
+            # A reader never repairs anything: the damage is reported.
+            if command[0] in ("show", "plot") and name in ("log.csv", "config.toml"):
+                assert r.returncode == 2, (label, command, r.stdout)
+
+
+def test_checkpoint_edits_are_refused(pristine: Path, tmp_path: Path) -> None:
+    doc = json.loads((pristine / "checkpoint.json").read_text())
+    for label, edit in checkpoint_edits(doc):
+        run = copy(pristine, tmp_path / label.replace(" ", "_"))
+        d = json.loads((run / "checkpoint.json").read_text())
+        edit(d)
+        (run / "checkpoint.json").write_text(json.dumps(d))
+        r = run_cli("resume", run)
+        assert_one_line_error(r, "checkpoint.json")
+
+
+@pytest.mark.parametrize(("field", "value"), [
+    ("population", "13"), ("generations", "7"), ("mutation_rate", "0.5"), ("size", "6"),
+    ("task", '"landmark"'),
+])
+def test_edited_config_toml_is_refused_naming_the_field(pristine: Path, tmp_path: Path, field: str,
+                                                         value: str) -> None:
+    run = copy(pristine, tmp_path / "run")
+    lines = (run / "config.toml").read_text().splitlines()
+    lines = [f"{field} = {value}" if line.startswith(f"{field} = ") else line for line in lines]
+    (run / "config.toml").write_text("\n".join(lines) + "\n")
+    r = run_cli("resume", run)
+    assert_one_line_error(r, f"at {field}:")
+
+
+def test_log_damage_in_show_and_plot(pristine: Path, tmp_path: Path) -> None:
+    text = (pristine / "log.csv").read_text()
+    header, *rows = text.splitlines()
+    cases = {
+        "header only": header + "\n",
+        "short row": "\n".join([header, rows[0], rows[1].rsplit(",", 1)[0]]) + "\n",
+        "other columns": text.replace("generation", "gen", 1),
+        "non-numeric": text.replace(rows[1].split(",")[1], "abc", 1),
+        "inf": "\n".join([header, rows[0], rows[1].replace(rows[1].split(",")[1], "inf", 1)]) + "\n",
+        "duplicated row": "\n".join([header, rows[0], rows[0], *rows[1:]]) + "\n",
+    }
+    for label, damaged in cases.items():
+        run = copy(pristine, tmp_path / label.replace(" ", "_"))
+        (run / "log.csv").write_text(damaged)
+        for command in ("show", "plot"):
+            assert_one_line_error(run_cli(command, run), "log.csv")
+        # resume rebuilds the log from the checkpoint
+        r = run_cli("resume", run)
+        assert r.returncode == 0, r.stderr
+        assert (run / "log.csv").read_text() == text
+
+
+def test_wrong_champion_and_deleted_best_json(pristine: Path, tmp_path: Path) -> None:
+    import dnnevo
+
+    run = copy(pristine, tmp_path / "run")
+    dnnevo.Network.random(4, 2, seed=0).save(run / "best.json")
+    for command in ("evaluate", "plot", "analyze"):
+        assert_one_line_error(run_cli(command, run), "best.json", "size 4")
+    (run / "best.json").unlink()
+    assert run_cli("resume", run).returncode == 0
+    assert (run / "best.json").read_bytes() == (pristine / "best.json").read_bytes()
+
+
+def test_figures_never_follow_symlinks(pristine: Path, tmp_path: Path) -> None:
+    run = copy(pristine, tmp_path / "run")
+    target = tmp_path / "important"
+    target.write_text("keep")
+    (run / "fitness.png").unlink(missing_ok=True)
+    (run / "fitness.png").symlink_to(target)
+    assert run_cli("show", run).returncode == 0
+    assert target.read_text() == "keep" and not (run / "fitness.png").is_symlink()
+    mode = 0o666 & ~_umask()
+    for name in ("fitness.png", "log.csv", "checkpoint.json", "best.json", "config.toml"):
+        assert (run / name).stat().st_mode & 0o777 == mode, name
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+@settings(max_examples=40 if FULL else 8, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.binary(max_size=200), name=st.sampled_from(["checkpoint.json", "log.csv", "config.toml"]))
+def test_random_bytes_are_one_line(pristine: Path, tmp_path_factory: pytest.TempPathFactory,
+                                   data: bytes, name: str) -> None:
+    run = copy(pristine, tmp_path_factory.mktemp("fuzz") / "run")
+    (run / name).write_bytes(data)
+    command = "resume" if name == "checkpoint.json" else "show"
+    check_outcome(run_cli(command, run), run, command)
+
+
+def test_two_writers_on_one_folder(tmp_path: Path) -> None:
+    out = tmp_path / "d"
+    first = subprocess.Popen([sys.executable, "-m", "dnnevo", "run", "sequence-1bit", "--quick",
+                              "--set", "generations=100000", "--seed", "3", "--out", str(out)],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not (out / "config.toml").exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        for args in (["run", "sequence-1bit", "--quick", "--seed", "4", "--out", out, "--force"],
+                     ["resume", out],
+                     ["sweep", "sequence-1bit", "--quick", "--seeds", "0", "--out", out, "--force"]):
+            assert_one_line_error(run_cli(*args), f"PID {first.pid}")
+        # Readers keep working during the run.
+        time.sleep(1.5)
+        assert run_cli("show", out).returncode == 0
+    finally:
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=60)
+    seed = RunDir(out).read_config()[1]["seed"]
+    assert seed == 3 and RunDir(out).read_checkpoint().run["seed"] == 3  # type: ignore[index]
+    assert_consistent(out)
+    # The lock died with its holder: the next writer is welcome.
+    done = len(RunDir(out).read_checkpoint().history)
+    r = run_cli("resume", out, "--generations", done + 2)
+    assert r.returncode == 0, r.stderr
+    assert len(RunDir(out).read_log()) == done + 2
+
+
+def test_force_clears_the_old_runs_figures(pristine: Path, tmp_path: Path) -> None:
+    run = copy(pristine, tmp_path / "run")
+    assert run_cli("plot", run).returncode == 0
+    (run / "notes.txt").write_text("mine")
+    r = run_cli("run", "sequence-1bit", "--quick", *SMALL, "--seed", "5", "--out", run, "--force")
+    assert r.returncode == 0, r.stderr
+    names = {p.name for p in run.iterdir()}
+    assert names == {".dnnevo.lock", "notes.txt", "config.toml", "log.csv", "best.json", "checkpoint.json"}
+
+
+def test_generations_extends_a_run_keeping_files_in_agreement(pristine: Path, tmp_path: Path) -> None:
+    run = copy(pristine, tmp_path / "run")
+    longer = tmp_path / "longer"
+    r = run_cli("run", "sequence-1bit", "--quick", "--set", "population=12", "--set", "generations=9",
+                "--seed", "3", "--out", longer)
+    assert r.returncode == 0
+    assert_one_line_error(run_cli("resume", run, "--generations", "3"), "generations is 3")
+    assert run_cli("resume", run, "--generations", "9").returncode == 0
+    assert_consistent(run)
+    assert "generations = 9" in (run / "config.toml").read_text()
+    for name in ("best.json", "checkpoint.json"):
+        a, b = (json.loads((d / name).read_text()) for d in (run, longer))
+        for doc in (a, b):
+            doc.get("history", [{}])
+            for row in doc.get("history", []):
+                row.pop("elapsed_s"), row.pop("evals_per_s")
+        assert a == b, name
+
+
+KILLS = 30 if FULL else 8
+KILL_RUN = ["sequence-1bit", "--quick", "--set", "population=40", "--set", "generations=200"]
+#: The command, checkpointing after every generation so that kills land inside writes too.
+FREQUENT = ("import sys, dnnevo; e = sys.modules['dnnevo.evolve']; e.CHECKPOINT_SECONDS = 0.0; "
+            "e.LOG_SECONDS = 0.0; from dnnevo.cli import main; sys.exit(main(sys.argv[1:]))")
+
+
+def test_kill_at_random_moments_then_resume_is_bit_identical(tmp_path: Path) -> None:
+    """SIGKILL at random moments (from start-up on, so also before the first checkpoint and
+    inside writes), then resume, again and again: the end equals an uninterrupted run."""
+    ref = tmp_path / "ref"
+    assert run_cli("run", *KILL_RUN, "--seed", "1", "--out", ref).returncode == 0
+    out = tmp_path / "killed"
+    rng = random.Random(17)
+    start = ["run", *KILL_RUN, "--seed", "1", "--out", str(out)]
+    progress = []
+    for i in range(KILLS):
+        args = start if not (out / "checkpoint.json").exists() else ["resume", str(out)]
+        p = subprocess.Popen([sys.executable, "-c", FREQUENT, *args],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        time.sleep(rng.uniform(0.0, 1.0))
+        p.kill()
+        _, err = p.communicate(timeout=60)
+        assert "Traceback" not in err, err
+        if (out / "checkpoint.json").exists():
+            progress.append(len(RunDir(out).read_checkpoint().history))
+    assert any(0 < n < 200 for n in progress), progress  # some kills landed mid-run
+    r = run_cli("resume", out) if (out / "checkpoint.json").exists() else run_cli(*start)
+    assert r.returncode == 0, r.stderr
+    assert (out / "best.json").read_bytes() == (ref / "best.json").read_bytes()
+    a, b = (json.loads((d / "checkpoint.json").read_text()) for d in (out, ref))
+    assert a["state"] == b["state"] and a["config_sha256"] == b["config_sha256"]
+    strip = ("elapsed_s", "evals_per_s")
+    assert [{k: v for k, v in row.items() if k not in strip} for row in a["history"]] == \
+        [{k: v for k, v in row.items() if k not in strip} for row in b["history"]]
+    assert {p.name for p in out.iterdir() if p.name.startswith(".")} <= LEFTOVER
+
+
+def test_ctrl_c_during_start_up_is_one_line(tmp_path: Path) -> None:
+    rng = random.Random(3)
+    for i in range(12 if FULL else 4):
+        p = subprocess.Popen([sys.executable, "-m", "dnnevo", "run", *KILL_RUN, "--out",
+                              str(tmp_path / f"r{i}")], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.PIPE, text=True)
+        # From 50 ms on: before that the interpreter itself is starting, not dnnevo.
+        time.sleep(rng.uniform(0.05, 0.5))
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=60)
+        lines = [line for line in err.splitlines() if line and not line.startswith("[")]  # progress
+        assert "Traceback" not in err and len(lines) <= 1, err
+
+
+LIMITS_SCRIPT = r"""
+import resource, sys
+resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))  # 2 GiB: a regression cannot take the machine
+import dnnevo
+from dnnevo import ConfigError, FormatError
+
+def refused(call, kind, fragment):
+    try:
+        call()
+    except kind as e:
+        assert fragment in str(e), (fragment, str(e))
+    else:
+        raise AssertionError(f"no {kind.__name__}: {call}")
+
+refused(lambda: dnnevo.Network.random(10**6, 1, seed=0), ConfigError, "the limit is")
+refused(lambda: dnnevo.Network.random(2**62, 2**62, seed=0), ConfigError, "the limit is")
+small = dnnevo.EvolutionConfig(population=10**12, size=5, n_inputs=2)
+refused(lambda: dnnevo.GeneticAlgorithm(small), ConfigError, "TiB")
+wide = dnnevo.EvolutionConfig(population=10, size=100_000, n_inputs=2)
+refused(lambda: dnnevo.GeneticAlgorithm(wide), ConfigError, "the limit is")
+refused(lambda: dnnevo.GeneticAlgorithm.from_state_dict({}), ConfigError, "'config' and 'evolution'")
+from dnnevo import InvalidArgumentError
+refused(lambda: dnnevo.Network.random(3, -1, seed=0), InvalidArgumentError, "n_inputs is -1")
+refused(lambda: dnnevo.Network.random(3, 1, seed=2**64), InvalidArgumentError, "seed is 18446744073709551616")
+refused(lambda: dnnevo.Network.random(3, 1, seed=-1), InvalidArgumentError, "seed is -1")
+nets = [dnnevo.Network.random(5, 2, seed=0)]
+refused(lambda: dnnevo.evaluate("sequence", nets, generation=-1, seed=0), InvalidArgumentError, "generation is -1")
+refused(lambda: dnnevo.evaluate("sequence", nets, generation=0, seed=0, threads=-2), InvalidArgumentError, "threads is -2")
+refused(lambda: dnnevo.EvolutionConfig(task_params={"perf_base": float("nan")}), ConfigError, "task_params.perf_base is nan")
+import numpy as np
+from dnnevo import InvalidNetworkError
+stack = {"tau": np.ones((2, 3)), "theta": np.zeros((2, 3)), "weights": np.zeros((2, 3, 3)),
+         "sensor_weights": np.zeros((2, 3, 1)), "states": np.zeros((2, 3))}
+refused(lambda: dnnevo.run_population(stack, np.zeros((4, 1))), InvalidNetworkError, "unknown key 'states'")
+deep = []
+for _ in range(100_000):
+    deep = [deep]
+net = dnnevo.Network.random(2, 1, seed=0)
+refused(lambda: net.save(sys.argv[1], meta={"x": deep}), FormatError, "deeper than 128")
+d = net.to_dict()
+d["meta"] = {"x": deep}
+refused(lambda: dnnevo.Network.from_dict(d), FormatError, "deeper than 128")
+print("ok")
+"""
+
+
+def test_api_limits_are_typed_errors_in_a_memory_limited_child(tmp_path: Path) -> None:
+    r = subprocess.run([sys.executable, "-c", LIMITS_SCRIPT, str(tmp_path / "n.json")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr[-2000:]
+
+
+def test_cli_sizes_past_the_limit_are_one_line(tmp_path: Path) -> None:
+    import resource
+
+    def limit() -> None:  # 2 GiB of address space: a regression cannot take the machine down
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    for setting in ("population=1000000000000", "size=100000",
+                    "task_params.trials_per_target=1000000000000", "task_params.perf_base=nan"):
+        r = subprocess.run([sys.executable, "-m", "dnnevo", "run", "sequence-1bit", "--quick", "--set",
+                            setting, "--out", str(tmp_path / "x"), "--force"],
+                           capture_output=True, text=True, timeout=120, preexec_fn=limit)
+        assert_one_line_error(r)

@@ -400,9 +400,17 @@ def test_cli_sizes_past_the_limit_are_one_line(tmp_path: Path) -> None:
     def limit() -> None:  # 2 GiB of address space: a regression cannot take the machine down
         resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
 
-    for setting in ("population=1000000000000", "size=100000",
-                    "task_params.trials_per_target=1000000000000", "task_params.perf_base=nan"):
-        r = subprocess.run([sys.executable, "-m", "dnnevo", "run", "sequence-1bit", "--quick", "--set",
+    cases = [("sequence-1bit", s) for s in (
+        "population=1000000000000", "size=100000", "task_params.trials_per_target=1000000000000",
+        "task_params.perf_base=nan")]
+    # Settings each within its own limit whose product is a trial of years or terabytes.
+    cases += [("sequence-1bit", "task_params.gap=[1, 1000000000000]"),
+              ("sequence-1bit", "integrator.substeps=1000000000"),
+              ("landmark", "task_params.trial_seconds=1e12"),
+              ("landmark", "task_params.sim={dt=1e-9}"),
+              ("nav1d-far", "integrator.substeps=9223372036854775808")]
+    for preset, setting in cases:
+        r = subprocess.run([sys.executable, "-m", "dnnevo", "run", preset, "--quick", "--set",
                             setting, "--out", str(tmp_path / "x"), "--force"],
                            capture_output=True, text=True, timeout=120, preexec_fn=limit)
         assert_one_line_error(r)

@@ -132,6 +132,33 @@ impl<K, V> std::fmt::Debug for Memo<K, V> {
 /// would otherwise make a task allocate terabytes and abort the process.
 pub const MAX_COUNT: usize = 1 << 20;
 
+/// The most time steps one trial may last, whatever settings it is derived from: 2^24. The
+/// paper's longest trial is about 1,000 time steps.
+pub const MAX_TRIAL_STEPS: u128 = 1 << 24;
+
+/// The most integration steps (time steps x substeps) one trial may take: 2^32, hours of one
+/// core for one network.
+pub const MAX_INTEGRATION_STEPS: u128 = 1 << 32;
+
+/// Checks that a trial of at most `steps` time steps (`what` says how it is derived), each of
+/// `substeps` integration steps, stays within [`MAX_TRIAL_STEPS`] and [`MAX_INTEGRATION_STEPS`]:
+/// a product of settings each within its own limit can still ask for years of work or terabytes.
+pub fn check_trial_steps(what: &str, steps: u128, substeps: usize) -> Result<()> {
+    if steps > MAX_TRIAL_STEPS {
+        return Err(Error::Config(format!(
+            "a trial can last {steps} time steps ({what}); the limit is {MAX_TRIAL_STEPS} (2^24)"
+        )));
+    }
+    let total = steps.saturating_mul(substeps as u128);
+    if total > MAX_INTEGRATION_STEPS {
+        return Err(Error::Config(format!(
+            "a trial can take {total} integration steps ({what}, times {substeps} substeps); \
+             the limit is {MAX_INTEGRATION_STEPS} (2^32)"
+        )));
+    }
+    Ok(())
+}
+
 /// Checks a count setting is in `1..=MAX_COUNT`, naming it.
 pub fn check_count(name: &str, value: usize) -> Result<()> {
     if value == 0 {

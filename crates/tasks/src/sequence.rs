@@ -269,7 +269,16 @@ impl SequenceConfig {
         self.integrator.validate().map_err(|e| match e {
             Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
             other => other,
-        })
+        })?;
+        let per_trigger = self.trigger_steps as u128
+            + self.delay.1 as u128
+            + self.reinforcement_steps as u128
+            + self.gap.1 as u128;
+        crate::common::check_trial_steps(
+            "triggers x (trigger_steps + delay + reinforcement_steps + gap), at their largest",
+            self.triggers as u128 * per_trigger,
+            self.integrator.substeps,
+        )
     }
 
     /// Reads a config from a JSON object of its fields (`null` means all defaults) and validates

@@ -163,7 +163,14 @@ impl LandmarkConfig {
         self.integrator.validate().map_err(|e| match e {
             Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
             other => other,
-        })
+        })?;
+        // `as` saturates, so an absurd ratio stays absurd rather than wrapping.
+        let longest = ((self.trial_seconds + self.training.trial_seconds) / self.sim.dt).round();
+        crate::common::check_trial_steps(
+            "(trial_seconds + training.trial_seconds) / sim.dt",
+            longest as u128,
+            self.integrator.substeps,
+        )
     }
 
     /// Robot steps per trial: `trial_seconds / sim.dt`, rounded.

@@ -260,19 +260,11 @@ impl Nav1dConfig {
             Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
             other => other,
         })?;
-        for (name, steps) in [
-            ("max_steps", self.max_steps),
-            ("reinforcement_steps", self.reinforcement_steps),
-        ] {
-            if steps.checked_mul(self.integrator.substeps).is_none() {
-                return config(format!(
-                    "{name} is {steps}; with {} substeps per time step that is more integration \
-                     steps than fit in a counter",
-                    self.integrator.substeps
-                ));
-            }
-        }
-        Ok(())
+        crate::common::check_trial_steps(
+            "max_steps + reinforcement_steps",
+            self.max_steps as u128 + self.reinforcement_steps as u128,
+            self.integrator.substeps,
+        )
     }
 
     /// Sensors per network: 2 with the reinforcement input, else 1.

@@ -430,6 +430,16 @@ fn config_errors_name_the_field() {
         json!({"max_steps": usize::MAX / 2, "integrator": {"method": "euler", "dt": 0.1, "substeps": 10}}),
     );
     assert!(e.contains("max_steps is"), "{e}");
+    // Each setting within its limit, their product not: 2^20 steps of 2^13 substeps.
+    let e = err(
+        json!({"max_steps": 1 << 20, "integrator": {"method": "euler", "dt": 0.1, "substeps": 1 << 13}}),
+    );
+    assert!(
+        e.contains(
+            "(max_steps + reinforcement_steps, times 8192 substeps); the limit is 4294967296"
+        ),
+        "{e}"
+    );
     // A goal task needs no classifier neuron; a 2-neuron network is enough.
     let t = Nav1dTask::from_params(&json!({"size": 2, "classifier": 9})).unwrap();
     assert_eq!(t.layout().size, 2);

@@ -371,6 +371,11 @@ nets = [dnnevo.Network.random(5, 2, seed=0)]
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=-1, seed=0), InvalidArgumentError, "generation is -1")
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=0, seed=0, threads=-2), InvalidArgumentError, "threads is -2")
 refused(lambda: dnnevo.EvolutionConfig(task_params={"perf_base": float("nan")}), ConfigError, "task_params.perf_base is nan")
+from dnnevo import landmark, nav1d, presets, sequence
+refused(lambda: nav1d.fresh_chains(presets.get("nav1d-far"), 10**13, 3, 0), InvalidArgumentError, "count is 10000000000000")
+refused(lambda: nav1d.assess(presets.get("nav1d-far"), dnnevo.Network.random(5, 1, seed=0), 0, 0), InvalidArgumentError, "count is 0")
+refused(lambda: landmark.assess(presets.get("landmark"), dnnevo.Network.random(8, 1, seed=0), 10**9, seed=0), InvalidArgumentError, "per_landmark is")
+refused(lambda: sequence.assess(presets.get("sequence-1bit"), nets[0], 2**40, 0), InvalidArgumentError, "trials_per_target is")
 import numpy as np
 from dnnevo import InvalidNetworkError
 stack = {"tau": np.ones((2, 3)), "theta": np.zeros((2, 3)), "weights": np.zeros((2, 3, 3)),

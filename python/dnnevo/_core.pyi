@@ -9,6 +9,7 @@ import numpy.typing as npt
 
 __all__ = [
     "LANES",
+    "MAX_COUNT",
     "Evolution",
     "Network",
     "Trace",
@@ -42,6 +43,7 @@ __all__ = [
 
 __version__: str
 LANES: int
+MAX_COUNT: int
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]

@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import nonnegative, task_params
+from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 
@@ -86,7 +86,7 @@ def assess(
 ) -> dict[str, Any]:
     """Judges ``net`` on ``per_landmark`` fresh trials of each landmark: ``{"confusion"
     (rows: true landmark 1, 2; columns: answer 1, 2), "rate", "success", "trials"}``."""
-    return json.loads(_core.landmark_assess(_params(config), net, nonnegative("per_landmark", per_landmark),
+    return json.loads(_core.landmark_assess(_params(config), net, bounded_count("per_landmark", per_landmark),
                                             nonnegative("seed", seed), robot_like))
 
 

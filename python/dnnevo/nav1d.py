@@ -32,7 +32,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import nonnegative, task_params
+from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 
@@ -125,7 +125,7 @@ def fresh_chains(config: EvolutionConfig, count: int, trials: int, seed: int) ->
     """``count`` fresh chains of ``trials`` trials, each in a random environment of the config's
     ``environments``, each trial with a random goal side."""
     return [_conditions(c) for c in json.loads(
-        _core.nav1d_fresh_chains(_params(config), nonnegative("count", count), nonnegative("trials", trials),
+        _core.nav1d_fresh_chains(_params(config), bounded_count("count", count), bounded_count("trials", trials),
                                  nonnegative("seed", seed)))]
 
 
@@ -154,7 +154,7 @@ def record(
 
 def assess(config: EvolutionConfig, net: _core.Network, count: int, seed: int) -> dict[str, Any]:
     """Judges ``net`` on ``count`` fresh chains: ``{"rate", "success", "episodes", ...}``."""
-    return json.loads(_core.nav1d_assess(_params(config), net, nonnegative("count", count), nonnegative("seed", seed)))
+    return json.loads(_core.nav1d_assess(_params(config), net, bounded_count("count", count), nonnegative("seed", seed)))
 
 
 def goal_rates(episodes: Sequence[dict[str, Any]]) -> dict[str, npt.NDArray[np.float64]]:
@@ -196,7 +196,7 @@ def system_assess(
     "classification_rate", "episodes"}``; see :func:`goal_rates` for the breakdown."""
     c, f, n = _parts(classifier, far, near)
     return json.loads(_core.nav1d_system_assess(
-        c, f, n, nonnegative("environments", environments), nonnegative("trials", trials),
+        c, f, n, bounded_count("environments", environments), bounded_count("trials", trials),
         nonnegative("seed", seed), persist_state))
 
 

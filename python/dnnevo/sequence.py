@@ -17,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import nonnegative, task_params
+from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 
 __all__ = ["TrialRecord", "assess", "run_trial", "switch_trial", "timings"]
@@ -81,7 +81,7 @@ def assess(
     config: EvolutionConfig, net: _core.Network, trials_per_target: int, seed: int
 ) -> dict[str, Any]:
     """Mean performance and success fraction per target on fresh timings, and the verdict."""
-    return json.loads(_core.sequence_assess(_params(config), net, nonnegative("trials_per_target", trials_per_target),
+    return json.loads(_core.sequence_assess(_params(config), net, bounded_count("trials_per_target", trials_per_target),
                                             nonnegative("seed", seed)))
 
 

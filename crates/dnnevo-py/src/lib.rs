@@ -52,6 +52,7 @@ mod _core {
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("LANES", ctrnn::LANES)?;
+        m.add("MAX_COUNT", tasks::MAX_COUNT)?;
         Ok(())
     }
 }

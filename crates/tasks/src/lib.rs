@@ -20,6 +20,7 @@ pub mod nav1d;
 pub mod registry;
 pub mod sequence;
 
+pub use common::MAX_COUNT;
 pub use registry::{build, names};
 pub use sequence::{
     performance, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask, TargetReport,

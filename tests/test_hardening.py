@@ -346,6 +346,7 @@ LIMITS_SCRIPT = r"""
 import resource, sys
 resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))  # 2 GiB: a regression cannot take the machine
 import dnnevo
+import numpy as np
 from dnnevo import ConfigError, FormatError
 
 def refused(call, kind, fragment):
@@ -371,7 +372,11 @@ nets = [dnnevo.Network.random(5, 2, seed=0)]
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=-1, seed=0), InvalidArgumentError, "generation is -1")
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=0, seed=0, threads=-2), InvalidArgumentError, "threads is -2")
 refused(lambda: dnnevo.EvolutionConfig(task_params={"perf_base": float("nan")}), ConfigError, "task_params.perf_base is nan")
-from dnnevo import landmark, nav1d, presets, sequence
+from dnnevo import analysis, landmark, nav1d, presets, sequence
+refused(lambda: nets[0].run(np.zeros((3, 2)), substeps=2**64), InvalidArgumentError, "substeps is 18446744073709551616")
+refused(lambda: dnnevo.run_population(nets, np.zeros((3, 2)), substeps=2**70), InvalidArgumentError, "substeps is")
+refused(lambda: analysis.equilibria(nets[0], [0.0, 0.0], starts=2**70), InvalidArgumentError, "starts is")
+refused(lambda: analysis.equilibria(nets[0], [0.0, 0.0], starts=10**9), InvalidArgumentError, "starts is 1000000000")
 refused(lambda: nav1d.fresh_chains(presets.get("nav1d-far"), 10**13, 3, 0), InvalidArgumentError, "count is 10000000000000")
 refused(lambda: nav1d.assess(presets.get("nav1d-far"), dnnevo.Network.random(5, 1, seed=0), 0, 0), InvalidArgumentError, "count is 0")
 refused(lambda: landmark.assess(presets.get("landmark"), dnnevo.Network.random(8, 1, seed=0), 10**9, seed=0), InvalidArgumentError, "per_landmark is")

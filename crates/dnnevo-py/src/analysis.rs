@@ -5,43 +5,47 @@
 use ctrnn::analysis::{self, CycleSearch, EquilibriumSearch, Sweep};
 use pyo3::prelude::*;
 
-use crate::arrays::arg_err;
+use crate::arrays::{arg_err, AnyInt};
 use crate::detach::detached;
 use crate::json::to_json;
 use crate::network::PyNetwork;
 
-/// A count argument as `usize`, or `InvalidArgumentError` naming it.
-fn count(name: &str, value: i64, min: i64) -> PyResult<usize> {
-    if value < min {
-        return Err(arg_err(format!("{name} is {value}; it must be >= {min}")));
+/// A count argument in `[min, MAX_COUNT]` as `usize`, or `InvalidArgumentError` naming it.
+fn count(name: &str, value: &AnyInt, min: usize) -> PyResult<usize> {
+    let range = format!("[{min}, {}]", tasks::MAX_COUNT);
+    let n: usize = value.to(name, &range)?;
+    if !(min..=tasks::MAX_COUNT).contains(&n) {
+        return Err(arg_err(format!(
+            "{name} is {n}; it must be an integer in {range}"
+        )));
     }
-    Ok(value as usize)
+    Ok(n)
 }
 
-fn seed(value: i64) -> PyResult<u64> {
-    u64::try_from(value).map_err(|_| arg_err(format!("seed is {value}; it must be >= 0")))
+fn seed(value: &AnyInt) -> PyResult<u64> {
+    value.to("seed", "[0, 2**64)")
 }
 
 /// Every equilibrium Newton's method reaches, with eigenvalues and stability, as JSON.
 #[pyfunction]
-#[pyo3(signature = (net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0))]
+#[pyo3(signature = (net, input, *, starts=AnyInt::from(512), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0)), text_signature = "(net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_equilibria(
     py: Python<'_>,
     net: &PyNetwork,
     input: Vec<f64>,
-    starts: i64,
+    starts: AnyInt,
     tolerance: f64,
     distinct: f64,
-    max_iterations: i64,
-    seed: i64,
+    max_iterations: AnyInt,
+    seed: AnyInt,
 ) -> PyResult<String> {
     let settings = EquilibriumSearch {
-        starts: count("starts", starts, 1)?,
+        starts: count("starts", &starts, 1)?,
         tolerance,
         distinct,
-        max_iterations: count("max_iterations", max_iterations, 1)?,
-        seed: self::seed(seed)?,
+        max_iterations: count("max_iterations", &max_iterations, 1)?,
+        seed: self::seed(&seed)?,
     };
     let n = net.inner.size() as f64;
     let cost = settings.starts as f64 * settings.max_iterations as f64 * n * n * n;
@@ -52,30 +56,30 @@ pub fn analysis_equilibria(
 
 /// The attracting limit cycles reached from the search's starts, as JSON.
 #[pyfunction]
-#[pyo3(signature = (net, input, *, starts=8, steps_per_tau=20, transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=200, seed=1))]
+#[pyo3(signature = (net, input, *, starts=AnyInt::from(8), steps_per_tau=AnyInt::from(20), transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=AnyInt::from(200), seed=AnyInt::from(1)), text_signature = "(net, input, *, starts=8, steps_per_tau=20, transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=200, seed=1)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_cycles(
     py: Python<'_>,
     net: &PyNetwork,
     input: Vec<f64>,
-    starts: i64,
-    steps_per_tau: i64,
+    starts: AnyInt,
+    steps_per_tau: AnyInt,
     transient: f64,
     window: f64,
     at_rest: f64,
     tolerance: f64,
-    orbit_points: i64,
-    seed: i64,
+    orbit_points: AnyInt,
+    seed: AnyInt,
 ) -> PyResult<String> {
     let settings = CycleSearch {
-        starts: count("starts", starts, 1)?,
-        steps_per_tau: count("steps_per_tau", steps_per_tau, 1)?,
+        starts: count("starts", &starts, 1)?,
+        steps_per_tau: count("steps_per_tau", &steps_per_tau, 1)?,
         transient,
         window,
         at_rest,
         tolerance,
-        orbit_points: count("orbit_points", orbit_points, 2)?,
-        seed: self::seed(seed)?,
+        orbit_points: count("orbit_points", &orbit_points, 2)?,
+        seed: self::seed(&seed)?,
     };
     let net = &net.inner;
     let found = detached(py, f64::INFINITY, |cancel| {
@@ -87,35 +91,35 @@ pub fn analysis_cycles(
 /// A sweep of input `index` from `start` to `stop` with the others held at `input`, as JSON;
 /// with `cycle_starts > 0` it also searches for limit cycles at each value from that many starts.
 #[pyfunction]
-#[pyo3(signature = (net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0))]
+#[pyo3(signature = (net, input, index, start, stop, *, steps=AnyInt::from(101), starts=AnyInt::from(128), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), cycle_starts=AnyInt::from(0)), text_signature = "(net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_bifurcation(
     py: Python<'_>,
     net: &PyNetwork,
     input: Vec<f64>,
-    index: i64,
+    index: AnyInt,
     start: f64,
     stop: f64,
-    steps: i64,
-    starts: i64,
+    steps: AnyInt,
+    starts: AnyInt,
     tolerance: f64,
     distinct: f64,
-    max_iterations: i64,
-    seed: i64,
-    cycle_starts: i64,
+    max_iterations: AnyInt,
+    seed: AnyInt,
+    cycle_starts: AnyInt,
 ) -> PyResult<String> {
-    let cycle_starts = count("cycle_starts", cycle_starts, 0)?;
+    let cycle_starts = count("cycle_starts", &cycle_starts, 0)?;
     let sweep = Sweep {
-        input: count("index", index, 0)?,
+        input: count("index", &index, 0)?,
         from: start,
         to: stop,
-        steps: count("steps", steps, 2)?,
+        steps: count("steps", &steps, 2)?,
         search: EquilibriumSearch {
-            starts: count("starts", starts, 1)?,
+            starts: count("starts", &starts, 1)?,
             tolerance,
             distinct,
-            max_iterations: count("max_iterations", max_iterations, 1)?,
-            seed: self::seed(seed)?,
+            max_iterations: count("max_iterations", &max_iterations, 1)?,
+            seed: self::seed(&seed)?,
         },
         cycles: (cycle_starts > 0).then(|| CycleSearch {
             starts: cycle_starts,

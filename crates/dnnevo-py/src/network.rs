@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict, PyTuple};
 use serde_json::{Map, Value};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint, Dense};
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint, AnyInt, Dense};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FormatError, IntoPy, InvalidNetworkError};
 
@@ -59,9 +59,8 @@ fn param(obj: &Bound<'_, PyAny>, name: &str, ndim: usize, expected: &str) -> PyR
 }
 
 /// Builds the integrator from keyword arguments, raising `InvalidArgumentError` on bad values.
-pub fn integrator(dt: f64, substeps: i64, method: &str) -> PyResult<Integrator> {
-    let substeps = usize::try_from(substeps)
-        .map_err(|_| arg_err(format!("substeps is {substeps}; it must be >= 1")))?;
+pub fn integrator(dt: f64, substeps: &AnyInt, method: &str) -> PyResult<Integrator> {
+    let substeps: usize = substeps.to("substeps", "[1, 2**64)")?;
     let integ = Integrator {
         method: method.parse::<Method>().py_err()?,
         dt,
@@ -343,16 +342,16 @@ impl PyNetwork {
     }
 
     /// Integrates through the rows of `inputs` (T, M), each held for `substeps` steps of `dt`.
-    #[pyo3(signature = (inputs, *, dt=0.1, substeps=1, method="euler"))]
+    #[pyo3(signature = (inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler"), text_signature = "($self, inputs, *, dt=0.1, substeps=1, method='euler')")]
     fn run(
         &mut self,
         py: Python<'_>,
         inputs: &Bound<'_, PyAny>,
         dt: f64,
-        substeps: i64,
+        substeps: AnyInt,
         method: &str,
     ) -> PyResult<PyTrace> {
-        let integ = integrator(dt, substeps, method)?;
+        let integ = integrator(dt, &substeps, method)?;
         let (n, m) = (self.inner.size(), self.inner.n_inputs());
         let x = dense(inputs, "inputs", arg_err)?;
         let steps = match x.shape.as_slice() {
@@ -613,17 +612,17 @@ fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
 
 /// Integrates P networks of the same shape together; see `dnnevo.run_population`.
 #[pyfunction]
-#[pyo3(signature = (networks, inputs, *, dt=0.1, substeps=1, method="euler", record=true))]
+#[pyo3(signature = (networks, inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", record=true), text_signature = "(networks, inputs, *, dt=0.1, substeps=1, method='euler', record=True)")]
 pub fn run_population<'py>(
     py: Python<'py>,
     networks: &Bound<'py, PyAny>,
     inputs: &Bound<'py, PyAny>,
     dt: f64,
-    substeps: i64,
+    substeps: AnyInt,
     method: &str,
     record: bool,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let integ = integrator(dt, substeps, method)?;
+    let integ = integrator(dt, &substeps, method)?;
     let mut pop = population_from(networks)?;
     let (p_len, n, m) = (pop.len(), pop.size(), pop.n_inputs());
     let x = dense(inputs, "inputs", arg_err)?;

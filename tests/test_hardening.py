@@ -271,6 +271,23 @@ def test_force_clears_the_old_runs_figures(pristine: Path, tmp_path: Path) -> No
     assert names == {".dnnevo.lock", "notes.txt", "config.toml", "log.csv", "best.json", "checkpoint.json"}
 
 
+def test_sweep_force_clears_the_old_sweeps_other_seeds(pristine: Path, tmp_path: Path) -> None:
+    out = tmp_path / "sweep"
+    out.mkdir()
+    for seed in (0, 7, 8):
+        copy(pristine, out / f"seed-{seed}")
+    (out / "seed-8" / "notes.txt").write_text("mine")
+    (out / "summary.csv").write_text("old")
+    r = run_cli("sweep", "sequence-1bit", "--quick", *SMALL, "--seeds", "0", "--out", out, "--force",
+                "--eval-trials", "5", "--no-dt-check")
+    assert r.returncode == 0, r.stderr
+    # Seed 7 was the old sweep's alone and is gone; seed 8 keeps only what was not dnnevo's.
+    assert sorted(p.name for p in out.iterdir()) == [".dnnevo.lock", "seed-0", "seed-8", "summary.csv",
+                                                      "summary.json"]
+    assert sorted(p.name for p in (out / "seed-8").iterdir()) == [".dnnevo.lock", "notes.txt"]
+    assert "old" not in (out / "summary.csv").read_text()
+
+
 def test_generations_extends_a_run_keeping_files_in_agreement(pristine: Path, tmp_path: Path) -> None:
     run = copy(pristine, tmp_path / "run")
     longer = tmp_path / "longer"

@@ -5,13 +5,16 @@ conditions, and the statistics of :mod:`dnnevo.sweep` printed and written to ``s
 from __future__ import annotations
 
 import argparse
+import re
+import shutil
+from pathlib import Path
 
 from dnnevo import presets, sweep
 from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
-from dnnevo.rundir import RunDir
+from dnnevo.rundir import LOCK_NAME, RunDir
 
 EXAMPLE = """examples:
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
@@ -24,7 +27,9 @@ champions (best.json) that pass on fresh conditions from seed BASE + seed (--eva
 'dnnevo evaluate' judges. Each final champion is also judged on the same conditions at a 10x
 finer step and with RK4 ('dnnevo evaluate --dt-check'); one that fails there where it did not at
 the run's step is counted as a step artefact (--no-dt-check skips the check). Writes
-OUT/summary.csv (a row per seed, then a row 'all') and OUT/summary.json."""
+OUT/summary.csv (a row per seed, then a row 'all') and OUT/summary.json. --force starts the sweep
+afresh: the old summary goes, and so do the old sweep's seed-N run folders (files dnnevo did not
+write are kept)."""
 
 
 def sweep_command(args: argparse.Namespace) -> int:
@@ -36,7 +41,24 @@ def sweep_command(args: argparse.Namespace) -> int:
         nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
     with RunDir(args.out).writing(create=True) as folder:
         folder.create(force=args.force, extra=sweep.SUMMARY_FILES)
+        if args.force:
+            _clear_other_seeds(args.out, args.seeds)
         return _sweep(args, config)
+
+
+def _clear_other_seeds(out: Path, seeds: list[int]) -> None:
+    """``--force``: the old sweep's run folders ``seed-N`` of seeds the new sweep does not run
+    lose their run files and figures (each under its lock), and go if nothing else is left, so
+    the folder holds only the new sweep's runs."""
+    keep = {f"seed-{s}" for s in seeds}
+    for p in sorted(out.iterdir()):
+        if p.name in keep or not re.fullmatch(r"seed-\d+", p.name) or not p.is_dir() or p.is_symlink():
+            continue
+        run = RunDir(p)
+        with run.writing(create=False):
+            run.clear()
+        if [q.name for q in p.iterdir()] in ([], [LOCK_NAME]):
+            shutil.rmtree(p)
 
 
 def _sweep(args: argparse.Namespace, config: EvolutionConfig) -> int:

@@ -441,3 +441,31 @@ def test_cli_sizes_past_the_limit_are_one_line(tmp_path: Path) -> None:
                             setting, "--out", str(tmp_path / "x"), "--force"],
                            capture_output=True, text=True, timeout=120, preexec_fn=limit)
         assert_one_line_error(r)
+
+
+def test_an_edited_fitness_function_of_the_same_name_is_refused(tmp_path: Path,
+                                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    import importlib
+    import tomllib
+
+    import dnnevo
+    from dnnevo.errors import ConfigError
+
+    source = "def fit(nets):\n    return [abs(net.theta[0]) {} 1.0 for net in nets]\n"
+    module = tmp_path / "edited_fitness.py"
+    module.write_text(source.format("+"))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import edited_fitness  # type: ignore[import-not-found]
+
+    cfg = dnnevo.EvolutionConfig(population=10, generations=4, size=2, n_inputs=1)
+    out = tmp_path / "run"
+    dnnevo.evolve(edited_fitness.fit, cfg, seed=1, out=out, progress=False,
+                  callback=lambda stats, ga: ga.generation >= 2)
+    # Unchanged: it resumes. Edited under the same name: refused, or accepted and recorded.
+    module.write_text(source.format("-"))
+    importlib.reload(edited_fitness)
+    with pytest.raises(ConfigError, match="not an edited python:edited_fitness.fit"):
+        dnnevo.resume(out, edited_fitness.fit, progress=False)
+    dnnevo.resume(out, edited_fitness.fit, progress=False, new_fitness=True)
+    run = tomllib.loads((out / "config.toml").read_text())["run"]
+    assert [c["task"] for c in run["fitness_changes"]] == ["python:edited_fitness.fit"]

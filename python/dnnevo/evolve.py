@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import hashlib
+import inspect
 import json
 import signal
 import sys
@@ -149,6 +151,8 @@ def evolve(
         return _loop(ga, task, [], None, progress=progress, callback=callback, threads=threads)
     run = RunDir(out)
     table = {**_run_table(seed), **(run_info or {})}
+    if callable(task) and (digest := _fitness_digest(task)) is not None:
+        table["fitness_sha256"] = digest
     with run.writing(create=True):
         run.create(force=force)
         # The checkpoint first: from here on the folder can be resumed.
@@ -201,14 +205,20 @@ def resume(
         if task is not None:
             fitness = task
             name = task if isinstance(task, str) else _python_task_name(task)
-            if name != ga.config.task:
+            digest = None if isinstance(task, str) else _fitness_digest(task)
+            # Same name, other source: a different function all the same.
+            edited = digest is not None and table.get("fitness_sha256", digest) != digest
+            if name != ga.config.task or edited:
                 if not new_fitness:
                     raise ConfigError(
-                        f"{run.path} was evolved with {ga.config.task}, not {name}; pass "
-                        "new_fitness=True to continue it with another fitness function")
+                        f"{run.path} was evolved with {ga.config.task}, not "
+                        f"{'an edited ' + name if edited and name == ga.config.task else name}; "
+                        "pass new_fitness=True to continue it with another fitness function")
                 changes = [*table.get("fitness_changes", []),
                            {"generation": ga.generation, "task": name}]
                 table = {**table, "fitness_changes": changes}
+                if digest is not None:
+                    table["fitness_sha256"] = digest
                 print(f"{run.path}: continuing at generation {ga.generation} with {name} "
                       f"(the run was evolved with {ga.config.task}); recorded in config.toml",
                       file=sys.stderr)
@@ -284,6 +294,17 @@ def _restored(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], di
         if cp.run is None:
             table = toml_table
     return ga, cp.history, table
+
+
+def _fitness_digest(task: FitnessFn) -> str | None:
+    """SHA-256 of a Python fitness function's source, so that resume can tell an edited function
+    from the run's own; None when Python cannot find the source (e.g. typed at a prompt)."""
+    target = task if inspect.isfunction(task) or inspect.ismethod(task) else type(task)
+    try:
+        source = inspect.getsource(target)
+    except (OSError, TypeError):
+        return None
+    return hashlib.sha256(source.encode()).hexdigest()
 
 
 def _run_table(seed: int) -> dict[str, Any]:

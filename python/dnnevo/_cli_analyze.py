@@ -123,7 +123,6 @@ def analyze(args: argparse.Namespace) -> int:
 
     trials = analysis.recorded_trials(config, net, seed=args.seed)
     outputs = np.vstack([o for o, _ in trials])
-    inputs = np.vstack([i for _, i in trials])
     basins = _basins(config, net, trials, found[0])
     if args.neurons:
         neurons = _pair(args.neurons, net.size)

@@ -7,15 +7,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import math
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from dnnevo import _cli_landmark, _cli_nav1d, _cli_sequence, _core, assess
+from dnnevo import _cli_landmark, _cli_nav1d, _cli_sequence, assess
 from dnnevo.assess import Assessment, Rate
-from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.rundir import RunDir
 from dnnevo.stepcheck import StepCheck, step_check, with_dt

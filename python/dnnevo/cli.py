@@ -21,7 +21,6 @@ import numpy as np
 
 from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, sweep
 from dnnevo.assess import DEFAULT_TRIALS
-from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.rundir import RunDir, save_figure
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from dnnevo import _core, stats
+from dnnevo import stats
 from dnnevo.assess import Assessment, assess
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError

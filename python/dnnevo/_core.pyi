@@ -10,6 +10,7 @@ import numpy.typing as npt
 __all__ = [
     "LANES",
     "MAX_COUNT",
+    "MUTATION_SCALE",
     "Evolution",
     "Network",
     "Trace",
@@ -44,6 +45,7 @@ __all__ = [
 __version__: str
 LANES: int
 MAX_COUNT: int
+MUTATION_SCALE: float
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]

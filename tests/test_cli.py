@@ -120,13 +120,52 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
         state = RunDir(run).read_checkpoint().state
         return dn.GeneticAlgorithm.from_state_dict(state).ask().networks
 
-    from dnnevo.cli import _seed_networks
+    from dnnevo.seeding import Seeding
 
     a, b = population(tmp_path / "a"), population(tmp_path / "b")
-    seeds = _seed_networks([tmp_path / "a", tmp_path / "b"], 10, populations=True)
+    seeds = Seeding((tmp_path / "a", tmp_path / "b"), populations=True).networks(10, seed=0)
     assert len(seeds) == len(a) == 10
     for k in (0, 3, 9):
         expected = dn.compose(a[k], b[k])
         assert (seeds[k].weights == expected.weights).all() and (seeds[k].tau == expected.tau).all()
+    # Cross weights drawn per member from the run's seed: only the off-diagonal blocks change.
+    crossed = Seeding((tmp_path / "a", tmp_path / "b"), populations=True, cross_scale=2.0).networks(10, seed=7)
+    na = a[0].size
+    for k in (0, 3):
+        w, plain_w = crossed[k].weights, seeds[k].weights
+        assert (w[:na, :na] == plain_w[:na, :na]).all() and (w[na:, na:] == plain_w[na:, na:]).all()
+        for block in (w[:na, na:], w[na:, :na]):
+            assert (block != 0).all() and (abs(block) <= 2.0).all()
+        assert (w == dn.compose(a[k], b[k], cross_scale=2.0, seed=7, member=k).weights).all()
+    assert not (crossed[0].weights[:na, na:] == crossed[1].weights[:na, na:]).all()
+    other_seed = Seeding((tmp_path / "a", tmp_path / "b"), populations=True, cross_scale=2.0).networks(10, seed=8)
+    assert not (other_seed[0].weights == crossed[0].weights).all()
+    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "f"), "--cross-scale", "1",
+               "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
+    assert r.returncode == 0, r.stderr
+    assert tomllib.loads((tmp_path / "f" / "config.toml").read_text())["run"]["cross_scale"] == 1.0
+    for bad, fragment in ((["--cross-scale", "1"], "--cross-scale needs"),
+                          (["--cross-scale", "-1", "--seed-from", str(tmp_path / "a")], "--cross-scale is -1.0"),
+                          (["--cross-scale", "nan", "--seed-from", str(tmp_path / "a")], "--cross-scale is nan")):
+        r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "g"), *bad)
+        assert r.returncode == 2 and fragment in r.stderr and "Traceback" not in r.stderr, r.stderr
     r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "e"), "--seed-populations")
     assert r.returncode == 2 and "--seed-populations needs" in r.stderr
+
+
+def test_a_sweep_seeds_every_run_from_earlier_runs(tmp_path: Path) -> None:
+    import json
+    import tomllib
+
+    small = ["--quick", "--set", "generations=1", "--set", "population=10"]
+    for name in ("a", "b"):
+        assert dnnevo("run", "sequence-1bit", *small, "--out", str(tmp_path / name)).returncode == 0
+    r = dnnevo("sweep", "sequence-2bit", *small, "--seeds", "0,1", "--out", str(tmp_path / "s"),
+               "--eval-trials", "4", "--no-dt-check", "--seed-populations", "--cross-scale", "0.5",
+               "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
+    assert r.returncode == 0, r.stderr
+    for seed in (0, 1):
+        run = tomllib.loads((tmp_path / "s" / f"seed-{seed}" / "config.toml").read_text())["run"]
+        assert run["seeded_with"] == "populations" and run["cross_scale"] == 0.5
+    info = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert json.dumps(info).count(str(tmp_path / "a")) >= 1

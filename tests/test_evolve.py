@@ -196,6 +196,9 @@ def test_config_validation_messages() -> None:
         ({"mutation_rate": -0.1}, "mutation_rate is -0.1"),
         ({"elitism": 100}, "elitism is 100"),
         ({"selection": "tournament"}, "selection is 'tournament'"),
+        ({"mutation": "gauss"}, "mutation is 'gauss'"),
+        ({"mutation_scale": 0.0}, "mutation_scale is 0.0; it must be in (0, 1]"),
+        ({"mutation_scale": 2}, "mutation_scale is 2"),
         ({"integrator": {"dt": 0}}, "integrator.dt is 0"),
         ({"ranges": {"tau": (0, 1)}}, "ranges.tau starts at 0.0"),
         ({"ranges": {"tau": (2, 1)}}, "ranges.tau is [2.0, 1.0]"),
@@ -205,6 +208,33 @@ def test_config_validation_messages() -> None:
         assert fragment in str(info.value)
     with pytest.raises(ConfigError, match="unknown key 'populaton'"):
         EvolutionConfig.from_dict({"populaton": 3})
+
+
+def test_creep_mutation_runs_deterministically_and_differs_from_uniform() -> None:
+    creep = dataclasses.replace(SMALL, mutation="creep", mutation_scale=0.02)
+
+    def genomes_after(config: EvolutionConfig) -> np.ndarray:
+        ga = dnnevo.GeneticAlgorithm(config, seed=4)
+        for _ in range(3):
+            ga.tell(follow_square(ga.ask().networks))
+        return ga.ask().genomes
+
+    np.testing.assert_array_equal(genomes_after(creep), genomes_after(creep))
+    uniform = genomes_after(dataclasses.replace(creep, mutation="uniform"))
+    assert not np.array_equal(genomes_after(creep), uniform)
+    assert EvolutionConfig.from_toml(creep.to_toml()) == creep
+
+
+def test_settings_added_later_leave_old_digests_unchanged() -> None:
+    """A folder written before ``mutation`` existed carries a digest of a config without it."""
+    from dnnevo.config import LATER_SETTINGS
+    from dnnevo.rundir import config_digest
+
+    config = EvolutionConfig()
+    old = {k: v for k, v in config.to_dict().items() if k not in LATER_SETTINGS}
+    text = json.dumps({"config": old, "seed": 5}, sort_keys=True, separators=(",", ":"))
+    assert config_digest(config, 5) == __import__("hashlib").sha256(text.encode()).hexdigest()
+    assert config_digest(dataclasses.replace(config, mutation="creep"), 5) != config_digest(config, 5)
 
 
 def test_env_thread_count_does_not_change_results(tmp_path: Path) -> None:

@@ -9,7 +9,7 @@ import re
 import shutil
 from pathlib import Path
 
-from dnnevo import presets, sweep
+from dnnevo import presets, seeding, sweep
 from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig
@@ -19,6 +19,8 @@ from dnnevo.rundir import LOCK_NAME, RunDir
 EXAMPLE = """examples:
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
   dnnevo sweep landmark --seeds 0-9 --out runs/sweep-lm --eval-trials 100
+  dnnevo sweep sequence-2bit --seeds 0-4 --out runs/inc --seed-from runs/sequence-1bit-seed0 \
+      --seed-from runs/sequence-2bit-alternating-seed0 --seed-populations --cross-scale 1
 
 Reports the seeds whose run met the task's rule (k/n with a 95% Wilson interval), the median
 first-success generation (95% bootstrap interval, fixed bootstrap seed; a seed that never
@@ -63,18 +65,19 @@ def _clear_other_seeds(out: Path, seeds: list[int]) -> None:
 
 def _sweep(args: argparse.Namespace, config: EvolutionConfig) -> int:
     trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
+    how = seeding.Seeding.from_args(args)
     runs = []
     for seed in args.seeds:
         result = sweep.run_seed(config, seed, args.out / f"seed-{seed}", threads=args.threads,
                                 force=args.force, eval_seed_base=args.eval_seed, eval_trials=trials,
-                                dt_check=args.dt_check)
+                                dt_check=args.dt_check, seeding=how)
         runs.append(result)
         if result.interrupted:
             break
     summary = sweep.summarize(runs)
     info = {"preset": args.preset, "quick": args.quick, "overrides": list(args.set), "task": config.task,
             "eval_seed": f"{args.eval_seed} + seed", "eval_trials": trials,
-            "eval_unit": UNITS[config.task]}
+            "eval_unit": UNITS[config.task], **(how.info() if how else {})}
     paths = summary.write(args.out, info)
     print("\n".join(lines(summary, args.eval_seed, trials, UNITS[config.task])))
     if runs[-1].interrupted:

@@ -10,6 +10,7 @@ import numpy.typing as npt
 __all__ = [
     "LANES",
     "MAX_COUNT",
+    "MUTATION_SCALE",
     "Evolution",
     "Network",
     "Trace",
@@ -44,6 +45,7 @@ __all__ = [
 __version__: str
 LANES: int
 MAX_COUNT: int
+MUTATION_SCALE: float
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]
@@ -125,7 +127,7 @@ class Network:
     def __reduce__(self) -> tuple[Any, ...]: ...
     def __eq__(self, other: object, /) -> bool: ...
 
-def compose(a: Network, b: Network) -> Network: ...
+def compose(a: Network, b: Network, *, cross_scale: float = 0.0, seed: int = 0, member: int = 0) -> Network: ...
 def run_population(
     networks: Sequence[Network] | Mapping[str, npt.ArrayLike],
     inputs: npt.ArrayLike,

@@ -12,14 +12,13 @@ if sys.excepthook is sys.__excepthook__:
     sys.excepthook = dnnevo._interrupted_import
 
 import argparse
-import functools
 import os
 import traceback
 from pathlib import Path
 
 import numpy as np
 
-from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, sweep
+from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, seeding, sweep
 from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.rundir import RunDir, save_figure
@@ -106,12 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, help="run folder (default runs/PRESET-seedN)")
     p.add_argument("--force", action="store_true",
                    help="overwrite a non-empty run folder (its run files and figures are removed)")
-    p.add_argument("--seed-from", action="append", default=[], type=Path, metavar="RUN",
-                   help="seed the initial population with RUN's champion (repeatable); "
-                        "champions whose sizes add up to the preset's size are composed")
-    p.add_argument("--seed-populations", action="store_true",
-                   help="with --seed-from: use each RUN's whole last population, not its champion; "
-                        "the i-th members of the runs are composed into the i-th seed")
+    seeding.add_arguments(p)
     run_options(p)
 
     p = sub.add_parser("resume", help="continue a stopped run",
@@ -149,6 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eval-trials", type=_positive, metavar="N", help="fresh " + trials_help)
     p.add_argument("--no-dt-check", dest="dt_check", action="store_false",
                    help="skip judging each final champion again at a 10x finer step and with RK4")
+    seeding.add_arguments(p)
     run_options(p)
 
     p = sub.add_parser("evaluate", help="judge a champion on fresh random conditions",
@@ -185,30 +180,12 @@ def build_parser() -> argparse.ArgumentParser:
 def _cmd_run(args: argparse.Namespace) -> int:
     config = presets.get(args.preset, quick=args.quick, overrides=args.set)
     out = args.out or Path("runs") / f"{args.preset}{'-quick' if args.quick else ''}-seed{args.seed}"
-    if args.seed_populations and not args.seed_from:
-        raise ConfigError("--seed-populations needs at least one --seed-from RUN")
-    seeds = _seed_networks(args.seed_from, config.size, populations=args.seed_populations)
-    info: dict[str, object] | None = None
-    if args.seed_from:
-        info = {"seeded_from": [str(p) for p in args.seed_from],
-                "seeded_with": "populations" if args.seed_populations else "champions"}
+    how = seeding.Seeding.from_args(args)
+    seeds = how.networks(config.size, args.seed) if how else None
+    info = how.info() if how else None
     result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,
                            seeds=seeds, force=args.force, run_info=info)
     return _report(result)
-
-
-def _seed_networks(runs: list[Path], size: int, *, populations: bool = False) -> list[dnnevo.Network]:
-    """The champions of ``runs`` (or, with ``populations``, each run's last population, member by
-    member); when their sizes add up to ``size`` they are composed in order (the first run's
-    output neuron stays the output), as in the paper's incremental route."""
-    if populations:
-        groups = [dnnevo.GeneticAlgorithm.from_state_dict(RunDir(r).read_checkpoint().state).ask().networks
-                  for r in runs]
-    else:
-        groups = [[_champion(RunDir(r))] for r in runs]
-    if len(groups) > 1 and sum(g[0].size for g in groups) == size:
-        return [functools.reduce(dnnevo.compose, members) for members in zip(*groups)]
-    return [net for group in groups for net in group]
 
 
 def _report(result: dnnevo.EvolutionResult) -> int:
@@ -217,12 +194,6 @@ def _report(result: dnnevo.EvolutionResult) -> int:
     print(f"best fitness {result.best_fitness:.4f} (generation {result.best_generation}); "
           f"{len(h['generation'])} generations in {wall:.1f} s; run folder {result.run_dir}")
     return 130 if result.interrupted else 0
-
-
-def _champion(run: RunDir) -> dnnevo.Network:
-    """The run's best.json, checked against its config.toml."""
-    config, table = run.read_config()
-    return run.read_best(config, table)
 
 
 def _cmd_resume(args: argparse.Namespace) -> int:

@@ -16,13 +16,19 @@ from typing import Any
 
 import tomli_w
 
+from dnnevo import _core
 from dnnevo.errors import ConfigError
 
 __all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides"]
 
 SELECTIONS = ("proportional", "rank")
+MUTATIONS = ("uniform", "creep")
 FILLS = ("mutants", "random")
 METHODS = ("euler", "rk4")
+
+#: Settings added after run folders began to carry a config digest. At their defaults they are
+#: left out of the digest (``rundir.config_digest``), so folders written before them still resume.
+LATER_SETTINGS = ("mutation", "mutation_scale")
 
 
 @dataclass(frozen=True)
@@ -80,6 +86,12 @@ class EvolutionConfig:
     generations: int = 100
     crossover_rate: float = 0.5
     mutation_rate: float = 0.025
+    """Probability that each gene of a child mutates (a per-gene rate)."""
+    mutation: str = "uniform"
+    """``"uniform"``: a mutated gene is redrawn over its range (the paper's); ``"creep"``: it moves
+    by a bell-shaped step of ``mutation_scale`` times its range's width, reflected at the ends."""
+    mutation_scale: float = _core.MUTATION_SCALE
+    """With ``mutation = "creep"``: the step's standard deviation as a fraction of the range."""
     elitism: int = 0
     """How many of the best individuals are copied unchanged (0 = the paper's GA)."""
     validation_candidates: int = 10
@@ -115,6 +127,11 @@ class EvolutionConfig:
             value = getattr(self, name)
             if not (isinstance(value, int | float) and 0.0 <= value <= 1.0):
                 raise ConfigError(f"{name} is {value!r}; it must be in [0, 1]")
+        if self.mutation not in MUTATIONS:
+            raise ConfigError(f"mutation is {self.mutation!r}; expected one of {MUTATIONS}")
+        scale = self.mutation_scale
+        if not (isinstance(scale, int | float) and not isinstance(scale, bool) and 0.0 < scale <= 1.0):
+            raise ConfigError(f"mutation_scale is {scale!r}; it must be in (0, 1]")
         if self.elitism >= self.population:
             raise ConfigError(
                 f"elitism is {self.elitism}; it must be < population ({self.population})"
@@ -170,6 +187,8 @@ class EvolutionConfig:
             "population": self.population,
             "crossover_rate": float(self.crossover_rate),
             "mutation_rate": float(self.mutation_rate),
+            "mutation": self.mutation,
+            "mutation_scale": float(self.mutation_scale),
             "elitism": self.elitism,
             "selection": self.selection,
             "validation_candidates": self.validation_candidates,

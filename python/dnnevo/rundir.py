@@ -39,7 +39,7 @@ from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from dnnevo.config import EvolutionConfig
+from dnnevo.config import LATER_SETTINGS, EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FormatError
 
 if TYPE_CHECKING:
@@ -152,7 +152,12 @@ def save_figure(fig: Any, path: Path, *, dpi: int = 120) -> None:
 
 def config_digest(config: EvolutionConfig, seed: int) -> str:
     """SHA-256 of the complete run config (every setting and the seed), as canonical JSON."""
-    doc = {"config": config.to_dict(), "seed": seed}
+    settings = config.to_dict()
+    defaults = EvolutionConfig()
+    for name in LATER_SETTINGS:
+        if getattr(config, name) == getattr(defaults, name):
+            del settings[name]
+    doc = {"config": settings, "seed": seed}
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"), allow_nan=False)
     return hashlib.sha256(text.encode()).hexdigest()
 

@@ -35,6 +35,7 @@ from dnnevo.assess import Assessment, assess
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.rundir import RunDir, write_atomic
+from dnnevo.seeding import Seeding
 from dnnevo.stats import Verdict
 from dnnevo.stepcheck import StepCheck, step_check
 
@@ -103,15 +104,20 @@ class SeedResult:
 def run_seed(
     config: EvolutionConfig, seed: int, out: Path, *, threads: int | None = None, force: bool = False,
     eval_seed_base: int = EVAL_SEED_BASE, eval_trials: int | None = None, dt_check: bool = True,
+    seeding: Seeding | None = None,
 ) -> SeedResult:
     """Runs ``config`` with ``seed`` into ``out``, then judges the final champion (``out /
     best.json``) on fresh conditions from :func:`eval_seed` with ``eval_trials`` (default: the
     task's :data:`~dnnevo.assess.DEFAULT_TRIALS`), and, with ``dt_check``, checks it at finer
-    steps on the same conditions (:func:`~dnnevo.stepcheck.step_check`)."""
+    steps on the same conditions (:func:`~dnnevo.stepcheck.step_check`). With ``seeding`` the
+    first population starts from earlier runs' networks (:mod:`dnnevo.seeding`)."""
     from dnnevo.evolve import evolve
 
     t0 = time.perf_counter()
-    result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force)
+    seeds = seeding.networks(config.size, seed) if seeding else None
+    info = seeding.info() if seeding else None
+    result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force,
+                    seeds=seeds, run_info=info)
     wall = time.perf_counter() - t0
     champion = RunDir(out).read_best(config, {"seed": seed})
     fresh = eval_seed(seed, eval_seed_base)

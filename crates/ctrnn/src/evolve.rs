@@ -222,6 +222,7 @@ impl Evolution {
                             &config.ranges,
                             child,
                             config.mutation_rate,
+                            config.mutation(),
                             &mut stream,
                         );
                     }

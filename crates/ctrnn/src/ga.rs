@@ -9,7 +9,10 @@
 //!    `Stream::new(seed, generation, Purpose::Reproduce, c, 0)`. With probability
 //!    `crossover_rate` it selects two parents and a cut x uniform in `1..=N-1`, taking neurons
 //!    `0..x` from the first and the rest from the second; otherwise it selects one parent and
-//!    copies it. Then each gene is resampled over its range with probability `mutation_rate`.
+//!    copies it. Then each gene is mutated with probability `mutation_rate` (a per-gene rate):
+//!    resampled over its range (`mutation = "uniform"`, the paper's), or moved by a bell-shaped
+//!    step of `mutation_scale` times its range's width (`mutation = "creep"`,
+//!    [`genome::Mutation::Creep`]).
 //!
 //! Because no child shares randomness with another, children are built in parallel and the result
 //! is the same bits for any number of threads.
@@ -34,7 +37,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::genome::{self, Layout, Ranges};
+use crate::genome::{self, Layout, Mutation, Ranges};
 use crate::rng::{Purpose, Stream};
 
 /// How parents are chosen from the fitness values.
@@ -90,9 +93,13 @@ pub struct GaConfig {
     /// Probability that a child is made by crossover rather than by copying one parent, in [0, 1].
     /// Default 0.5.
     pub crossover_rate: f64,
-    /// Probability that each gene of a child is resampled over its range, in [0, 1].
-    /// Default 0.025.
+    /// Probability that each gene of a child is mutated, in [0, 1]. Default 0.025.
     pub mutation_rate: f64,
+    /// How a gene mutates. Default [`MutationKind::Uniform`], as in the paper.
+    pub mutation: MutationKind,
+    /// With [`MutationKind::Creep`], the step's standard deviation as a fraction of the gene's
+    /// range, in (0, 1]. Default [`MUTATION_SCALE`].
+    pub mutation_scale: f64,
     /// Number of best individuals copied unchanged into the next generation (below
     /// `population`). Default 0, as in the paper.
     pub elitism: usize,
@@ -108,6 +115,21 @@ pub struct GaConfig {
     pub validation_candidates: usize,
 }
 
+/// [`GaConfig::mutation_scale`]'s default: a creep step's standard deviation is 5% of the
+/// gene's range (1.6 for the default weight range of width 32).
+pub const MUTATION_SCALE: f64 = 0.05;
+
+/// How a gene mutates: the names used in configs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MutationKind {
+    /// Resampled uniformly over its range (the paper's).
+    #[default]
+    Uniform,
+    /// Moved by a bell-shaped step scaled by `mutation_scale` ([`Mutation::Creep`]).
+    Creep,
+}
+
 /// [`GaConfig::validation_candidates`]'s default.
 pub const VALIDATION_CANDIDATES: usize = 10;
 
@@ -117,6 +139,8 @@ impl Default for GaConfig {
             population: 100,
             crossover_rate: 0.5,
             mutation_rate: 0.025,
+            mutation: MutationKind::Uniform,
+            mutation_scale: MUTATION_SCALE,
             elitism: 0,
             selection: Selection::Proportional,
             ranges: Ranges::default(),
@@ -126,6 +150,16 @@ impl Default for GaConfig {
 }
 
 impl GaConfig {
+    /// The mutation operator these settings name.
+    pub fn mutation(&self) -> Mutation {
+        match self.mutation {
+            MutationKind::Uniform => Mutation::Uniform,
+            MutationKind::Creep => Mutation::Creep {
+                scale: self.mutation_scale,
+            },
+        }
+    }
+
     /// Checks every setting; the error names the setting, its value and what is allowed.
     ///
     /// # Example
@@ -153,6 +187,15 @@ impl GaConfig {
                     "{name} is {rate}; it must be in [0, 1]"
                 )));
             }
+        }
+        if !(self.mutation_scale.is_finite()
+            && self.mutation_scale > 0.0
+            && self.mutation_scale <= 1.0)
+        {
+            return Err(Error::Config(format!(
+                "mutation_scale is {}; it must be in (0, 1]",
+                self.mutation_scale
+            )));
         }
         if self.elitism >= self.population {
             return Err(Error::Config(format!(
@@ -352,6 +395,7 @@ pub fn next_generation(
             &config.ranges,
             child,
             config.mutation_rate,
+            config.mutation(),
             &mut stream,
         );
     });
@@ -724,6 +768,53 @@ mod tests {
         // Everything after the elites was fully mutated.
         let parent_values: Vec<f64> = parents.clone();
         assert!(children[3 * g..].iter().all(|v| !parent_values.contains(v)));
+    }
+
+    #[test]
+    fn creep_mutation_moves_genes_a_little_and_is_configured_by_name() {
+        let l = layout(4, 2);
+        let p = 32;
+        let config = GaConfig {
+            population: p,
+            crossover_rate: 0.0,
+            mutation_rate: 1.0,
+            mutation: MutationKind::Creep,
+            mutation_scale: 0.01,
+            ..GaConfig::default()
+        };
+        let parents = initial_population(l, &config, 3).unwrap();
+        let fitness = vec![1.0; p];
+        let children = next_generation(&parents, &fitness, l, &config, 3, 0).unwrap();
+        let g = l.len();
+        // Each child is a copy of some parent with every gene moved by at most 6 sd = 6% of
+        // its range: find that parent and check the distance.
+        for child in children.chunks_exact(g) {
+            let near = parents.chunks_exact(g).any(|parent| {
+                (0..g).all(|k| {
+                    let (lo, hi) = genome::gene_range(l, &config.ranges, k);
+                    let d = (child[k] - parent[k]).abs();
+                    d > 0.0 && d <= 0.06 * (hi - lo) + 1e-12
+                })
+            });
+            assert!(near, "a creep child is not a small move from any parent");
+        }
+        let parsed: GaConfig = serde_json::from_str(
+            r#"{"population": 4, "mutation": "creep", "mutation_scale": 0.2}"#,
+        )
+        .unwrap();
+        assert_eq!(parsed.mutation(), Mutation::Creep { scale: 0.2 });
+        assert_eq!(GaConfig::default().mutation(), Mutation::Uniform);
+        for bad in [0.0, -0.1, 1.5, f64::NAN] {
+            let e = GaConfig {
+                mutation_scale: bad,
+                ..GaConfig::default()
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("mutation_scale is"), "{e}");
+        }
+        assert!(serde_json::from_str::<GaConfig>(r#"{"mutation": "gauss"}"#).is_err());
     }
 
     #[test]

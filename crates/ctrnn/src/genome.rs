@@ -289,10 +289,8 @@ pub fn random(layout: Layout, ranges: &Ranges, stream: &mut Stream) -> Vec<f64> 
         .collect()
 }
 
-/// Mutates `genes` in place: each gene, in order, is resampled uniformly over its range with
-/// probability `rate`. Returns how many genes were resampled.
-///
-/// Every gene costs one draw from `stream`, plus one more when it is resampled.
+/// Mutates `genes` in place: each gene, in order, is changed with probability `rate`, by
+/// `mutation` (see [`Mutation`]). Returns how many genes were changed.
 ///
 /// # Panics
 /// If `genes.len() != layout.len()`.
@@ -301,6 +299,7 @@ pub fn mutate(
     ranges: &Ranges,
     genes: &mut [f64],
     rate: f64,
+    mutation: Mutation,
     stream: &mut Stream,
 ) -> usize {
     assert_eq!(
@@ -312,11 +311,48 @@ pub fn mutate(
     for (g, gene) in genes.iter_mut().enumerate() {
         if stream.bernoulli(rate) {
             let (lo, hi) = gene_range(layout, ranges, g);
-            *gene = stream.range(lo, hi);
+            *gene = match mutation {
+                Mutation::Uniform => stream.range(lo, hi),
+                Mutation::Creep { scale } => {
+                    reflect(*gene + scale * (hi - lo) * creep_step(stream), lo, hi)
+                }
+            };
             changed += 1;
         }
     }
     changed
+}
+
+/// How a mutated gene changes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Mutation {
+    /// Resampled uniformly over its range (the paper's).
+    Uniform,
+    /// Moved by `scale` times its range's width times a bell-shaped step of mean 0 and standard
+    /// deviation 1 ([`creep_step`]), and reflected back into the range at its ends.
+    Creep {
+        /// The step's standard deviation as a fraction of the range's width, in (0, 1].
+        scale: f64,
+    },
+}
+
+/// A bell-shaped step of mean 0 and standard deviation 1: the sum of 12 uniform draws minus 6
+/// (the Irwin-Hall approximation of the Gaussian, bounded at +-6). Sums alone, so every platform
+/// gives the same bits, which a Gaussian through the math library's `ln` and `cos` would not.
+pub fn creep_step(stream: &mut Stream) -> f64 {
+    let mut sum = 0.0;
+    for _ in 0..12 {
+        sum += stream.uniform();
+    }
+    sum - 6.0
+}
+
+/// `x` folded into `[lo, hi]` by reflection at the ends (as often as needed).
+fn reflect(x: f64, lo: f64, hi: f64) -> f64 {
+    let width = hi - lo;
+    let t = (x - lo).rem_euclid(2.0 * width);
+    let folded = if t > width { 2.0 * width - t } else { t };
+    (lo + folded).clamp(lo, hi)
 }
 
 #[cfg(test)]
@@ -454,12 +490,15 @@ mod tests {
             let mut genes = random(l, &r, &mut s);
             assert!(in_range(&genes));
             assert!(decode(l, &genes).is_ok());
-            assert_eq!(mutate(l, &r, &mut genes, 1.0, &mut s), l.len());
+            assert_eq!(
+                mutate(l, &r, &mut genes, 1.0, Mutation::Uniform, &mut s),
+                l.len()
+            );
             assert!(in_range(&genes));
         }
         let mut genes = random(l, &r, &mut s);
         let before = genes.clone();
-        assert_eq!(mutate(l, &r, &mut genes, 0.0, &mut s), 0);
+        assert_eq!(mutate(l, &r, &mut genes, 0.0, Mutation::Uniform, &mut s), 0);
         assert_eq!(genes, before);
     }
 
@@ -477,7 +516,7 @@ mod tests {
         let (mut reported, mut differing) = (0usize, 0usize);
         for _ in 0..rounds {
             let before = genes.clone();
-            reported += mutate(l, &r, &mut genes, rate, &mut s);
+            reported += mutate(l, &r, &mut genes, rate, Mutation::Uniform, &mut s);
             differing += genes.iter().zip(&before).filter(|(a, b)| a != b).count();
         }
         let n = (rounds * l.len()) as f64; // 150_000 genes
@@ -487,6 +526,62 @@ mod tests {
             (reported as f64 - n * rate).abs() < 5.0 * sd,
             "{reported} of {n}"
         );
+    }
+
+    #[test]
+    fn creep_steps_have_unit_spread_and_stay_in_range() {
+        let mut s = stream(9);
+        let steps: Vec<f64> = (0..100_000).map(|_| creep_step(&mut s)).collect();
+        let n = steps.len() as f64;
+        let mean = steps.iter().sum::<f64>() / n;
+        let var = steps.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+        assert!(
+            mean.abs() < 0.02 && (var - 1.0).abs() < 0.02,
+            "{mean} {var}"
+        );
+        assert!(steps.iter().all(|x| x.abs() <= 6.0));
+
+        let l = Layout {
+            size: 3,
+            n_inputs: 2,
+        };
+        let r = Ranges::default();
+        let creep = Mutation::Creep { scale: 0.05 };
+        let mut genes = random(l, &r, &mut s);
+        let before = genes.clone();
+        assert_eq!(mutate(l, &r, &mut genes, 1.0, creep, &mut s), l.len());
+        for (g, (a, b)) in genes.iter().zip(&before).enumerate() {
+            let (lo, hi) = gene_range(l, &r, g);
+            assert!(lo <= *a && *a <= hi, "gene {g} = {a}");
+            // at most 6 standard deviations, i.e. 0.3 of the range's width
+            assert!(
+                (a - b).abs() <= 0.3 * (hi - lo) + 1e-12,
+                "gene {g}: {b} -> {a}"
+            );
+        }
+        // a gene near an end is reflected back in, never stuck at the end
+        let mut genes = vec![r.tau.1; l.len()];
+        mutate(
+            l,
+            &r,
+            &mut genes,
+            1.0,
+            Mutation::Creep { scale: 1.0 },
+            &mut s,
+        );
+        for (g, a) in genes.iter().enumerate() {
+            let (lo, hi) = gene_range(l, &r, g);
+            assert!(lo <= *a && *a <= hi, "gene {g} = {a}");
+        }
+    }
+
+    #[test]
+    fn reflection_folds_into_the_range() {
+        assert_eq!(reflect(11.0, 0.0, 10.0), 9.0);
+        assert_eq!(reflect(-3.0, 0.0, 10.0), 3.0);
+        assert_eq!(reflect(25.0, 0.0, 10.0), 5.0);
+        assert_eq!(reflect(-15.0, 0.0, 10.0), 5.0);
+        assert_eq!(reflect(4.0, 0.0, 10.0), 4.0);
     }
 
     fn layout_and_genes() -> impl Strategy<Value = (Layout, Vec<f64>)> {

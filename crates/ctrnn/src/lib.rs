@@ -34,7 +34,7 @@ pub use evolve::{Evolution, Fill, Stats, Task};
 pub use ga::{GaConfig, Selection};
 pub use genome::{Layout, Ranges};
 pub use integrate::{Integrator, Lanes, Method, LANES};
-pub use network::{compose, Network};
+pub use network::{compose, compose_with, Network};
 pub use population::{Block, Inputs, Population};
 pub use rng::{Purpose, Stream};
 pub use validation::Validation;

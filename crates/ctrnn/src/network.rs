@@ -12,6 +12,7 @@
 
 use crate::error::{check_finite, Error, Result};
 use crate::math::sigmoid;
+use crate::rng::Stream;
 
 /// A network of `size` neurons and `n_inputs` sensors, always valid once constructed.
 #[derive(Clone, Debug, PartialEq)]
@@ -167,7 +168,8 @@ fn expect_len(field: &str, got: usize, want: usize, shape: &str) -> Result<()> {
 ///
 /// `a`'s neurons come first, so `a`'s neuron 0 stays neuron 0 (the output); `b`'s neuron j becomes
 /// neuron `a.size() + j`. Every sensor feeds both parts as before. The cross weights between the
-/// parts start at 0, so the composite first behaves exactly like its two parts side by side.
+/// parts start at 0, so the composite first behaves exactly like its two parts side by side;
+/// [`compose_with`] draws them instead.
 ///
 /// # Example
 /// ```
@@ -178,6 +180,44 @@ fn expect_len(field: &str, got: usize, want: usize, shape: &str) -> Result<()> {
 /// assert_eq!(ab.weights(), &[2.0, 0.0, 0.0, -2.0]);
 /// ```
 pub fn compose(a: &Network, b: &Network) -> Result<Network> {
+    join(a, b, || 0.0)
+}
+
+/// [`compose`], with each cross weight (from a neuron of one part to a neuron of the other)
+/// drawn uniformly in `[-cross_scale, cross_scale]` from `stream`, in row-major order. With
+/// `cross_scale = 0` nothing is drawn and the cross weights are 0.
+///
+/// # Example
+/// ```
+/// use ctrnn::{compose_with, Network};
+/// use ctrnn::rng::{Purpose, Stream};
+/// let a = Network::new(vec![1.0], vec![0.0], vec![2.0], vec![1.0], None).unwrap();
+/// let b = Network::new(vec![3.0], vec![1.0], vec![-2.0], vec![0.5], None).unwrap();
+/// let mut stream = Stream::new(7, 0, Purpose::Seeding, 0, 1);
+/// let ab = compose_with(&a, &b, 1.0, &mut stream).unwrap();
+/// let w = ab.weights();
+/// assert_eq!((w[0], w[3]), (2.0, -2.0));
+/// assert!(w[1] != 0.0 && w[1].abs() <= 1.0 && w[2].abs() <= 1.0);
+/// ```
+pub fn compose_with(
+    a: &Network,
+    b: &Network,
+    cross_scale: f64,
+    stream: &mut Stream,
+) -> Result<Network> {
+    if !(cross_scale.is_finite() && cross_scale >= 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "cross_scale is {cross_scale}; it must be a finite number >= 0"
+        )));
+    }
+    if cross_scale == 0.0 {
+        return compose(a, b);
+    }
+    join(a, b, || stream.range(-cross_scale, cross_scale))
+}
+
+/// `a` and `b` side by side, each cross weight (row-major) taken from `cross`.
+fn join(a: &Network, b: &Network, mut cross: impl FnMut() -> f64) -> Result<Network> {
     if a.n_inputs != b.n_inputs {
         return Err(Error::InvalidNetwork(format!(
             "cannot compose networks with {} and {} inputs; both must have the same M",
@@ -185,12 +225,15 @@ pub fn compose(a: &Network, b: &Network) -> Result<Network> {
         )));
     }
     let n = a.size + b.size;
+    let in_a = |k: usize| k < a.size;
     let mut weights = vec![0.0; n * n];
-    for (part, offset) in [(a, 0), (b, a.size)] {
-        for i in 0..part.size {
-            let row = &part.weights[i * part.size..(i + 1) * part.size];
-            let start = (offset + i) * n + offset;
-            weights[start..start + part.size].copy_from_slice(row);
+    for i in 0..n {
+        for j in 0..n {
+            weights[i * n + j] = match (in_a(i), in_a(j)) {
+                (true, true) => a.weights[i * a.size + j],
+                (false, false) => b.weights[(i - a.size) * b.size + (j - a.size)],
+                _ => cross(),
+            };
         }
     }
     let cat = |x: &[f64], y: &[f64]| [x, y].concat();
@@ -321,5 +364,35 @@ mod tests {
         assert_eq!(&ab.sensor_weights()[6..], &[8.0, 9.0, 10.0]);
         let c = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
         assert!(compose(&a, &c).unwrap_err().to_string().contains("same M"));
+    }
+
+    #[test]
+    fn compose_with_draws_only_the_cross_weights() {
+        use crate::rng::Purpose;
+        let a = net2();
+        let b = Network::new(vec![5.0], vec![-1.0], vec![7.0], vec![8.0, 9.0, 10.0], None).unwrap();
+        let stream = || Stream::new(3, 0, Purpose::Seeding, 0, 1);
+        let ab = compose_with(&a, &b, 2.0, &mut stream()).unwrap();
+        let w = ab.weights();
+        // a's block and b's block are unchanged; the four cross weights are in [-2, 2], not 0.
+        assert_eq!((w[0], w[1], w[3], w[4], w[8]), (1.0, 2.0, 3.0, 4.0, 7.0));
+        let cross = [w[2], w[5], w[6], w[7]];
+        assert!(
+            cross.iter().all(|x| *x != 0.0 && x.abs() <= 2.0),
+            "{cross:?}"
+        );
+        // drawn in row-major order from the stream
+        let mut s = stream();
+        let expected: Vec<f64> = (0..4).map(|_| s.range(-2.0, 2.0)).collect();
+        assert_eq!(cross.to_vec(), expected);
+        // scale 0 is compose; a bad scale is an error
+        assert_eq!(
+            compose_with(&a, &b, 0.0, &mut stream()).unwrap(),
+            compose(&a, &b).unwrap()
+        );
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let e = compose_with(&a, &b, bad, &mut stream()).unwrap_err();
+            assert!(e.to_string().contains("cross_scale is"), "{e}");
+        }
     }
 }

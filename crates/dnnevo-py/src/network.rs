@@ -480,11 +480,23 @@ impl PyTrace {
     }
 }
 
-/// The fully interconnected network of `a` then `b`, cross weights 0 (paper §5.3).
+/// The fully interconnected network of `a` then `b` (paper §5.3). The cross weights are 0, or,
+/// with `cross_scale > 0`, each drawn uniformly in [-cross_scale, cross_scale] from the seeding
+/// stream `(seed, 0, Seeding, member, 1)`, so each member of a seeded population gets its own.
 #[pyfunction]
-pub fn compose(a: &PyNetwork, b: &PyNetwork) -> PyResult<PyNetwork> {
+#[pyo3(signature = (a, b, *, cross_scale=0.0, seed=AnyInt::from(0), member=AnyInt::from(0)), text_signature = "(a, b, *, cross_scale=0.0, seed=0, member=0)")]
+pub fn compose(
+    a: &PyNetwork,
+    b: &PyNetwork,
+    cross_scale: f64,
+    seed: AnyInt,
+    member: AnyInt,
+) -> PyResult<PyNetwork> {
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+    let member: u64 = member.to("member", "[0, 2**64)")?;
+    let mut stream = Stream::new(seed, 0, Purpose::Seeding, member, 1);
     Ok(PyNetwork::from_core(
-        ctrnn::compose(&a.inner, &b.inner).py_err()?,
+        ctrnn::compose_with(&a.inner, &b.inner, cross_scale, &mut stream).py_err()?,
     ))
 }
 

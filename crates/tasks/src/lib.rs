@@ -23,6 +23,6 @@ pub mod sequence;
 pub use common::MAX_COUNT;
 pub use registry::{build, names};
 pub use sequence::{
-    performance, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask, TargetReport,
-    TrialRecord,
+    performance, Aggregate, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask,
+    TargetReport, TrialRecord,
 };

@@ -32,7 +32,13 @@
 //! the mean of `P` over the trials. With `perf_base = "generation-mean"` the base is the mean of
 //! `mean_k R_k` over the whole generation (every individual and every trial), so one network's
 //! fitness depends on the whole batch it is scored with: score a generation in one call. If that
-//! mean is 1 (every network perfect) every fitness is 0.
+//! mean is 1 (every network perfect) every fitness is 0. With `perf_base = "target-mean"` each
+//! target has its own base, the generation's mean over that target's trials, so a target that the
+//! whole population fails still separates the networks that fail it least.
+//!
+//! With `aggregate = "min"` fitness is instead the worst target's score (each target's mean over
+//! its trials, clamped as `clamp` says), and with `"mean-min"` the mean of the two; the default
+//! `"mean"` is the paper's.
 //!
 //! Note that clamping per trial rewards a constant output: on B = {0*, 1*} with base 0.5, a
 //! network whose output is always 0 scores 1 on the 0* trials and 0 on the 1* trials, so its
@@ -86,13 +92,17 @@ pub const SUCCESS_TRIALS: usize = 20;
 
 /// The base of the performance score.
 ///
-/// In JSON and TOML it is a number in [0, 1) or the string `"generation-mean"`.
+/// In JSON and TOML it is a number in [0, 1), or the string `"generation-mean"` or
+/// `"target-mean"`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PerfBase {
     /// A fixed base in [0, 1): 0.5 for one bit, 2/3 for three bits in the paper.
     Value(f64),
     /// The mean reinforcement of the whole generation being scored (the paper's two-bit runs).
     GenerationMean,
+    /// Per target: the mean reinforcement of the generation's trials of that target, so a
+    /// target the whole population fails still rewards whoever fails it least.
+    TargetMean,
 }
 
 impl Default for PerfBase {
@@ -103,12 +113,17 @@ impl Default for PerfBase {
 
 /// The string form of [`PerfBase::GenerationMean`].
 const GENERATION_MEAN: &str = "generation-mean";
+/// The string form of [`PerfBase::TargetMean`].
+const TARGET_MEAN: &str = "target-mean";
+/// What a perf_base may be, for error messages.
+const PERF_BASE_FORMS: &str = "a number in [0, 1) or \"generation-mean\" or \"target-mean\"";
 
 impl Serialize for PerfBase {
     fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
         match self {
             PerfBase::Value(v) => s.serialize_f64(*v),
             PerfBase::GenerationMean => s.serialize_str(GENERATION_MEAN),
+            PerfBase::TargetMean => s.serialize_str(TARGET_MEAN),
         }
     }
 }
@@ -119,7 +134,7 @@ impl<'de> Deserialize<'de> for PerfBase {
         impl serde::de::Visitor<'_> for Visitor {
             type Value = PerfBase;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                write!(f, "a number in [0, 1) or the string \"{GENERATION_MEAN}\"")
+                f.write_str(PERF_BASE_FORMS)
             }
             fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<PerfBase, E> {
                 Ok(PerfBase::Value(v))
@@ -131,10 +146,10 @@ impl<'de> Deserialize<'de> for PerfBase {
                 Ok(PerfBase::Value(v as f64))
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<PerfBase, E> {
-                if v == GENERATION_MEAN {
-                    Ok(PerfBase::GenerationMean)
-                } else {
-                    Err(E::invalid_value(serde::de::Unexpected::Str(v), &self))
+                match v {
+                    GENERATION_MEAN => Ok(PerfBase::GenerationMean),
+                    TARGET_MEAN => Ok(PerfBase::TargetMean),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)),
                 }
             }
         }
@@ -153,6 +168,20 @@ pub enum Clamp {
     /// Once, on the mean of the trials' unclamped scores, so that failing one target cancels
     /// succeeding at another: any constant output scores 0 on B = {0*, 1*}.
     Evaluation,
+}
+
+/// How the scores of the targets make one fitness.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Aggregate {
+    /// The mean over all trials (every target has as many): the paper's.
+    #[default]
+    Mean,
+    /// The worst target's score (each target's score is the mean over its trials, clamped as
+    /// `clamp` says): a network is only as good as the target it learns least.
+    Min,
+    /// The mean of `mean` and `min`: rewards every target, and the weakest twice.
+    MeanMin,
 }
 
 /// The sequence-learning experiment's settings.
@@ -178,10 +207,13 @@ pub struct SequenceConfig {
     /// Gap between a reinforcement and the next trigger, inclusive range in time steps.
     /// Default (10, 40).
     pub gap: (usize, usize),
-    /// Base of the performance score: a number in [0, 1) or `"generation-mean"`. Default 0.5.
+    /// Base of the performance score: a number in [0, 1), `"generation-mean"` or
+    /// `"target-mean"`. Default 0.5.
     pub perf_base: PerfBase,
     /// Where the performance score is clamped at 0. Default `"trial"`.
     pub clamp: Clamp,
+    /// How the targets' scores make one fitness. Default `"mean"`.
+    pub aggregate: Aggregate,
     /// How one time step is integrated; `dt * substeps` is the length of a time step in units of
     /// simulated time. Default 10 Euler steps of dt = 0.1.
     pub integrator: Integrator,
@@ -206,6 +238,7 @@ impl Default for SequenceConfig {
             gap: (10, 40),
             perf_base: PerfBase::default(),
             clamp: Clamp::Trial,
+            aggregate: Aggregate::Mean,
             integrator: Integrator {
                 method: Method::Euler,
                 dt: 0.1,
@@ -261,9 +294,7 @@ impl SequenceConfig {
         }
         if let PerfBase::Value(b) = self.perf_base {
             if !(0.0..1.0).contains(&b) {
-                return config(format!(
-                    "perf_base is {b}; it must be a number in [0, 1) or \"{GENERATION_MEAN}\""
-                ));
+                return config(format!("perf_base is {b}; it must be {PERF_BASE_FORMS}"));
             }
         }
         self.integrator.validate().map_err(|e| match e {
@@ -339,8 +370,8 @@ pub struct Scores {
     pub r: Vec<f64>,
     /// `mean_k R_k` of every network and trial, row-major `P x trials`.
     pub mean_r: Vec<f64>,
-    /// The performance base that was used.
-    pub base: f64,
+    /// The performance base that was used for each target.
+    pub base: Vec<f64>,
     /// Fitness of every network: the mean of its trials' performance.
     pub fitness: Vec<f64>,
 }
@@ -380,10 +411,15 @@ pub fn performance(rs: &[f64], base: f64) -> f64 {
 
 /// `max(0, (mean_r - base) / (1 - base))`, 0 when `base >= 1`.
 fn score(mean_r: f64, base: f64) -> f64 {
+    unclamped_score(mean_r, base).max(0.0)
+}
+
+/// `(mean_r - base) / (1 - base)`, 0 when `base >= 1`.
+fn unclamped_score(mean_r: f64, base: f64) -> f64 {
     if base >= 1.0 {
         0.0
     } else {
-        ((mean_r - base) / (1.0 - base)).max(0.0)
+        (mean_r - base) / (1.0 - base)
     }
 }
 
@@ -632,7 +668,7 @@ impl SequenceTask {
                 triggers: k,
                 r: vec![],
                 mean_r: vec![],
-                base: self.fixed_base(),
+                base: vec![self.fixed_base(); config.targets.len()],
                 fitness: vec![],
             });
         }
@@ -684,18 +720,10 @@ impl SequenceTask {
             .collect::<Result<Vec<Vec<f64>>>>()?;
         let r = per_block.concat();
         let mean_r: Vec<f64> = r.chunks(k).map(mean).collect();
-        let base = match config.perf_base {
-            PerfBase::Value(b) => b,
-            PerfBase::GenerationMean => mean(&mean_r),
-        };
+        let base = self.bases(&mean_r);
         let fitness = mean_r
             .chunks(n_trials)
-            .map(|trials| match config.clamp {
-                Clamp::Trial => {
-                    trials.iter().map(|&m| score(m, base)).sum::<f64>() / n_trials as f64
-                }
-                Clamp::Evaluation => score(mean(trials), base),
-            })
+            .map(|trials| self.fitness(trials, &base))
             .collect();
         Ok(Scores {
             trials: n_trials,
@@ -707,11 +735,76 @@ impl SequenceTask {
         })
     }
 
-    /// The numeric base, or 0.5 in place of the generation mean when there is no generation.
+    /// The numeric base, or 0.5 in place of a generation's mean when there is no generation.
     fn fixed_base(&self) -> f64 {
         match self.config.perf_base {
             PerfBase::Value(b) => b,
-            PerfBase::GenerationMean => 0.5,
+            PerfBase::GenerationMean | PerfBase::TargetMean => 0.5,
+        }
+    }
+
+    /// The base of each target for a generation whose `mean_r` is `P x trials` row-major.
+    fn bases(&self, mean_r: &[f64]) -> Vec<f64> {
+        let targets = self.config.targets.len();
+        match self.config.perf_base {
+            PerfBase::Value(b) => vec![b; targets],
+            PerfBase::GenerationMean => vec![mean(mean_r); targets],
+            PerfBase::TargetMean => {
+                let (n_trials, per) = (self.config.n_trials(), self.config.trials_per_target);
+                (0..targets)
+                    .map(|j| {
+                        let of_target: Vec<f64> = mean_r
+                            .chunks(n_trials)
+                            .flat_map(|trials| &trials[j * per..(j + 1) * per])
+                            .copied()
+                            .collect();
+                        mean(&of_target)
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// One network's fitness from its trials' `mean_k R_k` (target-major) and each target's
+    /// base: see [`Clamp`] and [`Aggregate`].
+    fn fitness(&self, trials: &[f64], base: &[f64]) -> f64 {
+        let config = &self.config;
+        let per = config.trials_per_target;
+        let base_of = |t: usize| base[t / per];
+        // Kept in exactly the form of the paper's runs, so their fitness keeps its bits.
+        let overall = match config.clamp {
+            Clamp::Trial => {
+                trials
+                    .iter()
+                    .enumerate()
+                    .map(|(t, &m)| score(m, base_of(t)))
+                    .sum::<f64>()
+                    / trials.len() as f64
+            }
+            Clamp::Evaluation if base.iter().all(|&b| b == base[0]) => score(mean(trials), base[0]),
+            Clamp::Evaluation => {
+                let unclamped: Vec<f64> = trials
+                    .iter()
+                    .enumerate()
+                    .map(|(t, &m)| unclamped_score(m, base_of(t)))
+                    .collect();
+                mean(&unclamped).max(0.0)
+            }
+        };
+        if config.aggregate == Aggregate::Mean {
+            return overall;
+        }
+        let worst = trials
+            .chunks(per)
+            .zip(base)
+            .map(|(of_target, &b)| match config.clamp {
+                Clamp::Trial => of_target.iter().map(|&m| score(m, b)).sum::<f64>() / per as f64,
+                Clamp::Evaluation => score(mean(of_target), b),
+            })
+            .fold(f64::INFINITY, f64::min);
+        match config.aggregate {
+            Aggregate::Min => worst,
+            Aggregate::MeanMin | Aggregate::Mean => 0.5 * (overall + worst),
         }
     }
 
@@ -804,7 +897,7 @@ impl SequenceTask {
     /// [`assessment_timings(seed, t)`](Self::assessment_timings). Trials run [`LANES`] at a time in
     /// parallel; each gives the same R values as [`run_trial`](Self::run_trial).
     ///
-    /// Performance uses the numeric `perf_base`, or 0.5 when it is `"generation-mean"`.
+    /// Performance uses the numeric `perf_base`, or 0.5 when it is a generation's mean.
     /// Every target must have more triggers than its warm-up, or nothing would be judged.
     pub fn assess(&self, net: &Network, trials_per_target: usize, seed: u64) -> Result<Assessment> {
         let judged = self.judge(&[net], trials_per_target, seed, Purpose::Evaluate, None)?;
@@ -1241,8 +1334,8 @@ mod tests {
         let nets = [constant(100.0), quarter.clone(), constant(-100.0)];
         let s = t.scores(&nets, 0, 1, None).unwrap();
         assert!((s.mean_r[2] - 0.75).abs() < 1e-12);
-        assert!((s.base - 1.75 / 3.0).abs() < 1e-12, "{}", s.base);
-        assert_eq!(s.base, mean(&s.mean_r));
+        assert!((s.base[0] - 1.75 / 3.0).abs() < 1e-12, "{:?}", s.base);
+        assert_eq!(s.base, vec![mean(&s.mean_r)]);
         let want = [1.0, 0.4, 0.0];
         for (f, w) in s.fitness.iter().zip(want) {
             assert!((f - w).abs() < 1e-12, "{:?}", s.fitness);
@@ -1253,6 +1346,98 @@ mod tests {
         // A generation of perfect networks has nothing to beat: fitness 0, not NaN.
         let s = t.scores(&[constant(100.0)], 0, 1, None).unwrap();
         assert_eq!(s.fitness, vec![0.0]);
+    }
+
+    #[test]
+    fn target_mean_base_is_each_targets_generation_mean() {
+        let config = SequenceConfig {
+            triggers: 3,
+            perf_base: PerfBase::TargetMean,
+            ..SequenceConfig::default()
+        };
+        // Outputs 0, 0.25 and 1: mean R 1, 0.75 and 0 on 0*, and 0, 0.25 and 1 on 1*.
+        let nets = [constant(100.0), constant(3f64.ln()), constant(-100.0)];
+        let s = task(config.clone()).scores(&nets, 0, 1, None).unwrap();
+        let (b0, b1) = (1.75 / 3.0, 1.25 / 3.0);
+        assert!((s.base[0] - b0).abs() < 1e-12 && (s.base[1] - b1).abs() < 1e-12);
+        let p = |r: f64, b: f64| (r - b) / (1.0 - b);
+        let close = |got: &[f64], want: &[f64]| {
+            assert!(
+                got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-12),
+                "{got:?} != {want:?}"
+            )
+        };
+        // Per trial, clamped: always-0 earns 1 on its two 0* trials, 0 on its 1* trials.
+        close(&s.fitness, &[0.5, p(0.75, b0) / 2.0, p(1.0, b1) / 2.0]);
+        // Clamped once: the failed target costs what it falls below its own base.
+        let once = task(SequenceConfig {
+            clamp: Clamp::Evaluation,
+            ..config.clone()
+        })
+        .scores(&nets, 0, 1, None)
+        .unwrap();
+        let mean2 = |a: f64, b: f64| (2.0 * a + 2.0 * b) / 4.0;
+        close(
+            &once.fitness,
+            &[
+                mean2(1.0, p(0.0, b1)),
+                mean2(p(0.75, b0), p(0.25, b1)),
+                mean2(p(0.0, b0), 1.0),
+            ]
+            .map(|x| x.max(0.0)),
+        );
+    }
+
+    #[test]
+    fn min_and_mean_min_aggregates_judge_the_weakest_target() {
+        let nets = [
+            constant(100.0),
+            constant(3f64.ln()),
+            Network::new(vec![1.0], vec![0.5], vec![2.0], vec![3.0, -4.0], None).unwrap(),
+        ];
+        let config = SequenceConfig {
+            triggers: 4,
+            ..SequenceConfig::default()
+        };
+        let mean = task(config.clone()).scores(&nets, 0, 1, None).unwrap();
+        for clamp in [Clamp::Trial, Clamp::Evaluation] {
+            let with = |aggregate| {
+                task(SequenceConfig {
+                    aggregate,
+                    clamp,
+                    ..config.clone()
+                })
+                .scores(&nets, 0, 1, None)
+                .unwrap()
+            };
+            let (min, both) = (with(Aggregate::Min), with(Aggregate::MeanMin));
+            let overall = with(Aggregate::Mean);
+            for i in 0..nets.len() {
+                // Each target's score from the trials' mean R, by hand.
+                let trials = &mean.mean_r[i * 4..(i + 1) * 4];
+                let target = |j: usize| {
+                    let (a, b) = (trials[2 * j], trials[2 * j + 1]);
+                    match clamp {
+                        Clamp::Trial => (score(a, 0.5) + score(b, 0.5)) / 2.0,
+                        Clamp::Evaluation => score((a + b) / 2.0, 0.5),
+                    }
+                };
+                let worst = target(0).min(target(1));
+                assert_eq!(min.fitness[i], worst, "network {i}, {clamp:?}");
+                assert_eq!(both.fitness[i], 0.5 * (overall.fitness[i] + worst));
+            }
+        }
+        // Always 0 is perfect on 0* and worthless on 1*: the minimum gives it nothing.
+        assert_eq!(
+            task(SequenceConfig {
+                aggregate: Aggregate::Min,
+                ..config.clone()
+            })
+            .scores(&nets[..1], 0, 1, None)
+            .unwrap()
+            .fitness,
+            vec![0.0]
+        );
     }
 
     #[test]
@@ -1439,12 +1624,28 @@ mod tests {
         assert_eq!(back, c);
         let c = SequenceConfig::from_params(&serde_json::json!({"perf_base": 0})).unwrap();
         assert_eq!(c.perf_base, PerfBase::Value(0.0));
+        let c = SequenceConfig::from_params(
+            &serde_json::json!({"perf_base": "target-mean", "aggregate": "mean-min"}),
+        )
+        .unwrap();
+        assert_eq!(
+            (c.perf_base, c.aggregate),
+            (PerfBase::TargetMean, Aggregate::MeanMin)
+        );
+        let text = serde_json::to_string(&c).unwrap();
+        assert!(
+            text.contains("\"perf_base\":\"target-mean\"") && text.contains("\"mean-min\""),
+            "{text}"
+        );
         let err = |v: serde_json::Value| SequenceConfig::from_params(&v).unwrap_err().to_string();
         let e = err(serde_json::json!({"perf_base": "mean"}));
         assert!(
             e.contains("generation-mean") && e.contains("\"mean\""),
             "{e}"
         );
+        assert!(e.contains("target-mean"), "{e}");
+        let e = err(serde_json::json!({"aggregate": "median"}));
+        assert!(e.contains("unknown variant `median`"), "{e}");
         let e = err(serde_json::json!({"perf_base": 2.5}));
         assert!(e.contains("perf_base is 2.5"), "{e}");
         let e = err(serde_json::json!({"trigers": 3}));

@@ -10,6 +10,7 @@ import numpy.typing as npt
 __all__ = [
     "LANES",
     "MAX_COUNT",
+    "RETRY_STARTS",
     "Evolution",
     "Network",
     "Trace",
@@ -44,6 +45,7 @@ __all__ = [
 __version__: str
 LANES: int
 MAX_COUNT: int
+RETRY_STARTS: int
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]
@@ -234,6 +236,7 @@ def analysis_equilibria(
     distinct: float = 1e-06,
     max_iterations: int = 100,
     seed: int = 0,
+    retry_starts: int | None = None,
 ) -> str: ...
 def analysis_cycles(
     net: Network,
@@ -262,4 +265,5 @@ def analysis_bifurcation(
     max_iterations: int = 100,
     seed: int = 0,
     cycle_starts: int = 0,
+    retry_starts: int | None = None,
 ) -> str: ...

@@ -53,6 +53,7 @@ mod _core {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("LANES", ctrnn::LANES)?;
         m.add("MAX_COUNT", tasks::MAX_COUNT)?;
+        m.add("RETRY_STARTS", ctrnn::analysis::RETRY_STARTS)?;
         Ok(())
     }
 }

@@ -101,8 +101,8 @@ def analyze(args: argparse.Namespace) -> int:
     """``dnnevo analyze``."""
     started = time.perf_counter()
     run = RunDir(args.dir)
-    config, table = run.read_config()
-    net = run.read_best(config, table)
+    config, raw = run.read_config()
+    net = run.read_best(config, raw)
     m = net.n_inputs
     if config.task not in TASK_INPUTS:
         raise ConfigError(f"task {config.task!r} has no analysis defaults; tasks with one: {', '.join(TASK_INPUTS)}")

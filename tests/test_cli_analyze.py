@@ -16,7 +16,8 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.rundir import RunDir
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
-PRESETS = ("sequence-1bit", "nav1d-classifier", "landmark")
+PRESETS = ("sequence-1bit", "nav1d-classifier", "nav1d-single", "landmark")
+"""One preset per task family; nav1d-single is the multi-trial nav1d system (8 neurons)."""
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +49,7 @@ def test_analyze_writes_json_and_figures(runs: dict[str, Path], preset: str) -> 
             assert np.max(np.abs(rate * net.tau)) < 1e-9
             assert e["stability"] in analysis.STABILITIES
     assert len(doc["bifurcation"]["values"]) == 21
+    assert {"branches", "cycle_branch", "retried", "even"} <= doc["bifurcation"].keys()
     assert len(doc["lesions"]["lesions"]) == net.size + 2
     i, j = doc["neurons"]
     assert i != j

@@ -27,7 +27,8 @@ With the sensors held at each --input vector (default: all off, then each of the
 on alone), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
 saddle, unstable) and attracting limit cycles are found and printed. --sweep varies one input
 (default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
-points (H: a cycle is born); --sweep-cycles also finds the cycles along it. Lesions clamp each
+points (H: a cycle is born); --sweep-cycles also follows the attracting cycles along it,
+each branch from where it appears to where it vanishes. Lesions clamp each
 neuron at its mean firing rate over real trials, and cut the N strongest connections, then judge
 the champion on the same fresh trials as 'dnnevo evaluate'. See docs/analysis.md. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
 two neurons, those that vary most unless --neurons, with a real trial, equilibria by stability, cycles,
@@ -266,12 +267,17 @@ def event_texts(events: list[analysis.Event]) -> list[str]:
     return texts
 
 
-def _end_text(end: analysis.CycleEnd | None, edge: str) -> str:
+def _end_text(end: analysis.CycleEnd | None, edge: str, events: list[analysis.Event]) -> str:
+    """A cycle branch's end; a lost one names the folds between its two swept values (a cycle
+    that is lost at a fold of equilibria may end on a saddle-node on the cycle)."""
     if end is None:
         return edge
     if end.kind == "hopf":
         return f"a Hopf point at {end.value:.4g}"
-    return f"{end.value:.4g} (lost between {end.with_cycle:g} and {end.without_cycle:g})"
+    lo, hi = sorted((end.with_cycle, end.without_cycle))
+    folds = [e.value for e in events if e.kind == "fold" and lo <= e.value <= hi]
+    there = f"; fold{'s' * (len(folds) > 1)} at {', '.join(f'{v:.4g}' for v in folds)} there" if folds else ""
+    return f"{end.value:.4g} (lost between {end.with_cycle:g} and {end.without_cycle:g}{there})"
 
 
 def _eq_line(e: analysis.Equilibrium) -> str:
@@ -307,8 +313,8 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
         lines.append(f"    (the count stays even at {len(bif.even)} value{'s' * (len(bif.even) != 1)} ({shown}): "
                      "equilibria were missed there, see docs/analysis.md)")
     for b in bif.branches:
-        lines.append(f"    cycle branch {b.id}: from {_end_text(b.start, 'the sweep start')} "
-                     f"to {_end_text(b.end, 'the sweep end')}")
+        lines.append(f"    cycle branch {b.id}: from {_end_text(b.start, 'the sweep start', bif.events)} "
+                     f"to {_end_text(b.end, 'the sweep end', bif.events)}")
     if basins is not None:
         every, which = basins
         shares = ", ".join(f"{chr(65 + k)} {np.mean(which == k):.0%}" for k in range(int(which.max(initial=-1)) + 1))

@@ -652,10 +652,14 @@ fn three_bit_champion() -> Network {
 
 #[test]
 fn the_3bit_champions_two_folds_near_0_4374_are_two_pairs() {
-    // Its reinforcement sweep reports "fold at 0.4374" twice: 11 equilibria at 0.43, 7 at 0.44.
+    // Its reinforcement sweep (0 to 1 in 101 values) reports "fold at 0.4374" twice: 11
+    // equilibria at 0.43, 7 at 0.44. The same two values, 11 apart here.
     let net = three_bit_champion();
     let sweep = Sweep {
         input: 1,
+        from: 0.43,
+        to: 0.44,
+        steps: 11,
         ..Sweep::default()
     };
     let b = bifurcation(&net, &[0.0, 0.0], &sweep, None).unwrap();
@@ -673,13 +677,9 @@ fn the_3bit_champions_two_folds_near_0_4374_are_two_pairs() {
     assert!(apart > 1.0, "the two folds are {apart} apart");
     // Each is a pair of its own: just before it two equilibria lie near its state, just after
     // it none.
-    let many = EquilibriumSearch {
-        starts: 2048,
-        ..EquilibriumSearch::default()
-    };
     for e in near {
         let around = |p: f64| {
-            equilibria(&net, &[0.0, p], &many)
+            equilibria(&net, &[0.0, p], &EquilibriumSearch::default())
                 .unwrap()
                 .iter()
                 .filter(|q| {

@@ -267,17 +267,21 @@ def event_texts(events: list[analysis.Event]) -> list[str]:
     return texts
 
 
-def _end_text(end: analysis.CycleEnd | None, edge: str, events: list[analysis.Event]) -> str:
-    """A cycle branch's end; a lost one names the folds between its two swept values (a cycle
-    that is lost at a fold of equilibria may end on a saddle-node on the cycle)."""
+def _end_text(end: analysis.CycleEnd | None, edge: str, events: list[analysis.Event],
+              period: float | None = None) -> str:
+    """A cycle branch's end, with the period there (and ``period``, the one at the nearest swept
+    value); a lost one names the folds between its two swept values (a cycle lost at a fold of
+    equilibria, its period growing, may end on a saddle-node on the cycle)."""
     if end is None:
         return edge
     if end.kind == "hopf":
-        return f"a Hopf point at {end.value:.4g}"
+        return f"a Hopf point at {end.value:.4g} (period {end.period:.3g})"
     lo, hi = sorted((end.with_cycle, end.without_cycle))
     folds = [e.value for e in events if e.kind == "fold" and lo <= e.value <= hi]
     there = f"; fold{'s' * (len(folds) > 1)} at {', '.join(f'{v:.4g}' for v in folds)} there" if folds else ""
-    return f"{end.value:.4g} (lost between {end.with_cycle:g} and {end.without_cycle:g}{there})"
+    was = f", {period:.3g} at {end.with_cycle:g}" if period is not None else ""
+    return (f"{end.value:.4g} (lost between {end.with_cycle:g} and {end.without_cycle:g}{there}; "
+            f"period {end.period:.3g} there{was})")
 
 
 def _eq_line(e: analysis.Equilibrium) -> str:
@@ -313,8 +317,9 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
         lines.append(f"    (the count stays even at {len(bif.even)} value{'s' * (len(bif.even) != 1)} ({shown}): "
                      "equilibria were missed there, see docs/analysis.md)")
     for b in bif.branches:
-        lines.append(f"    cycle branch {b.id}: from {_end_text(b.start, 'the sweep start', bif.events)} "
-                     f"to {_end_text(b.end, 'the sweep end', bif.events)}")
+        first, last = (bif.cycles[s][bif.cycle_branch[s].index(b.id)].period for s in (b.first, b.last))
+        lines.append(f"    cycle branch {b.id}: from {_end_text(b.start, 'the sweep start', bif.events, first)} "
+                     f"to {_end_text(b.end, 'the sweep end', bif.events, last)}")
     if basins is not None:
         every, which = basins
         shares = ", ".join(f"{chr(65 + k)} {np.mean(which == k):.0%}" for k in range(int(which.max(initial=-1)) + 1))

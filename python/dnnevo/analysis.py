@@ -208,18 +208,24 @@ class CycleEnd:
     """The swept value next to the end where the cycle was found."""
     without_cycle: float
     """The swept value next to the end, on the other side, where it was not."""
+    period: float
+    """The period at the end: ``2 pi / omega`` of a Hopf point's eigenvalues ``±i omega``, or the
+    last cycle the bisection found. A lost cycle whose period grows towards its end ends at a
+    homoclinic orbit or a saddle-node on the cycle; one whose period stays finite, at a fold of
+    cycles."""
 
     def to_dict(self) -> dict[str, Any]:
         """As plain JSON types."""
         return {"kind": self.kind, "value": self.value, "with_cycle": self.with_cycle,
-                "without_cycle": self.without_cycle}
+                "without_cycle": self.without_cycle, "period": self.period}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any] | None) -> CycleEnd | None:
         """From the JSON form the Rust core returns (None stays None)."""
         if d is None:
             return None
-        return cls(d["kind"], float(d["value"]), float(d["with_cycle"]), float(d["without_cycle"]))
+        return cls(d["kind"], float(d["value"]), float(d["with_cycle"]), float(d["without_cycle"]),
+                   float(d["period"]))
 
 
 @dataclass(frozen=True)

@@ -55,6 +55,11 @@ pub struct CycleEnd {
     pub with_cycle: f64,
     /// The swept value next to the end, on the other side, where it was not.
     pub without_cycle: f64,
+    /// The cycle's period at the end: `2 pi / omega` of the Hopf point's eigenvalues `±i omega`
+    /// (the limit of a vanishing cycle's period), or the last cycle found by the bisection. A
+    /// lost cycle whose period grows towards its end is ending at a homoclinic orbit or a
+    /// saddle-node on the cycle; one whose period stays finite, at a fold of cycles.
+    pub period: f64,
 }
 
 /// One attracting cycle followed across consecutive swept values.
@@ -201,6 +206,7 @@ pub(crate) fn locate(
                 value: e.value,
                 with_cycle,
                 without_cycle,
+                period: 2.0 * std::f64::consts::PI / e.eigenvalue[1],
             });
         }
     }
@@ -220,5 +226,6 @@ pub(crate) fn locate(
         value: good,
         with_cycle,
         without_cycle,
+        period: last.period,
     })
 }

@@ -509,6 +509,11 @@ fn a_cycle_branch_ends_at_the_closed_form_hopf_point() {
         assert_eq!(end.kind, CycleEndKind::Hopf);
         assert!((end.value - 1.0).abs() < 1e-6, "{end:?}");
         assert!(end.with_cycle < 1.0 && end.with_cycle > 0.8, "{end:?}");
+        // The vanishing cycle's period: 2 pi / omega with omega = b / a = 0.8.
+        assert!(
+            (end.period - 2.0 * std::f64::consts::PI / 0.8).abs() < 1e-6,
+            "{end:?}"
+        );
     }
 }
 
@@ -535,6 +540,7 @@ fn a_cycle_branch_is_followed_and_one_lost_is_located_by_bisection() {
     .unwrap();
     assert_eq!(end.kind, CycleEndKind::Lost);
     assert!(last < end.value && end.value < 1.0, "{end:?}");
+    assert!(end.period > 7.0 && end.period < 9.0, "{end:?}");
 }
 
 /// Two uncoupled self-exciting neurons (w = 8, theta = 4), the input driving neuron 0 only:

@@ -484,8 +484,9 @@ class LesionTable:
 
 def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -> list[tuple[_Array, _Array]]:
     """Real trials of ``config``'s task drawn from ``seed``, each as (firing rates (T, N), inputs
-    (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain of 2
-    trials (nav1d)."""
+    (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain
+    (nav1d) of the task's chain length (:func:`dnnevo.nav1d.chain_len`: 5 trials for nav1d-single,
+    whose network learns its environment in trial 1), at least 2."""
     nonnegative("seed", seed)
     out: list[tuple[_Array, _Array]] = []
     if config.task == "sequence":
@@ -503,7 +504,7 @@ def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -
     elif config.task == "nav1d":
         from dnnevo import nav1d
 
-        chain = nav1d.fresh_chains(config, 1, 2, seed)[0]
+        chain = nav1d.fresh_chains(config, 1, max(2, nav1d.chain_len(config)), seed)[0]
         nr = nav1d.record(config, net, chain)
         out.append((nr.outputs, np.column_stack([nr.landmark, nr.reinforcement][: net.n_inputs])))
     else:

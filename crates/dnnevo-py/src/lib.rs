@@ -38,7 +38,7 @@ mod _core {
     };
     #[pymodule_export]
     use super::nav1d::{
-        nav1d_assess, nav1d_chains, nav1d_exact, nav1d_fresh_chains, nav1d_record,
+        nav1d_assess, nav1d_chain_len, nav1d_chains, nav1d_exact, nav1d_fresh_chains, nav1d_record,
         nav1d_system_assess, nav1d_system_record,
     };
     #[pymodule_export]

@@ -700,3 +700,24 @@ fn the_3bit_champions_two_folds_near_0_4374_are_two_pairs() {
         assert_eq!(around(e.value + 1e-6), 0, "after the fold at {}", e.value);
     }
 }
+
+#[test]
+fn two_branches_reaching_one_cycle_leave_it_to_the_closer() {
+    use super::branches::{continues, orbit_gap, Here};
+    let net = centre_pair(5.5, 2.0, 1.0);
+    let c = limit_cycles(&net, &[0.0], &CycleSearch::default(), None).unwrap()[0].clone();
+    assert!(orbit_gap(&c, &c) == 0.0 && continues(&c, &c));
+    let mut here = Here { cycles: Vec::new() };
+    here.continued(c.clone(), 0, 0.5);
+    here.continued(c.clone(), 1, 0.1);
+    here.continued(c.clone(), 2, 0.3);
+    here.fresh(c.clone());
+    assert_eq!(here.cycles.len(), 1);
+    assert_eq!(here.cycles[0].1, Some(1));
+    // A cycle far from another (shifted by more than both sizes) does not continue it.
+    let mut far = c.clone();
+    for p in &mut far.orbit {
+        p[0] += 10.0;
+    }
+    assert!(!continues(&c, &far));
+}

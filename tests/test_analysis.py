@@ -225,3 +225,83 @@ def test_a_sweep_with_cycles_brackets_them_by_its_hopf_points() -> None:
     assert c.stable and c.output_range.shape == (2, 2) and c.output_range[0, 0] < 0.5 < c.output_range[0, 1]
     assert b.to_dict()["cycles"][16][0]["period"] == c.period
     assert analysis.bifurcation(net, 0, -1.0, 1.0, steps=3).cycles == [[], [], []]
+
+
+def hopf_at_one(a: float = 5.0, b: float = 4.0) -> dnnevo.Network:
+    """The oscillator ``[[a, b], [-b, a]]`` with its Hopf point placed at input 1 in closed form:
+    at ``v = theta + (x, x)`` with ``f(x) (1 - f(x)) = 1/a`` the Jacobian is ``[[0, b/a], [-b/a,
+    0]]``, and these sensor weights make that state the equilibrium at input 1."""
+    p = (1 + math.sqrt(1 - 4 / a)) / 2
+    x, g = logit(p), p - 0.5
+    return dnnevo.Network(tau=[1.0, 1.0], theta=[(a + b) / 2, (a - b) / 2], weights=[[a, b], [-b, a]],
+                          sensor_weights=[[x - (a + b) * g], [x - (a - b) * g]])
+
+
+def test_a_cycle_branch_ends_at_the_closed_form_hopf_point(tmp_path: Path) -> None:
+    b = analysis.bifurcation(hopf_at_one(), 0, 0.0, 2.0, steps=24, cycle_starts=2)
+    assert len(b.branches) == 1
+    branch = b.branches[0]
+    assert branch.start is None and branch.end is not None
+    assert branch.end.kind == "hopf" and branch.end.value == pytest.approx(1.0, abs=1e-6)
+    assert all(row == [0] * len(c) for row, c in zip(b.cycle_branch, b.cycles, strict=True))
+    assert all(len(c) == 1 for v, c in zip(b.values, b.cycles, strict=True) if v < 0.9)
+    d = json.loads(json.dumps(b.to_dict()))
+    assert d["branches"][0]["end"]["kind"] == "hopf" and d["cycle_branch"][0] == [0]
+    back = analysis.bifurcation(hopf_at_one(), 0, 2.0, 0.0, steps=24, cycle_starts=2)
+    assert back.branches[0].end is None and back.branches[0].start is not None
+    assert back.branches[0].start.value == pytest.approx(1.0, abs=1e-6)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from dnnevo.plot import plot_bifurcation
+
+    fig, ax = plt.subplots()
+    assert plot_bifurcation(b, ax) is ax
+    labels = ax.get_legend_handles_labels()[1]
+    assert "cycle branch 0 (min, max)" in labels and "cycle ends at a Hopf point" in labels
+    fig.savefig(tmp_path / "bif.png")
+    plt.close(fig)
+
+
+def uncoupled_pair() -> dnnevo.Network:
+    """Two uncoupled self-exciting neurons (w = 8, theta = 4), the input driving neuron 0: 9
+    equilibria between neuron 0's folds, 3 outside."""
+    return dnnevo.Network(tau=[1.0, 1.0], theta=[4.0, 4.0], weights=[[8.0, 0.0], [0.0, 8.0]],
+                          sensor_weights=[[1.0], [0.0]])
+
+
+def test_an_even_count_is_searched_again_by_the_cores_rule() -> None:
+    net = uncoupled_pair()
+    assert analysis.RETRY_STARTS == _core.RETRY_STARTS == 8192
+    assert len(analysis.equilibria(net, [0.0], starts=2, retry_starts=0)) == 2
+    assert len(analysis.equilibria(net, [0.0], starts=2)) == 9
+    assert len(analysis.attractors(net, [0.0]).equilibria) == 9
+    lo, hi = bistable_interval(8.0)
+    b = analysis.bifurcation(net, 0, -4.0, 4.0, steps=41, starts=2)
+    assert b.retried and b.retried[0] == -4.0 and not b.even
+    assert [len(r) for r in b.equilibria] == [9 if 4 - hi < v < 4 - lo else 3 for v in b.values]
+    weak = analysis.bifurcation(net, 0, -4.0, 4.0, steps=41, starts=2, retry_starts=3)
+    assert weak.even and set(weak.even) <= set(weak.retried)
+    assert weak.to_dict()["even"] == weak.even
+    from dnnevo._cli_analyze import summary
+
+    lines = summary([analysis.attractors(net, [0.0])], weak, None, "input 0")
+    assert any("count stays even" in line for line in lines), lines
+    assert any("searched again with 8192 starts" in line for line in lines), lines
+    with pytest.raises(InvalidArgumentError, match="retry_starts"):
+        analysis.equilibria(net, [0.0], retry_starts=-1)
+
+
+def test_folds_at_one_value_are_told_apart_in_the_report() -> None:
+    """The seed-0 3-bit champion's reinforcement sweep has two folds at 0.4374 (two pairs: 11, 9
+    then 7 equilibria); the report must not read as one fold printed twice."""
+    net = dnnevo.Network.load(DATA / "sequence-3bit-seed0-champion.json")
+    b = analysis.bifurcation(net, 1, 0.0, 1.0, steps=101)
+    from dnnevo._cli_analyze import event_texts
+
+    texts = event_texts(b.events)
+    assert len(set(texts)) == len(texts), texts
+    near = [t for t in texts if t.startswith(("fold at 0.43735 ", "fold at 0.43743 "))]
+    assert len(near) == 2 and all("neuron" in t for t in near), near

@@ -16,7 +16,8 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.rundir import RunDir
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
-PRESETS = ("sequence-1bit", "nav1d-classifier", "landmark")
+PRESETS = ("sequence-1bit", "nav1d-classifier", "nav1d-single", "landmark")
+"""One preset per task family; nav1d-single is the multi-trial nav1d system (8 neurons)."""
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +49,7 @@ def test_analyze_writes_json_and_figures(runs: dict[str, Path], preset: str) -> 
             assert np.max(np.abs(rate * net.tau)) < 1e-9
             assert e["stability"] in analysis.STABILITIES
     assert len(doc["bifurcation"]["values"]) == 21
+    assert {"branches", "cycle_branch", "retried", "even"} <= doc["bifurcation"].keys()
     assert len(doc["lesions"]["lesions"]) == net.size + 2
     i, j = doc["neurons"]
     assert i != j
@@ -100,3 +102,20 @@ def test_analyze_errors(runs: dict[str, Path], tmp_path: Path) -> None:
 def test_analyze_help_has_an_example() -> None:
     r = run_cli("analyze", "--help")
     assert r.returncode == 0 and "dnnevo analyze runs/demo" in r.stdout
+
+
+def test_nav1d_single_records_a_whole_chain(runs: dict[str, Path]) -> None:
+    """nav1d-single's network learns its environment in trial 1 of a 5-trial chain and keeps its
+    state between trials: analyze records such a chain, not the 2 trials of the classifier."""
+    from dnnevo import nav1d
+
+    run = RunDir(runs["nav1d-single"])
+    config, raw = run.read_config()
+    net = run.read_best(config, raw)
+    assert nav1d.chain_len(config) == config.task_params["trials_per_environment"] == 5
+    (outputs, inputs), = analysis.recorded_trials(config, net, seed=0)
+    record = nav1d.record(config, net, nav1d.fresh_chains(config, 1, 5, 0)[0])
+    assert record.trial.max() == 4
+    assert np.array_equal(outputs, record.outputs) and inputs.shape == (len(outputs), 2)
+    classifier = RunDir(runs["nav1d-classifier"]).read_config()[0]
+    assert nav1d.chain_len(classifier) == 1

@@ -27,7 +27,8 @@ With the sensors held at each --input vector (default: all off, then each of the
 on alone), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
 saddle, unstable) and attracting limit cycles are found and printed. --sweep varies one input
 (default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
-points (H: a cycle is born); --sweep-cycles also finds the cycles along it. Lesions clamp each
+points (H: a cycle is born); --sweep-cycles also follows the attracting cycles along it,
+each branch from where it appears to where it vanishes. Lesions clamp each
 neuron at its mean firing rate over real trials, and cut the N strongest connections, then judge
 the champion on the same fresh trials as 'dnnevo evaluate'. See docs/analysis.md. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
 two neurons, those that vary most unless --neurons, with a real trial, equilibria by stability, cycles,
@@ -101,8 +102,8 @@ def analyze(args: argparse.Namespace) -> int:
     """``dnnevo analyze``."""
     started = time.perf_counter()
     run = RunDir(args.dir)
-    config, table = run.read_config()
-    net = run.read_best(config, table)
+    config, raw = run.read_config()
+    net = run.read_best(config, raw)
     m = net.n_inputs
     if config.task not in TASK_INPUTS:
         raise ConfigError(f"task {config.task!r} has no analysis defaults; tasks with one: {', '.join(TASK_INPUTS)}")
@@ -248,6 +249,41 @@ def _moving_neuron(bif: Bifurcation) -> int:
     return int(np.argmax(np.ptp(rates, axis=0)))
 
 
+def event_texts(events: list[analysis.Event]) -> list[str]:
+    """Each event as "fold at 0.4374"; events that would read the same get more digits and the
+    firing rate of the neuron that tells them apart (two folds at one value are two pairs)."""
+    texts = [f"{e.kind} at {e.value:.4g}" for e in events]
+    for text in set(texts):
+        group = [k for k, t in enumerate(texts) if t == text]
+        if len(group) < 2:
+            continue
+        digits = next((d for d in range(5, 13) if len({f"{events[k].value:.{d}g}" for k in group}) == len(group)), 12)
+        rates = np.array([events[k].outputs for k in group])
+        neuron = int(np.argmax(np.ptp(rates, axis=0))) if rates.size else None
+        for k in group:
+            e = events[k]
+            where = f" (neuron {neuron} at {e.outputs[neuron]:.2f})" if neuron is not None else ""
+            texts[k] = f"{e.kind} at {e.value:.{digits}g}{where}"
+    return texts
+
+
+def _end_text(end: analysis.CycleEnd | None, edge: str, events: list[analysis.Event],
+              period: float | None = None) -> str:
+    """A cycle branch's end, with the period there (and ``period``, the one at the nearest swept
+    value); a lost one names the folds between its two swept values (a cycle lost at a fold of
+    equilibria, its period growing, may end on a saddle-node on the cycle)."""
+    if end is None:
+        return edge
+    if end.kind == "hopf":
+        return f"a Hopf point at {end.value:.4g} (period {end.period:.3g})"
+    lo, hi = sorted((end.with_cycle, end.without_cycle))
+    folds = [e.value for e in events if e.kind == "fold" and lo <= e.value <= hi]
+    there = f"; fold{'s' * (len(folds) > 1)} at {', '.join(f'{v:.4g}' for v in folds)} there" if folds else ""
+    was = f", {period:.3g} at {end.with_cycle:g}" if period is not None else ""
+    return (f"{end.value:.4g} (lost between {end.with_cycle:g} and {end.without_cycle:g}{there}; "
+            f"period {end.period:.3g} there{was})")
+
+
 def _eq_line(e: analysis.Equilibrium) -> str:
     rates = " ".join(f"{o:.2f}" for o in e.outputs)
     scale = f", time scale {e.time_scale:.3g}" if e.time_scale is not None else ""
@@ -271,8 +307,19 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
             lines.append(f"    cycle: period {c.period:.3g}, output 0 between "
                          f"{np.min(c.orbit[:, 0]):.3g} and {np.max(c.orbit[:, 0]):.3g} (state), "
                          f"largest multiplier {c.max_multiplier:.3g}")
-    events = ", ".join(f"{e.kind} at {e.value:.4g}" for e in bif.events) or "none"
+    events = ", ".join(event_texts(bif.events)) or "none"
     lines.append(f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}")
+    if bif.retried:
+        lines.append(f"    searched again with {analysis.RETRY_STARTS} starts at {len(bif.retried)} value"
+                     f"{'s' * (len(bif.retried) != 1)} where the count of equilibria was even")
+    if bif.even:
+        shown = ", ".join(f"{v:g}" for v in bif.even[:8]) + (", ..." if len(bif.even) > 8 else "")
+        lines.append(f"    (the count stays even at {len(bif.even)} value{'s' * (len(bif.even) != 1)} ({shown}): "
+                     "equilibria were missed there, see docs/analysis.md)")
+    for b in bif.branches:
+        first, last = (bif.cycles[s][bif.cycle_branch[s].index(b.id)].period for s in (b.first, b.last))
+        lines.append(f"    cycle branch {b.id}: from {_end_text(b.start, 'the sweep start', bif.events, first)} "
+                     f"to {_end_text(b.end, 'the sweep end', bif.events, last)}")
     if basins is not None:
         every, which = basins
         shares = ", ".join(f"{chr(65 + k)} {np.mean(which == k):.0%}" for k in range(int(which.max(initial=-1)) + 1))

@@ -11,6 +11,7 @@ __all__ = [
     "LANES",
     "MAX_COUNT",
     "MUTATION_SCALE",
+    "RETRY_STARTS",
     "Evolution",
     "Network",
     "Trace",
@@ -28,6 +29,7 @@ __all__ = [
     "nav1d_assess",
     "nav1d_chains",
     "nav1d_exact",
+    "nav1d_chain_len",
     "nav1d_fresh_chains",
     "nav1d_record",
     "nav1d_system_assess",
@@ -46,6 +48,7 @@ __version__: str
 LANES: int
 MAX_COUNT: int
 MUTATION_SCALE: float
+RETRY_STARTS: int
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]
@@ -197,6 +200,7 @@ def sequence_trial(
 ) -> str: ...
 def sequence_assess(params: str, net: Network, trials_per_target: int, seed: int) -> str: ...
 def nav1d_chains(params: str, seed: int, generation: int) -> str: ...
+def nav1d_chain_len(params: str) -> int: ...
 def nav1d_fresh_chains(params: str, count: int, trials: int, seed: int) -> str: ...
 def nav1d_exact(params: str, environment: str, goal: str) -> str: ...
 def nav1d_record(params: str, net: Network, conditions: str, reset: bool = True) -> str: ...
@@ -236,6 +240,7 @@ def analysis_equilibria(
     distinct: float = 1e-06,
     max_iterations: int = 100,
     seed: int = 0,
+    retry_starts: int | None = None,
 ) -> str: ...
 def analysis_cycles(
     net: Network,
@@ -264,4 +269,5 @@ def analysis_bifurcation(
     max_iterations: int = 100,
     seed: int = 0,
     cycle_starts: int = 0,
+    retry_starts: int | None = None,
 ) -> str: ...

@@ -11,7 +11,8 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
   with period, amplitude per neuron and Floquet multipliers;
 - :func:`bifurcation`: one input swept from ``start`` to ``stop``, the equilibria followed, and
   the folds (an equilibrium pair appears or vanishes) and Hopf points (a complex pair crosses the
-  imaginary axis) located;
+  imaginary axis) located; optionally the attracting cycles followed as :class:`CycleBranch` es,
+  each with where it appears and disappears;
 - :func:`clamp`, :func:`cut` and :func:`lesions`: a neuron held at a constant output, or a
   connection removed, and the champion re-scored on fresh trials by :func:`dnnevo.assess.assess`.
 
@@ -51,10 +52,13 @@ __all__ = [
     "Attractors",
     "Bifurcation",
     "Cycle",
+    "CycleBranch",
+    "CycleEnd",
     "Equilibrium",
     "Event",
     "Lesion",
     "LesionTable",
+    "RETRY_STARTS",
     "attractors",
     "clamp",
     "cut",
@@ -176,13 +180,73 @@ class Event:
     value: float
     """The input value where it happens."""
     state: _Array
+    """The equilibrium there: two events at nearly the same value are told apart by it (two
+    folds at one value are two different pairs of equilibria meeting)."""
     eigenvalue: complex
     """The critical eigenvalue: real and near 0 (fold), or near ``i omega`` (Hopf)."""
+    outputs: _Array = field(default_factory=lambda: np.zeros(0))
+    """The firing rates ``f(v - theta)`` at ``state``."""
 
     def to_dict(self) -> dict[str, Any]:
         """As plain JSON types."""
         return {"kind": self.kind, "value": self.value, "state": self.state.tolist(),
-                "eigenvalue": [self.eigenvalue.real, self.eigenvalue.imag]}
+                "outputs": self.outputs.tolist(), "eigenvalue": [self.eigenvalue.real, self.eigenvalue.imag]}
+
+
+@dataclass(frozen=True)
+class CycleEnd:
+    """Where a cycle branch appears or disappears in a sweep."""
+
+    kind: str
+    """``"hopf"`` (the cycle shrinks onto an equilibrium at a Hopf point of the sweep) or
+    ``"lost"`` (it stops being found: a fold of cycles, a homoclinic orbit, or a change the search
+    missed)."""
+    value: float
+    """The input value of the end: the Hopf point's, or the last value (by bisection) where the
+    cycle was still found."""
+    with_cycle: float
+    """The swept value next to the end where the cycle was found."""
+    without_cycle: float
+    """The swept value next to the end, on the other side, where it was not."""
+    period: float
+    """The period at the end: ``2 pi / omega`` of a Hopf point's eigenvalues ``±i omega``, or the
+    last cycle the bisection found. A lost cycle whose period grows towards its end ends at a
+    homoclinic orbit or a saddle-node on the cycle; one whose period stays finite, at a fold of
+    cycles."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types."""
+        return {"kind": self.kind, "value": self.value, "with_cycle": self.with_cycle,
+                "without_cycle": self.without_cycle, "period": self.period}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any] | None) -> CycleEnd | None:
+        """From the JSON form the Rust core returns (None stays None)."""
+        if d is None:
+            return None
+        return cls(d["kind"], float(d["value"]), float(d["with_cycle"]), float(d["without_cycle"]),
+                   float(d["period"]))
+
+
+@dataclass(frozen=True)
+class CycleBranch:
+    """One attracting cycle followed across consecutive swept values."""
+
+    id: int
+    first: int
+    """Index of the first swept value with the cycle."""
+    last: int
+    """Index of the last swept value with the cycle."""
+    start: CycleEnd | None
+    """Where it appears (in sweep order), None if it is there at the first value."""
+    end: CycleEnd | None
+    """Where it disappears, None if it is there at the last value."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types."""
+        return {"id": self.id, "first": self.first, "last": self.last,
+                "start": self.start.to_dict() if self.start else None,
+                "end": self.end.to_dict() if self.end else None}
 
 
 @dataclass(frozen=True)
@@ -197,13 +261,26 @@ class Bifurcation:
     events: list[Event]
     cycles: list[list[Cycle]] = field(default_factory=list)
     """The attracting cycles at each value (empty lists unless the sweep searched for them)."""
+    cycle_branch: list[list[int]] = field(default_factory=list)
+    """The branch id of each cycle, parallel to ``cycles``: an index into ``branches``."""
+    branches: list[CycleBranch] = field(default_factory=list)
+    """The cycles followed across values, by id."""
+    retried: list[float] = field(default_factory=list)
+    """The values where the first search found an even number of equilibria and searched again
+    with :data:`RETRY_STARTS` (or the sweep's ``retry_starts``) starts."""
+
+    @property
+    def even(self) -> list[float]:
+        """The values where the count of equilibria is still even: some were missed there."""
+        return [float(v) for v, row in zip(self.values, self.equilibria, strict=True) if len(row) % 2 == 0]
 
     def to_dict(self) -> dict[str, Any]:
         """As plain JSON types (cycles without their orbits)."""
         return {"index": self.index, "input": self.input.tolist(), "values": self.values.tolist(),
                 "equilibria": [[e.to_dict() for e in row] for row in self.equilibria],
                 "cycles": [[c.to_dict(orbit=False) for c in row] for row in self.cycles],
-                "events": [e.to_dict() for e in self.events]}
+                "cycle_branch": self.cycle_branch, "branches": [b.to_dict() for b in self.branches],
+                "events": [e.to_dict() for e in self.events], "retried": self.retried, "even": self.even}
 
 
 def _input(net: _core.Network, value: npt.ArrayLike | None) -> list[float]:
@@ -216,9 +293,15 @@ def _input(net: _core.Network, value: npt.ArrayLike | None) -> list[float]:
     return arr.tolist()
 
 
+RETRY_STARTS: int = _core.RETRY_STARTS
+"""The default ``retry_starts``: a search that finds an even number of equilibria searches
+again with this many starts (0.2 s for 10 neurons). The number lives in the Rust core
+(``ctrnn::analysis::RETRY_STARTS``)."""
+
+
 def equilibria(
     net: _core.Network, input: npt.ArrayLike | None = None, *, starts: int = 512, tolerance: float = 1e-10,
-    distinct: float = 1e-6, max_iterations: int = 100, seed: int = 0,
+    distinct: float = 1e-6, max_iterations: int = 100, seed: int = 0, retry_starts: int | None = None,
 ) -> list[Equilibrium]:
     """Every equilibrium of ``net`` with its sensors held at ``input`` (default: all 0) that damped
     Newton's method reaches from ``starts`` starting points, sorted by state.
@@ -226,9 +309,12 @@ def equilibria(
     Starts are output vectors in (0, 1)^N mapped to ``v = weights o + c`` (the box every
     equilibrium lies in), half near the cube's corners. An equilibrium is accepted when
     ``max_i tau_i |dv_i/dt| <= tolerance``; two closer than ``distinct`` in every coordinate are
-    one. None is guaranteed for large N: raise ``starts`` to check."""
+    one. None is guaranteed for large N: a generic network has an odd number of equilibria, so
+    when the count is even the search is repeated with ``retry_starts`` starts (default
+    :data:`RETRY_STARTS`; 0 never). A count that is still even means some were missed."""
     text = _core.analysis_equilibria(net, _input(net, input), starts=starts, tolerance=tolerance,
-                                     distinct=distinct, max_iterations=max_iterations, seed=seed)
+                                     distinct=distinct, max_iterations=max_iterations, seed=seed,
+                                     retry_starts=retry_starts)
     return [Equilibrium.from_dict(d) for d in json.loads(text)]
 
 
@@ -252,23 +338,31 @@ def limit_cycles(
 
 def bifurcation(
     net: _core.Network, index: int, start: float, stop: float, *, input: npt.ArrayLike | None = None,
-    steps: int = 101, starts: int = 128, seed: int = 0, cycle_starts: int = 0,
+    steps: int = 101, starts: int = 128, seed: int = 0, cycle_starts: int = 0, retry_starts: int | None = None,
 ) -> Bifurcation:
     """Sweeps input ``index`` over ``steps`` values from ``start`` to ``stop`` (the other inputs
     held at ``input``, default 0), following the equilibria (each value's search also starts
     from the previous value's equilibria) and locating folds and Hopf points by bisection. With
     ``cycle_starts > 0`` it also searches each value for attracting cycles (the
-    :func:`limit_cycles` defaults with that many starts, plus the previous value's cycles); that
-    costs about as much as 100 equilibrium searches per value."""
+    :func:`limit_cycles` defaults with that many starts, plus a point of each of the previous
+    value's cycles) and follows them as :class:`CycleBranch` es, each with where it appears and
+    disappears; that costs about as much as 100 equilibrium searches per value. A value whose
+    count of equilibria is even is searched again with ``retry_starts`` starts (as
+    :func:`equilibria`); those values are in ``retried``, and those still even in ``even``."""
     base = _input(net, input)
     d = json.loads(_core.analysis_bifurcation(net, base, index, start, stop, steps=steps, starts=starts,
-                                              seed=seed, cycle_starts=cycle_starts))
+                                              seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts))
     events = [Event(e["kind"], float(e["value"]), np.array(e["state"], dtype=float),
-                    complex(*(math.nan if x is None else x for x in e["eigenvalue"])))
+                    complex(*(math.nan if x is None else x for x in e["eigenvalue"])),
+                    np.array(e["outputs"], dtype=float))
               for e in d["events"]]
     return Bifurcation(int(d["input"]), np.array(base), np.array(d["values"], dtype=float),
                        [[Equilibrium.from_dict(e) for e in row] for row in d["equilibria"]], events,
-                       [[Cycle.from_dict(c) for c in row] for row in d["cycles"]])
+                       [[Cycle.from_dict(c) for c in row] for row in d["cycles"]],
+                       [[int(k) for k in row] for row in d["cycle_branch"]],
+                       [CycleBranch(int(b["id"]), int(b["first"]), int(b["last"]), CycleEnd.from_dict(b["start"]),
+                                    CycleEnd.from_dict(b["end"])) for b in d["branches"]],
+                       [float(v) for v in d["retried"]])
 
 
 @dataclass(frozen=True)
@@ -287,21 +381,14 @@ class Attractors:
                 "cycles": [c.to_dict(orbit=orbits) for c in self.cycles]}
 
 
-RETRY_STARTS = 8192
-""":func:`attractors` searches again with this many starts when it finds an even number of
-equilibria."""
-
-
 def attractors(net: _core.Network, input: npt.ArrayLike | None = None, label: str = "") -> Attractors:
     """:func:`equilibria` and :func:`limit_cycles` under ``input``, with the default settings.
 
     A generic network has an odd number of equilibria (their indices add up to 1, since the
     vector field points inward on a large box), so an even count means some were missed: the
-    search is then repeated with :data:`RETRY_STARTS` starts (0.2 s for 10 neurons)."""
+    search is then repeated with :data:`RETRY_STARTS` starts (by :func:`equilibria` itself)."""
     values = _input(net, input)
     found = equilibria(net, values)
-    if len(found) % 2 == 0:
-        found = equilibria(net, values, starts=RETRY_STARTS)
     return Attractors(label or ",".join(f"{x:g}" for x in values), np.array(values), found,
                       limit_cycles(net, values))
 
@@ -397,8 +484,9 @@ class LesionTable:
 
 def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -> list[tuple[_Array, _Array]]:
     """Real trials of ``config``'s task drawn from ``seed``, each as (firing rates (T, N), inputs
-    (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain of 2
-    trials (nav1d)."""
+    (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain
+    (nav1d) of the task's chain length (:func:`dnnevo.nav1d.chain_len`: 5 trials for nav1d-single,
+    whose network learns its environment in trial 1), at least 2."""
     nonnegative("seed", seed)
     out: list[tuple[_Array, _Array]] = []
     if config.task == "sequence":
@@ -416,7 +504,7 @@ def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -
     elif config.task == "nav1d":
         from dnnevo import nav1d
 
-        chain = nav1d.fresh_chains(config, 1, 2, seed)[0]
+        chain = nav1d.fresh_chains(config, 1, max(2, nav1d.chain_len(config)), seed)[0]
         nr = nav1d.record(config, net, chain)
         out.append((nr.outputs, np.column_stack([nr.landmark, nr.reinforcement][: net.n_inputs])))
     else:

@@ -115,6 +115,12 @@ def cases(config: EvolutionConfig) -> list[Condition]:
     return [Condition(**json.loads(_core.nav1d_exact(params, e, g))) for e, g in CASES]
 
 
+def chain_len(config: EvolutionConfig) -> int:
+    """Trials per chain of the config's success check: ``trials_per_environment`` for a
+    ``single`` (or chained ``goal``) task, whose state carries from trial to trial, else 1."""
+    return _core.nav1d_chain_len(_params(config))
+
+
 def chains(config: EvolutionConfig, seed: int, generation: int) -> list[list[Condition]]:
     """The chains of trials every individual of ``generation`` ran."""
     return [_conditions(c) for c in json.loads(

@@ -279,13 +279,19 @@ def plot_phase_portrait(
     return ax
 
 
+_CYCLE_COLORS = ["k", "tab:purple", "tab:brown", "tab:olive", "tab:cyan", "tab:pink"]
+"""One colour per cycle branch of a bifurcation figure, by id."""
+
+
 def plot_bifurcation(
     result: Bifurcation, ax: Axes | None = None, *, neuron: int = 0, xlabel: str | None = None,
     title: str | None = None,
 ) -> Axes:
     """The equilibria's firing rate of ``neuron`` against the swept input, coloured by
-    stability, the attracting cycles' range of it (black bars) when the sweep searched for them,
-    and the folds (F) and Hopf points (H) marked by dotted lines."""
+    stability; when the sweep searched for cycles, each cycle branch's range of it (lowest to
+    highest rate over the orbit) as a band of its own colour, with its ends marked (a star where
+    it starts or ends at a Hopf point, a cross where it is lost: a fold of cycles or a homoclinic
+    orbit); and the folds (F) and Hopf points (H) marked by dotted lines."""
     ax = _axes(ax)
     for s, color in STABILITY_COLORS.items():
         pts = [(v, e.outputs[neuron]) for v, row in zip(result.values, result.equilibria, strict=True)
@@ -293,14 +299,28 @@ def plot_bifurcation(
         if pts:
             x, y = np.array(pts).T
             ax.scatter(x, y, s=9, color=color, label=s.replace("_", " "), zorder=3)
-    ranges = [(v, c.output_range[neuron]) for v, row in zip(result.values, result.cycles, strict=False)
-              for c in row]
-    if ranges:
-        x = np.array([v for v, _ in ranges])
-        lo, hi = np.array([r for _, r in ranges]).T
-        ax.vlines(x, lo, hi, color="k", lw=0.8, alpha=0.5, zorder=2)
-        ax.scatter(np.concatenate([x, x]), np.concatenate([lo, hi]), s=9, marker="_", color="k",
-                   label="cycle (min, max)", zorder=3)
+    marked: set[str] = set()
+    for branch in result.branches:
+        color = _CYCLE_COLORS[branch.id % len(_CYCLE_COLORS)]
+        pts = [(float(result.values[s]), result.cycles[s][result.cycle_branch[s].index(branch.id)].output_range[neuron])
+               for s in range(branch.first, branch.last + 1)]
+        x = np.array([v for v, _ in pts])
+        lo, hi = np.array([r for _, r in pts]).T
+        ax.fill_between(x, lo, hi, color=color, alpha=0.25, lw=0, zorder=1)
+        ax.vlines(x[[0, -1]], lo[[0, -1]], hi[[0, -1]], color=color, lw=0.8, zorder=2)
+        ax.plot(x, lo, x, hi, color=color, lw=0.8, zorder=2)
+        ax.plot([], [], color=color, lw=4, alpha=0.5, label=f"cycle branch {branch.id} (min, max)")
+        for end, k in ((branch.start, 0), (branch.end, -1)):
+            if end is None:
+                continue
+            hopf = end.kind == "hopf"
+            # A Hopf end sits on its equilibrium; a lost one at the middle of the last range.
+            y = next((float(e.outputs[neuron]) for e in result.events
+                      if hopf and e.kind == "hopf" and e.value == end.value and e.outputs.size), (lo[k] + hi[k]) / 2)
+            label = "cycle ends at a Hopf point" if hopf else "cycle lost (fold of cycles, homoclinic)"
+            ax.scatter([end.value], [y], s=40, marker="*" if hopf else "X", color=color,
+                       edgecolors="k", linewidths=0.5, zorder=4, label=None if label in marked else label)
+            marked.add(label)
     for e in result.events:
         ax.axvline(e.value, color="0.4", lw=0.7, ls=":")
         ax.text(e.value, 1.04, "F" if e.kind == "fold" else "H", ha="center", fontsize=8)

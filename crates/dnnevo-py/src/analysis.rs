@@ -26,9 +26,18 @@ fn seed(value: &AnyInt) -> PyResult<u64> {
     value.to("seed", "[0, 2**64)")
 }
 
-/// Every equilibrium Newton's method reaches, with eigenvalues and stability, as JSON.
+/// `retry_starts`, or the core's default ([`analysis::RETRY_STARTS`]) when None; 0 never retries.
+fn retry(value: Option<&AnyInt>) -> PyResult<usize> {
+    match value {
+        None => Ok(EquilibriumSearch::default().retry_starts),
+        Some(v) => count("retry_starts", v, 0),
+    }
+}
+
+/// Every equilibrium Newton's method reaches, with eigenvalues and stability, as JSON; searched
+/// again with `retry_starts` starts (None: the core's default) when the count is even.
 #[pyfunction]
-#[pyo3(signature = (net, input, *, starts=AnyInt::from(512), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0)), text_signature = "(net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0)")]
+#[pyo3(signature = (net, input, *, starts=AnyInt::from(512), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, retry_starts=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_equilibria(
     py: Python<'_>,
@@ -39,6 +48,7 @@ pub fn analysis_equilibria(
     distinct: f64,
     max_iterations: AnyInt,
     seed: AnyInt,
+    retry_starts: Option<AnyInt>,
 ) -> PyResult<String> {
     let settings = EquilibriumSearch {
         starts: count("starts", &starts, 1)?,
@@ -46,9 +56,11 @@ pub fn analysis_equilibria(
         distinct,
         max_iterations: count("max_iterations", &max_iterations, 1)?,
         seed: self::seed(&seed)?,
+        retry_starts: retry(retry_starts.as_ref())?,
     };
     let n = net.inner.size() as f64;
-    let cost = settings.starts as f64 * settings.max_iterations as f64 * n * n * n;
+    let starts = settings.starts + settings.retry_starts;
+    let cost = starts as f64 * settings.max_iterations as f64 * n * n * n;
     let net = &net.inner;
     let found = detached(py, cost, |_| analysis::equilibria(net, &input, &settings))?;
     Ok(to_json(&found))
@@ -89,9 +101,10 @@ pub fn analysis_cycles(
 }
 
 /// A sweep of input `index` from `start` to `stop` with the others held at `input`, as JSON;
-/// with `cycle_starts > 0` it also searches for limit cycles at each value from that many starts.
+/// with `cycle_starts > 0` it also searches for limit cycles at each value from that many starts
+/// and follows them as branches. `retry_starts` as for `analysis_equilibria`.
 #[pyfunction]
-#[pyo3(signature = (net, input, index, start, stop, *, steps=AnyInt::from(101), starts=AnyInt::from(128), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), cycle_starts=AnyInt::from(0)), text_signature = "(net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0)")]
+#[pyo3(signature = (net, input, index, start, stop, *, steps=AnyInt::from(101), starts=AnyInt::from(128), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), cycle_starts=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0, retry_starts=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_bifurcation(
     py: Python<'_>,
@@ -107,6 +120,7 @@ pub fn analysis_bifurcation(
     max_iterations: AnyInt,
     seed: AnyInt,
     cycle_starts: AnyInt,
+    retry_starts: Option<AnyInt>,
 ) -> PyResult<String> {
     let cycle_starts = count("cycle_starts", &cycle_starts, 0)?;
     let sweep = Sweep {
@@ -120,6 +134,7 @@ pub fn analysis_bifurcation(
             distinct,
             max_iterations: count("max_iterations", &max_iterations, 1)?,
             seed: self::seed(&seed)?,
+            retry_starts: retry(retry_starts.as_ref())?,
         },
         cycles: (cycle_starts > 0).then(|| CycleSearch {
             starts: cycle_starts,

@@ -38,7 +38,7 @@ mod _core {
     };
     #[pymodule_export]
     use super::nav1d::{
-        nav1d_assess, nav1d_chains, nav1d_exact, nav1d_fresh_chains, nav1d_record,
+        nav1d_assess, nav1d_chain_len, nav1d_chains, nav1d_exact, nav1d_fresh_chains, nav1d_record,
         nav1d_system_assess, nav1d_system_record,
     };
     #[pymodule_export]
@@ -54,6 +54,7 @@ mod _core {
         m.add("LANES", ctrnn::LANES)?;
         m.add("MAX_COUNT", tasks::MAX_COUNT)?;
         m.add("MUTATION_SCALE", ctrnn::ga::MUTATION_SCALE)?;
+        m.add("RETRY_STARTS", ctrnn::analysis::RETRY_STARTS)?;
         Ok(())
     }
 }

@@ -24,6 +24,13 @@ pub fn nav1d_chains(params: &str, seed: u64, generation: u64) -> PyResult<String
     Ok(to_json(&task(params)?.chains(seed, generation)))
 }
 
+/// Trials per chain of the task's success check: `trials_per_environment` for a `single` or
+/// chained `goal` task, else 1.
+#[pyfunction]
+pub fn nav1d_chain_len(params: &str) -> PyResult<usize> {
+    Ok(task(params)?.chain_len())
+}
+
 /// `count` fresh chains of `trials` trials, as JSON.
 #[pyfunction]
 pub fn nav1d_fresh_chains(

@@ -14,15 +14,22 @@
 //!   imaginary axis. Its input value is refined by bisection along the linked equilibrium.
 //!
 //! Linking is by continuation: Newton's method at the next value from each equilibrium, and back.
+//! A value where the search finds an even number of equilibria is searched again with
+//! [`EquilibriumSearch::retry_starts`] starts, by the same rule as a single search; the values
+//! where that happened are listed in [`Bifurcation::retried`].
 //! Each event is found to within `2^-40` of the step between input values, and reports the state
 //! and the critical eigenvalue there (near 0 for a fold, near `±i omega` for a Hopf point). An
 //! event whose critical eigenvalue is not within [`CRITICAL`] of the imaginary axis is dropped.
+//!
+//! With [`Sweep::cycles`], the attracting limit cycles are followed from value to value as
+//! [`CycleBranch`]es, each with where it starts and ends (see the `branches` module).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde::Serialize;
 
-use super::cycles::{self, Cycle, CycleSearch};
+use super::branches::{cycles_at, locate, CycleBranch};
+use super::cycles::{Cycle, CycleSearch};
 use super::equilibria::{max_abs, newton, search, Equilibrium, EquilibriumSearch};
 use super::field::Field;
 use super::stability::eigenvalues;
@@ -52,8 +59,9 @@ pub struct Sweep {
     /// The equilibrium search at each value. Default: [`EquilibriumSearch::default`] with 128
     /// starts (the previous value's equilibria are also starts).
     pub search: EquilibriumSearch,
-    /// The limit-cycle search at each value, if any (the previous value's cycles are also
-    /// starts). Default: None, since it costs about 100 times an equilibrium search.
+    /// The limit-cycle search at each value, if any; the previous value's cycles are followed
+    /// from a point of each, as well. Default: None, since it costs about 100 times an
+    /// equilibrium search.
     pub cycles: Option<CycleSearch>,
 }
 
@@ -123,8 +131,11 @@ pub struct Event {
     pub kind: EventKind,
     /// The input value where it happens.
     pub value: f64,
-    /// The equilibrium there.
+    /// The equilibrium there. Two events at nearly the same input value are told apart by it:
+    /// two folds at one value are two different pairs of equilibria meeting.
     pub state: Vec<f64>,
+    /// The firing rates `f(v - theta)` there.
+    pub outputs: Vec<f64>,
     /// The critical eigenvalue `[re, im]` there: the real one nearest 0 (fold), or the one with
     /// positive imaginary part nearest the imaginary axis (Hopf).
     pub eigenvalue: [f64; 2],
@@ -142,8 +153,16 @@ pub struct Bifurcation {
     /// The attracting limit cycles at each value, sorted by period (empty lists unless the
     /// sweep searched for cycles).
     pub cycles: Vec<Vec<Cycle>>,
+    /// The branch id of each cycle, parallel to `cycles`: an index into `branches`.
+    pub cycle_branch: Vec<Vec<usize>>,
+    /// The cycles followed across values, by id, each with where it starts and ends.
+    pub branches: Vec<CycleBranch>,
     /// Folds and Hopf points, by input value.
     pub events: Vec<Event>,
+    /// The input values where the first search found an even number of equilibria and the
+    /// search was repeated with `retry_starts` starts. A count that is still even at one of them
+    /// means that equilibria were missed there.
+    pub retried: Vec<f64>,
 }
 
 fn distance(a: &[f64], b: &[f64]) -> f64 {
@@ -172,15 +191,30 @@ fn det_sign(field: &Field<'_>, v: &[f64]) -> f64 {
 }
 
 /// Everything needed to look at the system at one input value.
-struct At<'a> {
+pub(crate) struct At<'a> {
     net: &'a Network,
     base: Vec<f64>,
     input: usize,
-    search: EquilibriumSearch,
+    pub(crate) search: EquilibriumSearch,
 }
 
-impl At<'_> {
-    fn field(&self, value: f64) -> Result<Field<'_>> {
+impl<'a> At<'a> {
+    /// `net` with input `input` swept, the others held at `base`.
+    pub(crate) fn new(
+        net: &'a Network,
+        base: &[f64],
+        input: usize,
+        search: EquilibriumSearch,
+    ) -> Self {
+        At {
+            net,
+            base: base.to_vec(),
+            input,
+            search,
+        }
+    }
+
+    pub(crate) fn field(&self, value: f64) -> Result<Field<'_>> {
         let mut input = self.base.clone();
         input[self.input] = value;
         Field::new(self.net, &input)
@@ -266,9 +300,15 @@ impl At<'_> {
         let scale = ev.iter().map(|z| z[0].hypot(z[1])).fold(1.0, f64::max);
         let critical = eigenvalue[0].abs() <= CRITICAL * scale
             && (kind == EventKind::Fold || eigenvalue[1] > CRITICAL * scale);
+        let theta = self.net.theta();
         Ok(critical.then_some(Event {
             kind,
             value,
+            outputs: state
+                .iter()
+                .zip(theta)
+                .map(|(v, t)| crate::math::sigmoid(v - t))
+                .collect(),
             state,
             eigenvalue,
         }))
@@ -339,15 +379,13 @@ pub fn bifurcation(
 ) -> Result<Bifurcation> {
     Field::new(net, input)?;
     sweep.validate(net.n_inputs())?;
-    let at = At {
-        net,
-        base: input.to_vec(),
-        input: sweep.input,
-        search: sweep.search,
-    };
+    let at = At::new(net, input, sweep.input, sweep.search);
     let values: Vec<f64> = (0..sweep.steps).map(|s| sweep.value(s)).collect();
     let mut equilibria: Vec<Vec<Equilibrium>> = Vec::with_capacity(sweep.steps);
+    let mut retried = Vec::new();
     let mut cycles: Vec<Vec<Cycle>> = Vec::with_capacity(sweep.steps);
+    let mut cycle_branch: Vec<Vec<usize>> = Vec::with_capacity(sweep.steps);
+    let mut branches = 0;
     for &p in &values {
         if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
             return Err(Error::Interrupted);
@@ -356,18 +394,32 @@ pub fn bifurcation(
             .last()
             .map(|prev| prev.iter().map(|e| e.state.clone()).collect())
             .unwrap_or_default();
-        equilibria.push(search(&at.field(p)?, &sweep.search, &extra)?);
-        let found = match &sweep.cycles {
-            None => Vec::new(),
+        let found = search(&at.field(p)?, &sweep.search, &extra)?;
+        if found.retried {
+            retried.push(p);
+        }
+        equilibria.push(found.equilibria);
+        let (here, ids) = match &sweep.cycles {
+            None => (Vec::new(), Vec::new()),
             Some(settings) => {
-                let extra: Vec<Vec<f64>> = cycles
-                    .last()
-                    .map(|prev: &Vec<Cycle>| prev.iter().map(|c| c.orbit[0].clone()).collect())
-                    .unwrap_or_default();
-                cycles::search(&at.field(p)?, settings, &extra, cancel)?
+                let previous: Vec<(Cycle, usize)> = match (cycles.last(), cycle_branch.last()) {
+                    (Some(c), Some(b)) => c.iter().cloned().zip(b.iter().copied()).collect(),
+                    _ => Vec::new(),
+                };
+                cycles_at(&at, p, settings, &previous, cancel)?
+                    .into_iter()
+                    .map(|(c, id)| {
+                        let id = id.unwrap_or_else(|| {
+                            branches += 1;
+                            branches - 1
+                        });
+                        (c, id)
+                    })
+                    .unzip()
             }
         };
-        cycles.push(found);
+        cycles.push(here);
+        cycle_branch.push(ids);
     }
     let mut events = Vec::new();
     for s in 0..sweep.steps - 1 {
@@ -398,7 +450,8 @@ pub fn bifurcation(
     events.sort_by(|x, y| x.value.total_cmp(&y.value));
     // A fold's two equilibria each report it: keep the report with the critical eigenvalue
     // nearer 0 (the other one's bisection may stop short where Newton's method, near the fold,
-    // jumps to its partner).
+    // jumps to its partner). Events at nearly the same value but far apart in state are
+    // different pairs, and both are kept.
     let spacing = (sweep.to - sweep.from).abs() / (sweep.steps - 1) as f64;
     let mut merged: Vec<Event> = Vec::with_capacity(events.len());
     for e in events {
@@ -413,11 +466,88 @@ pub fn bifurcation(
             None => merged.push(e),
         }
     }
+    let branches = match &sweep.cycles {
+        Some(settings) => follow_branches(
+            &at,
+            settings,
+            &values,
+            &cycles,
+            &cycle_branch,
+            branches,
+            &merged,
+            cancel,
+        )?,
+        None => Vec::new(),
+    };
     Ok(Bifurcation {
         input: sweep.input,
         values,
         equilibria,
         cycles,
+        cycle_branch,
+        branches,
         events: merged,
+        retried,
     })
+}
+
+/// The `count` branches of `cycle_branch`, each with its start and end located.
+#[allow(clippy::too_many_arguments)]
+fn follow_branches(
+    at: &At<'_>,
+    settings: &CycleSearch,
+    values: &[f64],
+    cycles: &[Vec<Cycle>],
+    cycle_branch: &[Vec<usize>],
+    count: usize,
+    events: &[Event],
+    cancel: Option<&AtomicBool>,
+) -> Result<Vec<CycleBranch>> {
+    let cycle = |s: usize, id: usize| {
+        cycle_branch[s]
+            .iter()
+            .position(|b| *b == id)
+            .map(|k| &cycles[s][k])
+    };
+    let mut out = Vec::with_capacity(count);
+    for id in 0..count {
+        let present: Vec<usize> = (0..values.len())
+            .filter(|&s| cycle(s, id).is_some())
+            .collect();
+        let (Some(&first), Some(&last)) = (present.first(), present.last()) else {
+            continue;
+        };
+        let start = match (first > 0, cycle(first, id)) {
+            (true, Some(c)) => Some(locate(
+                at,
+                settings,
+                values[first],
+                values[first - 1],
+                c,
+                events,
+                cancel,
+            )?),
+            _ => None,
+        };
+        let end = match (last + 1 < values.len(), cycle(last, id)) {
+            (true, Some(c)) => Some(locate(
+                at,
+                settings,
+                values[last],
+                values[last + 1],
+                c,
+                events,
+                cancel,
+            )?),
+            _ => None,
+        };
+        out.push(CycleBranch {
+            id,
+            first,
+            last,
+            start,
+            end,
+        });
+    }
+    Ok(out)
 }

@@ -7,7 +7,10 @@
 //! or four crossings earlier. One period from that crossing, integrated together with the
 //! variational equation `dPhi/dt = J(v(t)) Phi`, gives the orbit, the amplitude of each neuron and
 //! the monodromy matrix, whose eigenvalues are the Floquet multipliers. One multiplier is 1 (along
-//! the orbit); the cycle is stable when every other one lies inside the unit circle.
+//! the orbit); the cycle is stable when every other one lies inside the unit circle. An orbit
+//! with no multiplier within [`TRIVIAL_MULTIPLIER`] of 1 is not a cycle but a slowly decaying
+//! spiral into a focus (near a Hopf point its crossings can come within the tolerance of each
+//! other while it still shrinks), and is dropped.
 //!
 //! Forward integration finds attracting cycles only: an unstable cycle repels every start.
 
@@ -21,6 +24,10 @@ use super::field::Field;
 use super::stability::eigenvalues;
 use crate::error::{Error, Result};
 use crate::Network;
+
+/// A closed orbit is a cycle only if one of its Floquet multipliers lies within this of 1 (the
+/// trivial one, along the orbit; integration and closing errors move it by about 1e-5).
+pub const TRIVIAL_MULTIPLIER: f64 = 1e-3;
 
 /// Settings of a limit-cycle search.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -215,7 +222,8 @@ fn check_cancel(cancel: Option<&AtomicBool>) -> Result<()> {
     }
 }
 
-/// Integrates one period from `start` with the variational equation and describes the cycle.
+/// Integrates one period from `start` with the variational equation and describes the cycle;
+/// None if no multiplier is within [`TRIVIAL_MULTIPLIER`] of 1 (a decaying spiral).
 fn describe(
     field: &Field<'_>,
     start: &[f64],
@@ -224,7 +232,7 @@ fn describe(
     section_neuron: usize,
     dt: f64,
     settings: &CycleSearch,
-) -> Result<Cycle> {
+) -> Result<Option<Cycle>> {
     let n = field.size();
     let steps = ((period / dt).ceil() as usize).max(settings.orbit_points);
     let h = period / steps as f64;
@@ -253,20 +261,21 @@ fn describe(
         .enumerate()
         .map(|(k, [re, im])| (re.hypot(*im), k))
         .collect();
+    let from_one = |z: &[f64; 2]| (z[0] - 1.0).hypot(z[1]);
     let trivial = multipliers
         .iter()
         .enumerate()
-        .min_by(|a, b| {
-            let d = |z: &[f64; 2]| (z[0] - 1.0).hypot(z[1]);
-            d(a.1).total_cmp(&d(b.1))
-        })
+        .min_by(|a, b| from_one(a.1).total_cmp(&from_one(b.1)))
         .map(|(k, _)| k);
+    if trivial.is_none_or(|k| from_one(&multipliers[k]) > TRIVIAL_MULTIPLIER) {
+        return Ok(None);
+    }
     let max_multiplier = moduli
         .iter()
         .filter(|(_, k)| Some(*k) != trivial)
         .fold(0.0, |m: f64, (r, _)| m.max(*r));
     moduli.sort_by(|a, b| b.0.total_cmp(&a.0));
-    Ok(Cycle {
+    Ok(Some(Cycle {
         period,
         crossings,
         section_neuron,
@@ -282,7 +291,7 @@ fn describe(
         max_multiplier,
         stable: max_multiplier < 1.0,
         orbit,
-    })
+    }))
 }
 
 /// Follows one start; Some(cycle) when the orbit closes.
@@ -336,7 +345,7 @@ fn from_start(
                 let (t0, x0) = &sections[sections.len() - p];
                 let gap: Vec<f64> = x.iter().zip(x0).map(|(a, b)| a - b).collect();
                 if max_abs(&gap) < settings.tolerance {
-                    return describe(field, &x, t - t0, p, k, dt, settings).map(Some);
+                    return describe(field, &x, t - t0, p, k, dt, settings);
                 }
             }
             sections.push((t, x));
@@ -354,14 +363,10 @@ pub(crate) fn search(
     cancel: Option<&AtomicBool>,
 ) -> Result<Vec<Cycle>> {
     settings.validate()?;
-    let tau = field.net.tau();
-    let tau_max = tau.iter().fold(0.0, |m: f64, t| m.max(*t));
-    let tau_min = tau.iter().fold(f64::INFINITY, |m: f64, t| m.min(*t));
-    let dt = tau_min / settings.steps_per_tau as f64;
     let mut found: Vec<Cycle> = Vec::new();
     let starts = starting_states(field, settings.starts, settings.seed);
     for start in extra.iter().cloned().chain(starts) {
-        let Some(cycle) = from_start(field, start, dt, settings, tau_max, cancel)? else {
+        let Some(cycle) = follow(field, settings, start, cancel)? else {
             continue;
         };
         if !found.iter().any(|c| same_cycle(c, &cycle)) {
@@ -372,8 +377,24 @@ pub(crate) fn search(
     Ok(found)
 }
 
+/// The attracting cycle reached from `start`, if the orbit closes: the integration of one start
+/// of [`search`], at `tau_min / steps_per_tau` for `transient` then `window` largest time
+/// constants.
+pub(crate) fn follow(
+    field: &Field<'_>,
+    settings: &CycleSearch,
+    start: Vec<f64>,
+    cancel: Option<&AtomicBool>,
+) -> Result<Option<Cycle>> {
+    let tau = field.net.tau();
+    let tau_max = tau.iter().fold(0.0, |m: f64, t| m.max(*t));
+    let tau_min = tau.iter().fold(f64::INFINITY, |m: f64, t| m.min(*t));
+    let dt = tau_min / settings.steps_per_tau as f64;
+    from_start(field, start, dt, settings, tau_max, cancel)
+}
+
 /// Whether two cycles are one: close periods and the second's first point near the first's orbit.
-fn same_cycle(a: &Cycle, b: &Cycle) -> bool {
+pub(crate) fn same_cycle(a: &Cycle, b: &Cycle) -> bool {
     if (a.period - b.period).abs() > 1e-3 * a.period.max(b.period) {
         return false;
     }

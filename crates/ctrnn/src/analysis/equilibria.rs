@@ -10,6 +10,12 @@
 //! Newton's method is damped (the step is halved until `|G|` falls), and a start that stalls is
 //! dropped. This finds every equilibrium reachable from some start; none is guaranteed for large
 //! N, so raise [`EquilibriumSearch::starts`] to check a result.
+//!
+//! A generic network has an **odd** number of equilibria: the vector field points inward on a
+//! large enough box, so their indices add up to 1. An even count therefore means that some were
+//! missed, and the search is repeated with [`EquilibriumSearch::retry_starts`] starts (default
+//! [`RETRY_STARTS`]). This is the one place that rule lives: `dnnevo analyze`, its conditions and
+//! its sweeps all search through here.
 
 use serde::Serialize;
 
@@ -18,6 +24,10 @@ use super::stability::{eigenvalues, time_scale, Stability};
 use crate::error::{Error, Result};
 use crate::math::sigmoid;
 use crate::Network;
+
+/// Starts of the second search when the first finds an even number of equilibria (the default
+/// of [`EquilibriumSearch::retry_starts`]); 0.2 s for 10 neurons with weights up to 16.
+pub const RETRY_STARTS: usize = 8192;
 
 /// Settings of an equilibrium search.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,6 +43,10 @@ pub struct EquilibriumSearch {
     pub max_iterations: usize,
     /// Seed of the starting points. Default: 0.
     pub seed: u64,
+    /// When the search finds an even number of equilibria (so it missed some), it searches again
+    /// with this many starts, if more than `starts`; 0 never searches again. Default:
+    /// [`RETRY_STARTS`].
+    pub retry_starts: usize,
 }
 
 impl Default for EquilibriumSearch {
@@ -43,6 +57,7 @@ impl Default for EquilibriumSearch {
             distinct: 1e-6,
             max_iterations: 100,
             seed: 0,
+            retry_starts: RETRY_STARTS,
         }
     }
 }
@@ -217,16 +232,48 @@ pub(crate) fn insert_distinct(found: &mut Vec<Vec<f64>>, v: Vec<f64>, distinct: 
     }
 }
 
+/// What one search found.
+pub(crate) struct Found {
+    /// Sorted by state, each linearised.
+    pub(crate) equilibria: Vec<Equilibrium>,
+    /// Whether the first search found an even number and the search was repeated with
+    /// `retry_starts` starts.
+    pub(crate) retried: bool,
+}
+
 /// Every equilibrium found from the search's starts (and from `extra` starts, if any), sorted by
-/// state (lexicographic), each linearised.
+/// state (lexicographic), each linearised; searched again with `retry_starts` starts when the
+/// count is even.
 pub(crate) fn search(
     field: &Field<'_>,
     settings: &EquilibriumSearch,
     extra: &[Vec<f64>],
-) -> Result<Vec<Equilibrium>> {
+) -> Result<Found> {
     settings.validate()?;
+    let first = search_from(field, settings, settings.starts, extra)?;
+    if first.len() % 2 == 1 || settings.retry_starts <= settings.starts {
+        return Ok(Found {
+            equilibria: first,
+            retried: false,
+        });
+    }
+    // The first search's roots are starts too, so the second finds no fewer.
+    let mut again: Vec<Vec<f64>> = first.into_iter().map(|e| e.state).collect();
+    again.extend_from_slice(extra);
+    Ok(Found {
+        equilibria: search_from(field, settings, settings.retry_starts, &again)?,
+        retried: true,
+    })
+}
+
+fn search_from(
+    field: &Field<'_>,
+    settings: &EquilibriumSearch,
+    starts: usize,
+    extra: &[Vec<f64>],
+) -> Result<Vec<Equilibrium>> {
     let mut roots = Vec::new();
-    let starts = starting_states(field, settings.starts, settings.seed);
+    let starts = starting_states(field, starts, settings.seed);
     for v in extra.iter().cloned().chain(starts) {
         if let Some(r) = newton(field, v, settings.tolerance, settings.max_iterations) {
             insert_distinct(&mut roots, r, settings.distinct);
@@ -246,7 +293,9 @@ pub(crate) fn search(
 }
 
 /// Every equilibrium of `net` with its sensors held at `input` that Newton's method reaches from
-/// the search's starts, sorted by state.
+/// the search's starts, sorted by state. When their count is even, some were missed, and the
+/// search is repeated with [`EquilibriumSearch::retry_starts`] starts; a count that is still even
+/// is returned as found (the caller can tell by its parity).
 ///
 /// # Example
 /// ```
@@ -266,5 +315,5 @@ pub fn equilibria(
     input: &[f64],
     settings: &EquilibriumSearch,
 ) -> Result<Vec<Equilibrium>> {
-    search(&Field::new(net, input)?, settings, &[])
+    Ok(search(&Field::new(net, input)?, settings, &[])?.equilibria)
 }

@@ -10,7 +10,8 @@
 //! - [`equilibria`]: Newton's method from many starts, deduplicated, each with its eigenvalues,
 //!   [`Stability`] and slowest time scale.
 //! - [`limit_cycles`]: long RK4 integration, a Poincaré section, and Floquet multipliers.
-//! - [`bifurcation`]: a sweep of one input with folds and Hopf points located by bisection.
+//! - [`bifurcation`]: a sweep of one input with folds and Hopf points located by bisection, and
+//!   the limit cycles followed as [`CycleBranch`]es with where each starts and ends.
 //! - [`vector_field`] and [`jacobian`] for checks and plots.
 //!
 //! # Example
@@ -25,6 +26,7 @@
 //! ```
 
 mod bifurcation;
+mod branches;
 mod cycles;
 mod equilibria;
 mod field;
@@ -33,7 +35,8 @@ mod stability;
 mod tests;
 
 pub use bifurcation::{bifurcation, Bifurcation, Event, EventKind, Sweep, CRITICAL};
-pub use cycles::{limit_cycles, Cycle, CycleSearch};
-pub use equilibria::{equilibria, Equilibrium, EquilibriumSearch};
+pub use branches::{CycleBranch, CycleEnd, CycleEndKind, CYCLE_BISECTIONS};
+pub use cycles::{limit_cycles, Cycle, CycleSearch, TRIVIAL_MULTIPLIER};
+pub use equilibria::{equilibria, Equilibrium, EquilibriumSearch, RETRY_STARTS};
 pub use field::{jacobian, vector_field};
 pub use stability::{Stability, MARGINAL};

@@ -438,3 +438,286 @@ fn a_sweep_with_cycles_finds_them_between_its_hopf_points() {
         "only {checked} values between the Hopf points"
     );
 }
+
+/// The 2-neuron oscillator `[[a, b], [-b, a]]` (a > 4, thresholds at the centre) with its Hopf
+/// point placed in closed form at input 1: at `v_i = theta_i + x` with `f(x) (1 - f(x)) = 1/a`
+/// the Jacobian is `[[0, b/a], [-b/a, 0]]` (eigenvalues `±i b/a`), and sensor weights
+/// `s_0 = x - (a + b) g`, `s_1 = x - (a - b) g` (`g = f(x) - 1/2`) make that state the
+/// equilibrium at input 1. At input 0 the equilibrium is the centre, an unstable focus.
+fn hopf_at_one(a: f64, b: f64) -> Network {
+    let p = (1.0 + (1.0 - 4.0 / a).sqrt()) / 2.0;
+    let (x, g) = (logit(p), p - 0.5);
+    let theta = vec![(a + b) / 2.0, (a - b) / 2.0];
+    let s = vec![x - (a + b) * g, x - (a - b) * g];
+    Network::new(vec![1.0; 2], theta, vec![a, b, -b, a], s, None).unwrap()
+}
+
+fn cycle_sweep(from: f64, to: f64, steps: usize) -> Sweep {
+    Sweep {
+        from,
+        to,
+        steps,
+        cycles: Some(CycleSearch {
+            starts: 2,
+            ..CycleSearch::default()
+        }),
+        ..Sweep::default()
+    }
+}
+
+#[test]
+fn a_cycle_branch_ends_at_the_closed_form_hopf_point() {
+    let net = hopf_at_one(5.0, 4.0);
+    // 24 values from 0 to 2 (and back): input 1 falls between two of them.
+    for (from, to) in [(0.0, 2.0), (2.0, 0.0)] {
+        let b = bifurcation(&net, &[0.0], &cycle_sweep(from, to, 24), None).unwrap();
+        let hopf: Vec<&Event> = b
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::Hopf)
+            .collect();
+        assert_eq!(hopf.len(), 1, "{:?}", b.events);
+        assert!(
+            (hopf[0].value - 1.0).abs() < 1e-9,
+            "Hopf at {}",
+            hopf[0].value
+        );
+        assert_eq!(b.branches.len(), 1, "{:#?}", b.branches);
+        let branch = &b.branches[0];
+        assert_eq!(branch.id, 0);
+        // Every value below the Hopf point has the cycle, on branch 0; none above it has one.
+        // (Within 0.1 below it the cycle converges too slowly to close within the search's
+        // window, so it may be missed there; the branch's end is still the Hopf point.)
+        for (s, p) in b.values.iter().enumerate() {
+            let found = b.cycles[s].len();
+            assert!(found <= usize::from(*p < 1.0), "input {p}: {found} cycles");
+            assert!(*p > 0.9 || found == 1, "input {p}: no cycle");
+            assert_eq!(b.cycle_branch[s], vec![0; found]);
+            assert_eq!(
+                found == 1,
+                (branch.first..=branch.last).contains(&s),
+                "input {p}"
+            );
+        }
+        let (open, closed) = if from < to {
+            (&branch.start, &branch.end)
+        } else {
+            (&branch.end, &branch.start)
+        };
+        assert!(open.is_none(), "the cycle is there at input 0: {open:?}");
+        let end = closed.as_ref().expect("the branch ends inside the sweep");
+        assert_eq!(end.kind, CycleEndKind::Hopf);
+        assert!((end.value - 1.0).abs() < 1e-6, "{end:?}");
+        assert!(end.with_cycle < 1.0 && end.with_cycle > 0.8, "{end:?}");
+        // The vanishing cycle's period: 2 pi / omega with omega = b / a = 0.8.
+        assert!(
+            (end.period - 2.0 * std::f64::consts::PI / 0.8).abs() < 1e-6,
+            "{end:?}"
+        );
+    }
+}
+
+#[test]
+fn a_cycle_branch_is_followed_and_one_lost_is_located_by_bisection() {
+    // With the Hopf point's event dropped, the end can only be found by following the cycle:
+    // bisection stops where the continued cycle is no longer found, before the Hopf point (a
+    // cycle that small or slow does not close), and after the last value where it was found.
+    let net = hopf_at_one(5.0, 4.0);
+    let b = bifurcation(&net, &[0.0], &cycle_sweep(0.0, 2.0, 24), None).unwrap();
+    let branch = &b.branches[0];
+    let last = b.values[branch.last];
+    let settings = cycle_sweep(0.0, 2.0, 24).cycles.unwrap();
+    let at = super::bifurcation::At::new(&net, &[0.0], 0, EquilibriumSearch::default());
+    let end = super::branches::locate(
+        &at,
+        &settings,
+        last,
+        b.values[branch.last + 1],
+        &b.cycles[branch.last][0],
+        &[],
+        None,
+    )
+    .unwrap();
+    assert_eq!(end.kind, CycleEndKind::Lost);
+    assert!(last < end.value && end.value < 1.0, "{end:?}");
+    assert!(end.period > 7.0 && end.period < 9.0, "{end:?}");
+}
+
+/// Two uncoupled self-exciting neurons (w = 8, theta = 4), the input driving neuron 0 only:
+/// neuron 1 always has 3 equilibria, neuron 0 has 3 between its folds at `4 - h(x+-)` and 1
+/// outside, so the network has 9 or 3.
+fn uncoupled_pair() -> Network {
+    Network::new(
+        vec![1.0, 1.0],
+        vec![4.0, 4.0],
+        vec![8.0, 0.0, 0.0, 8.0],
+        vec![1.0, 0.0],
+        None,
+    )
+    .unwrap()
+}
+
+#[test]
+fn an_even_count_is_searched_again_in_a_search_and_in_a_sweep() {
+    let net = uncoupled_pair();
+    let few = EquilibriumSearch {
+        starts: 2,
+        retry_starts: 0,
+        ..EquilibriumSearch::default()
+    };
+    // The centre and one corner: 2 of the 9.
+    assert_eq!(equilibria(&net, &[0.0], &few).unwrap().len(), 2);
+    let retry = EquilibriumSearch {
+        retry_starts: RETRY_STARTS,
+        ..few
+    };
+    assert_eq!(equilibria(&net, &[0.0], &retry).unwrap().len(), 9);
+    let (lo, hi) = bistable_interval(8.0).unwrap();
+    let folds = [4.0 - hi, 4.0 - lo];
+    let sweep = |search| Sweep {
+        from: -4.0,
+        to: 4.0,
+        steps: 41,
+        search,
+        ..Sweep::default()
+    };
+    let without = bifurcation(&net, &[0.0], &sweep(few), None).unwrap();
+    assert!(without.retried.is_empty());
+    assert!(without.equilibria.iter().any(|e| e.len().is_multiple_of(2)));
+    let with = bifurcation(&net, &[0.0], &sweep(retry), None).unwrap();
+    assert!(!with.retried.is_empty());
+    for (s, p) in with.values.iter().enumerate() {
+        let inside = folds[0] < *p && *p < folds[1];
+        assert_eq!(
+            with.equilibria[s].len(),
+            if inside { 9 } else { 3 },
+            "input {p}"
+        );
+    }
+    // The first value has no earlier equilibria to start from: both sweeps search it alike.
+    assert_eq!(without.equilibria[0].len(), 2);
+    assert_eq!(with.retried[0], with.values[0]);
+    // A retry with too few starts leaves the count even, and the sweep says where it retried.
+    let weak = EquilibriumSearch {
+        retry_starts: 3,
+        ..few
+    };
+    let b = bifurcation(&net, &[0.0], &sweep(weak), None).unwrap();
+    let even: Vec<f64> = (0..b.values.len())
+        .filter(|&s| b.equilibria[s].len().is_multiple_of(2))
+        .map(|s| b.values[s])
+        .collect();
+    assert!(!even.is_empty());
+    assert!(even.iter().all(|p| b.retried.contains(p)));
+}
+
+#[test]
+fn folds_at_one_input_value_are_different_pairs_each_reported_once() {
+    // Neuron 0's fold happens once for each of neuron 1's three states: three folds at exactly
+    // the same input value, at three different states.
+    let net = uncoupled_pair();
+    let b = bifurcation(
+        &net,
+        &[0.0],
+        &Sweep {
+            from: -4.0,
+            to: 4.0,
+            steps: 41,
+            ..Sweep::default()
+        },
+        None,
+    )
+    .unwrap();
+    let (lo, hi) = bistable_interval(8.0).unwrap();
+    let v1 = equilibria(&net, &[0.0], &EquilibriumSearch::default()).unwrap();
+    let mut v1: Vec<f64> = v1.iter().map(|e| e.state[1]).collect();
+    v1.sort_by(f64::total_cmp);
+    v1.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    assert_eq!(v1.len(), 3, "{v1:?}");
+    assert_eq!(b.events.len(), 6, "{:#?}", b.events);
+    for want in [4.0 - hi, 4.0 - lo] {
+        let at: Vec<&Event> = b
+            .events
+            .iter()
+            .filter(|e| (e.value - want).abs() < 1e-6)
+            .collect();
+        assert_eq!(at.len(), 3, "folds at {want}: {at:#?}");
+        let mut states: Vec<f64> = at.iter().map(|e| e.state[1]).collect();
+        states.sort_by(f64::total_cmp);
+        for (s, v) in states.iter().zip(&v1) {
+            assert!((s - v).abs() < 1e-6, "{states:?} {v1:?}");
+        }
+    }
+}
+
+/// The seed-0 sequence-3bit champion (`dnnevo run sequence-3bit --seed 0`).
+fn three_bit_champion() -> Network {
+    let text = include_str!("../../../../tests/data/sequence-3bit-seed0-champion.json");
+    crate::io::from_json(text).unwrap().network
+}
+
+#[test]
+fn the_3bit_champions_two_folds_near_0_4374_are_two_pairs() {
+    // Its reinforcement sweep (0 to 1 in 101 values) reports "fold at 0.4374" twice: 11
+    // equilibria at 0.43, 7 at 0.44. The same two values, 11 apart here.
+    let net = three_bit_champion();
+    let sweep = Sweep {
+        input: 1,
+        from: 0.43,
+        to: 0.44,
+        steps: 11,
+        ..Sweep::default()
+    };
+    let b = bifurcation(&net, &[0.0, 0.0], &sweep, None).unwrap();
+    let near: Vec<&Event> = b
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::Fold && (e.value - 0.4374).abs() < 5e-4)
+        .collect();
+    assert_eq!(near.len(), 2, "{near:#?}");
+    let apart = near[0]
+        .state
+        .iter()
+        .zip(&near[1].state)
+        .fold(0.0, |m: f64, (x, y)| m.max((x - y).abs()));
+    assert!(apart > 1.0, "the two folds are {apart} apart");
+    // Each is a pair of its own: just before it two equilibria lie near its state, just after
+    // it none.
+    for e in near {
+        let around = |p: f64| {
+            equilibria(&net, &[0.0, p], &EquilibriumSearch::default())
+                .unwrap()
+                .iter()
+                .filter(|q| {
+                    q.state
+                        .iter()
+                        .zip(&e.state)
+                        .all(|(x, y)| (x - y).abs() < 0.5)
+                })
+                .count()
+        };
+        assert_eq!(around(e.value - 1e-6), 2, "before the fold at {}", e.value);
+        assert_eq!(around(e.value + 1e-6), 0, "after the fold at {}", e.value);
+    }
+}
+
+#[test]
+fn two_branches_reaching_one_cycle_leave_it_to_the_closer() {
+    use super::branches::{continues, orbit_gap, Here};
+    let net = centre_pair(5.5, 2.0, 1.0);
+    let c = limit_cycles(&net, &[0.0], &CycleSearch::default(), None).unwrap()[0].clone();
+    assert!(orbit_gap(&c, &c) == 0.0 && continues(&c, &c));
+    let mut here = Here { cycles: Vec::new() };
+    here.continued(c.clone(), 0, 0.5);
+    here.continued(c.clone(), 1, 0.1);
+    here.continued(c.clone(), 2, 0.3);
+    here.fresh(c.clone());
+    assert_eq!(here.cycles.len(), 1);
+    assert_eq!(here.cycles[0].1, Some(1));
+    // A cycle far from another (shifted by more than both sizes) does not continue it.
+    let mut far = c.clone();
+    for p in &mut far.orbit {
+        p[0] += 10.0;
+    }
+    assert!(!continues(&c, &far));
+}

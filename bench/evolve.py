@@ -3,7 +3,7 @@
 
 (a) GA overhead per generation, as a share of dnnevo's evaluation time (target < 1 %):
   evaluate      dnnevo.evaluate("sequence", genomes, ...) of the current population (median)
-  GA step       ga._evo.tell(fitness) with a fixed fitness vector: proportional selection,
+  GA step       ga.tell(fitness) with a fixed fitness vector: proportional selection,
                 crossover, mutation and the champion/statistics bookkeeping, in Rust (median)
   loop          dnnevo.evolve("sequence", ..., out=folder) for --generations generations: wall
                 time per generation minus the evaluate median (= GA step + the validation of the
@@ -107,7 +107,7 @@ def part_a(cfg, args):
     t_eval, _ = median_time(lambda g: dnnevo.evaluate("sequence", genomes, generation=g, seed=0,
                                                       config=cfg), args.eval_repeats)
     fitness = np.random.default_rng(1).random(cfg.population)
-    t_tell, _ = median_time(lambda _: ga._evo.tell(fitness), args.repeats)
+    t_tell, _ = median_time(lambda _: ga.tell(fitness), args.repeats)
     npga = NumpyGA(cfg, genomes)
     t_numpy, _ = median_time(lambda _: npga.tell(fitness), args.repeats)
 

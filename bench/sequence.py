@@ -11,7 +11,7 @@ Figures, in seconds per generation (median of timed runs after a quarter-second 
   dnnevo evaluate   dnnevo.evaluate("sequence", genomes, generation=g, seed=0, config=cfg), all cores
                     (and with threads=1, for a per-core comparison)
   dnnevo generation one whole generation of the GA on the Rust side (evaluate + breed), as
-                    dnnevo.evolve runs it (GeneticAlgorithm._evo.step)
+                    dnnevo.evolve runs it (GeneticAlgorithm.step)
   numpy evaluate    tests/sequence_reference.py, batched over P with einsum, one core, with the
                     same timings (dnnevo.sequence.timings); --numpy-repeats runs (default 1)
 The projection is 500 generations (the paper's run) at that rate, against the target of 60 s.
@@ -25,7 +25,6 @@ Exits with 1 if the two codes disagree; a missed target is reported, not an erro
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import sys
 import time
@@ -74,7 +73,6 @@ def main(argv=None) -> int:
     ga = dnnevo.GeneticAlgorithm(cfg, seed=seed)
     genomes = ga.ask().genomes
     params = ref.decode_genomes(genomes, cfg.size, cfg.n_inputs)
-    task_json = json.dumps(cfg.task_json())
 
     describe_machine()
     print(f"workload: preset sequence-1bit, P = {cfg.population}, N = {cfg.size}, "
@@ -94,7 +92,7 @@ def main(argv=None) -> int:
                                   threads=1), args.repeats)
 
     def dnnevo_generation(_):
-        return ga._evo.step("sequence", task_json, None)
+        return ga.step()
 
     t_gen, _ = median_time(dnnevo_generation, args.repeats)
 

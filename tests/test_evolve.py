@@ -103,7 +103,7 @@ def test_evaluate_matches_in_run_scores() -> None:
     genomes, networks = ga.ask()
     from_genomes = dnnevo.evaluate("sequence", genomes, generation=0, seed=11, config=config)
     from_networks = dnnevo.evaluate("sequence", networks, generation=0, seed=11, config=config)
-    stats, fitness = ga._evo.step("sequence", json.dumps(config.task_json()), None)
+    stats, fitness = ga.step()
     np.testing.assert_array_equal(from_genomes, fitness)
     np.testing.assert_array_equal(from_networks, fitness)
 

@@ -267,7 +267,7 @@ def _restored(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], di
     except DnnevoError as e:
         raise RunFileError(f"{run.checkpoint}: state.evolution: {e}") from None
     where = run.checkpoint
-    evo = json.loads(ga._evo.to_json())
+    evo = json.loads(ga.state_dict()["evolution"])
     expected = {"config": ga.config.ga_json(),
                 "layout": {"size": ga.config.size, "n_inputs": ga.config.n_inputs}}
     found = {"config": evo["config"], "layout": evo["layout"]}
@@ -387,8 +387,7 @@ def _loop(
                         )
                     stats = ga.tell(fitness)
                 else:
-                    assert task_json is not None
-                    stats, _ = ga._evo.step(task, task_json, threads)
+                    stats = ga.step(threads=threads).stats
                 seconds = time.perf_counter() - t0
                 validation = ga.best_validation or (float("nan"), float("nan"))
                 if _champion_key(ga) != seen:
@@ -444,32 +443,30 @@ def _loop(
 
 def _champion_key(ga: GeneticAlgorithm) -> tuple[Any, ...] | None:
     """What identifies the champion: a new one has another generation, fitness or validation."""
-    champ = ga._evo.champion()
-    return None if champ is None else (champ[1], champ[2], ga.best_validation)
+    return (ga.best_fitness, ga.best_generation, ga.best_validation)
 
 
 def _champion_success(ga: GeneticAlgorithm, task_json: str | None) -> float:
     """1.0 or 0.0 when the built-in task has a success criterion, else NaN."""
-    champ = ga._evo.champion()
-    if task_json is None or champ is None:
+    best = ga.best
+    if task_json is None or best is None:
         return float("nan")
     seed = (ga.seed ^ SUCCESS_SEED_SALT) & 0xFFFF_FFFF_FFFF_FFFF
-    verdict = _core.task_success(ga.config.task, task_json, champ[0], seed)
+    verdict = _core.task_success(ga.config.task, task_json, best, seed)
     return float("nan") if verdict is None else float(verdict)
 
 
 def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
     """Writes the champion as best.json; before the first generation there is none."""
-    champ = ga._evo.champion()
-    if champ is None:
+    net = ga.best
+    if net is None:
         run.best.unlink(missing_ok=True)
         return
-    net, fitness, generation = champ
     meta: dict[str, Any] = {
         "task": ga.config.task,
         "seed": ga.seed,
-        "generation": generation,
-        "fitness": fitness,
+        "generation": ga.best_generation,
+        "fitness": ga.best_fitness,
         "dnnevo_version": _core.__version__,
     }
     if ga.best_validation is not None:
@@ -480,10 +477,9 @@ def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
 def _result(
     ga: GeneticAlgorithm, history: list[dict[str, float]], run: RunDir | None, interrupted: bool
 ) -> EvolutionResult:
-    champ = ga._evo.champion()
-    if champ is None:
+    net, fitness, generation = ga.best, ga.best_fitness, ga.best_generation
+    if net is None or fitness is None or generation is None:
         raise FitnessError("no generation was scored, so there is no champion")
-    net, fitness, generation = champ
     columns = history[0].keys() if history else ()
     arrays = {k: np.array([row[k] for row in history]) for k in columns}
     return EvolutionResult(

@@ -23,7 +23,7 @@ from dnnevo import _core
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 
-__all__ = ["Ask", "GeneticAlgorithm"]
+__all__ = ["Ask", "GeneticAlgorithm", "Scored"]
 
 
 class Ask(NamedTuple):
@@ -31,6 +31,13 @@ class Ask(NamedTuple):
 
     genomes: npt.NDArray[np.float64]
     networks: list[_core.Network]
+
+
+class Scored(NamedTuple):
+    """One generation scored by a built-in task: its statistics and every individual's fitness."""
+
+    stats: dict[str, float]
+    fitness: npt.NDArray[np.float64]
 
 
 class GeneticAlgorithm:
@@ -78,6 +85,14 @@ class GeneticAlgorithm:
         selection) and breeds the next. Returns best, mean, std and min of the scored generation."""
         return self._evo.tell(fitness)
 
+    def step(self, *, threads: int | None = None) -> Scored:
+        """Scores the current population with the built-in task ``config.task`` and breeds the
+        next, as ``dnnevo.evolve`` does each generation (the task is built once and kept). The
+        GIL is released; Ctrl-C stops the scoring and raises ``KeyboardInterrupt``, leaving the
+        population as it was. ``threads`` is the Rust worker count (default: all cores)."""
+        stats, fitness = self._evo.step(self.config.task, json.dumps(self.config.task_json()), threads)
+        return Scored(stats, fitness)
+
     @property
     def best(self) -> _core.Network | None:
         """The best network scored so far, or None before the first ``tell``."""
@@ -88,6 +103,12 @@ class GeneticAlgorithm:
     def best_fitness(self) -> float | None:
         """The training fitness of :attr:`best`."""
         return self._evo.champion_fitness
+
+    @property
+    def best_generation(self) -> int | None:
+        """The generation :attr:`best` was scored in, or None before the first generation."""
+        champ = self._evo.champion()
+        return None if champ is None else champ[2]
 
     @property
     def best_validation(self) -> tuple[float, float] | None:

@@ -6,6 +6,7 @@ use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use tasks::landmark::LandmarkTask;
 
+use crate::detach::detached;
 use crate::errors::{ConfigError, IntoPy, InvalidArgumentError};
 use crate::json::{self, to_json};
 use crate::network::PyNetwork;
@@ -38,7 +39,7 @@ pub fn landmark_record(
     Ok(to_json(&record))
 }
 
-/// Assesses a network on fresh trials, as JSON.
+/// Assesses a network on fresh trials, as JSON. Releases the GIL; Ctrl-C interrupts.
 #[pyfunction]
 #[pyo3(signature = (params, net, per_landmark, seed, robot_like=false))]
 pub fn landmark_assess(
@@ -51,9 +52,9 @@ pub fn landmark_assess(
 ) -> PyResult<String> {
     let task = task(params)?;
     let net = &net.inner;
-    let report = py
-        .detach(|| task.assess(net, per_landmark, seed, robot_like))
-        .py_err()?;
+    let report = detached(py, f64::INFINITY, |cancel| {
+        task.assess_cancellable(net, per_landmark, seed, robot_like, Some(cancel))
+    })?;
     Ok(to_json(&report))
 }
 

@@ -5,6 +5,7 @@
 use pyo3::prelude::*;
 use tasks::nav1d::{Condition, Environment, Nav1dTask, Part, Side, System};
 
+use crate::detach::detached;
 use crate::errors::{IntoPy, InvalidArgumentError};
 use crate::json::{self, to_json};
 use crate::network::PyNetwork;
@@ -59,7 +60,7 @@ pub fn nav1d_record(
     Ok(to_json(&record))
 }
 
-/// Assesses a network on `chains` fresh chains, as JSON.
+/// Assesses a network on `chains` fresh chains, as JSON. Releases the GIL; Ctrl-C interrupts.
 #[pyfunction]
 pub fn nav1d_assess(
     py: Python<'_>,
@@ -70,7 +71,9 @@ pub fn nav1d_assess(
 ) -> PyResult<String> {
     let task = task(params)?;
     let net = &net.inner;
-    let report = py.detach(|| task.assess(net, chains, seed)).py_err()?;
+    let report = detached(py, f64::INFINITY, |cancel| {
+        task.assess_cancellable(net, chains, seed, Some(cancel))
+    })?;
     Ok(to_json(&report))
 }
 
@@ -89,7 +92,8 @@ fn system(parts: [&PyPart<'_>; 3], persist_state: bool) -> PyResult<System> {
         .persist_state(persist_state))
 }
 
-/// Assesses the integrated system on fresh environments, as JSON.
+/// Assesses the integrated system on fresh environments, as JSON. Releases the GIL; Ctrl-C
+/// interrupts.
 #[pyfunction]
 #[pyo3(signature = (classifier, far, near, environments, trials, seed, persist_state=true))]
 #[allow(clippy::too_many_arguments)]
@@ -104,9 +108,9 @@ pub fn nav1d_system_assess(
     persist_state: bool,
 ) -> PyResult<String> {
     let system = system([&classifier, &far, &near], persist_state)?;
-    let report = py
-        .detach(|| system.assess(environments, trials, seed))
-        .py_err()?;
+    let report = detached(py, f64::INFINITY, |cancel| {
+        system.assess_cancellable(environments, trials, seed, Some(cancel))
+    })?;
     Ok(to_json(&report))
 }
 
@@ -115,6 +119,7 @@ pub fn nav1d_system_assess(
 #[pyfunction]
 #[pyo3(signature = (classifier, far, near, conditions, persist_state=true))]
 pub fn nav1d_system_record(
+    py: Python<'_>,
     classifier: PyPart<'_>,
     far: PyPart<'_>,
     near: PyPart<'_>,
@@ -122,7 +127,8 @@ pub fn nav1d_system_record(
     persist_state: bool,
 ) -> PyResult<String> {
     let system = system([&classifier, &far, &near], persist_state)?;
-    let (a, b, chosen) = system.record(&chain(conditions)?).py_err()?;
+    let chain = chain(conditions)?;
+    let (a, b, chosen) = py.detach(|| system.record(&chain)).py_err()?;
     Ok(to_json(
         &serde_json::json!({"first": a, "rest": b, "chosen": chosen}),
     ))

@@ -4,6 +4,7 @@
 use pyo3::prelude::*;
 use tasks::sequence::SequenceTask;
 
+use crate::detach::detached;
 use crate::errors::IntoPy;
 use crate::json::{self, to_json};
 use crate::network::PyNetwork;
@@ -44,6 +45,7 @@ pub fn sequence_trial(
 }
 
 /// Assesses a network on fresh timings, `trials_per_target` trials per target, as JSON.
+/// Releases the GIL; Ctrl-C interrupts.
 #[pyfunction]
 pub fn sequence_assess(
     py: Python<'_>,
@@ -54,8 +56,8 @@ pub fn sequence_assess(
 ) -> PyResult<String> {
     let task = task(params)?;
     let net = &net.inner;
-    let report = py
-        .detach(|| task.assess(net, trials_per_target, seed))
-        .py_err()?;
+    let report = detached(py, f64::INFINITY, |cancel| {
+        task.assess_cancellable(net, trials_per_target, seed, Some(cancel))
+    })?;
     Ok(to_json(&report))
 }

@@ -900,7 +900,18 @@ impl SequenceTask {
     /// Performance uses the numeric `perf_base`, or 0.5 when it is a generation's mean.
     /// Every target must have more triggers than its warm-up, or nothing would be judged.
     pub fn assess(&self, net: &Network, trials_per_target: usize, seed: u64) -> Result<Assessment> {
-        let judged = self.judge(&[net], trials_per_target, seed, Purpose::Evaluate, None)?;
+        self.assess_cancellable(net, trials_per_target, seed, None)
+    }
+
+    /// [`assess`](Self::assess) that stops with [`Error::Interrupted`] soon after `cancel` is set.
+    pub fn assess_cancellable(
+        &self,
+        net: &Network,
+        trials_per_target: usize,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Assessment> {
+        let judged = self.judge(&[net], trials_per_target, seed, Purpose::Evaluate, cancel)?;
         let targets: Vec<TargetReport> = self
             .config
             .targets

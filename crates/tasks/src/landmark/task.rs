@@ -369,13 +369,25 @@ impl LandmarkTask {
         seed: u64,
         robot_like: bool,
     ) -> Result<Assessment> {
+        self.assess_cancellable(net, per_landmark, seed, robot_like, None)
+    }
+
+    /// [`assess`](Self::assess) that stops with [`Error::Interrupted`] soon after `cancel` is set.
+    pub fn assess_cancellable(
+        &self,
+        net: &Network,
+        per_landmark: usize,
+        seed: u64,
+        robot_like: bool,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Assessment> {
         if per_landmark == 0 {
             return Err(Error::InvalidArgument(
                 "trials per landmark is 0; assessing needs at least 1".into(),
             ));
         }
         let trials = self.fresh_trials(per_landmark, seed, robot_like)?;
-        let outputs = self.outputs(std::slice::from_ref(net), &trials, None)?;
+        let outputs = self.outputs(std::slice::from_ref(net), &trials, cancel)?;
         let mut confusion = [[0usize; 2]; 2];
         let mut list = vec![];
         for (s, &f) in trials.iter().zip(&outputs[0]) {

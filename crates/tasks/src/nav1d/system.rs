@@ -3,6 +3,8 @@
 //! near or the far goal-seeking network, which drives every later trial, its state persisting
 //! from trial to trial.
 
+use std::sync::atomic::AtomicBool;
+
 use ctrnn::{Error, Network, Result};
 use serde::Serialize;
 
@@ -146,6 +148,15 @@ impl System {
     /// own, which then persists (unless [`persist_state`](Self::persist_state) is off). Chains run
     /// in parallel.
     pub fn run(&self, chains: &[Vec<Condition>]) -> Result<Vec<SystemEpisode>> {
+        self.run_cancellable(chains, None)
+    }
+
+    /// [`run`](Self::run) that stops with [`Error::Interrupted`] soon after `cancel` is set.
+    pub fn run_cancellable(
+        &self,
+        chains: &[Vec<Condition>],
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<SystemEpisode>> {
         if chains
             .iter()
             .any(|c| c.is_empty() || c.len() != chains[0].len())
@@ -158,7 +169,8 @@ impl System {
         let first = self
             .classifier
             .task
-            .episodes(&self.classifier.network, &firsts)?;
+            .episodes_of(&[&self.classifier.network], &firsts, cancel)?
+            .concat();
         let chosen: Vec<Environment> = first
             .iter()
             .map(|e| {
@@ -179,12 +191,14 @@ impl System {
             let reached: Vec<Vec<bool>> = if k == 0 {
                 vec![vec![]; picked.len()]
             } else if self.persist_state {
-                let episodes = part.task.episodes(&part.network, &tails)?;
+                let episodes = part.task.episodes_of(&[&part.network], &tails, cancel)?;
+                let episodes = episodes.concat();
                 episodes.into_iter().map(|ep| ep.reached).collect()
             } else {
                 let singles: Vec<Vec<Condition>> =
                     tails.iter().flatten().map(|c| vec![*c]).collect();
-                let episodes = part.task.episodes(&part.network, &singles)?;
+                let episodes = part.task.episodes_of(&[&part.network], &singles, cancel)?;
+                let episodes = episodes.concat();
                 let flat: Vec<bool> = episodes.iter().map(|ep| ep.reached[0]).collect();
                 flat.chunks(k).map(<[bool]>::to_vec).collect()
             };
@@ -215,6 +229,17 @@ impl System {
         trials: usize,
         seed: u64,
     ) -> Result<SystemAssessment> {
+        self.assess_cancellable(environments, trials, seed, None)
+    }
+
+    /// [`assess`](Self::assess) that stops with [`Error::Interrupted`] soon after `cancel` is set.
+    pub fn assess_cancellable(
+        &self,
+        environments: usize,
+        trials: usize,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<SystemAssessment> {
         if environments == 0 || trials == 0 {
             return Err(Error::InvalidArgument(format!(
                 "environments is {environments} and trials is {trials}; both must be >= 1"
@@ -224,7 +249,7 @@ impl System {
             .classifier
             .task
             .fresh_chains(environments, trials, seed);
-        let episodes = self.run(&chains)?;
+        let episodes = self.run_cancellable(&chains, cancel)?;
         let reached: usize = episodes
             .iter()
             .map(|e| e.reached.iter().filter(|&&r| r).count())

@@ -310,7 +310,7 @@ impl Nav1dTask {
     /// [`episodes`](Self::episodes) of every network of `nets` (`out[network][chain]`):
     /// (network, chain) pairs run [`LANES`] at a time in parallel; a lane's results do not
     /// depend on its neighbours.
-    fn episodes_of(
+    pub(crate) fn episodes_of(
         &self,
         nets: &[&Network],
         chains: &[Vec<Condition>],
@@ -407,12 +407,24 @@ impl Nav1dTask {
     /// [`fresh_chains`](Self::fresh_chains): it succeeds when at least [`SUCCESS_RATE`] of the
     /// scored trials are done right.
     pub fn assess(&self, net: &Network, chains: usize, seed: u64) -> Result<Assessment> {
+        self.assess_cancellable(net, chains, seed, None)
+    }
+
+    /// [`assess`](Self::assess) that stops with [`Error::Interrupted`] soon after `cancel` is set.
+    pub fn assess_cancellable(
+        &self,
+        net: &Network,
+        chains: usize,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Assessment> {
         if chains == 0 {
             return Err(Error::InvalidArgument(
                 "chains is 0; assessing needs at least 1".into(),
             ));
         }
-        let episodes = self.episodes(net, &self.fresh_chains(chains, self.chain_len(), seed))?;
+        let fresh = self.fresh_chains(chains, self.chain_len(), seed);
+        let episodes = self.episodes_of(&[net], &fresh, cancel)?.concat();
         let rate = self.rate(&episodes);
         Ok(Assessment {
             objective: self.config.objective,

@@ -200,9 +200,25 @@ impl LandmarkTask {
         seed: u64,
         robot_like: bool,
     ) -> Result<Vec<Sensing>> {
+        self.sensed(purpose, per_landmark, seed, robot_like, None)
+    }
+
+    /// [`trials_from`](Self::trials_from) that stops with [`Error::Interrupted`] soon after
+    /// `cancel` is set: sensing many robot-like trials takes seconds.
+    fn sensed(
+        &self,
+        purpose: Purpose,
+        per_landmark: usize,
+        seed: u64,
+        robot_like: bool,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<Sensing>> {
         (0..2 * per_landmark)
             .into_par_iter()
             .map(|t| {
+                if interrupted(cancel) {
+                    return Err(Error::Interrupted);
+                }
                 let stream = Stream::new(seed, 0, purpose, 0, t as u64);
                 let landmark = if t < per_landmark { 1 } else { 2 };
                 self.sense(landmark, stream, robot_like)
@@ -386,8 +402,8 @@ impl LandmarkTask {
                 "trials per landmark is 0; assessing needs at least 1".into(),
             ));
         }
-        let trials = self.fresh_trials(per_landmark, seed, robot_like)?;
-        let outputs = self.outputs(std::slice::from_ref(net), &trials, cancel)?;
+        let trials = self.sensed(Purpose::Evaluate, per_landmark, seed, robot_like, cancel)?;
+        let outputs = self.outputs_by_pair(std::slice::from_ref(net), &trials, cancel)?;
         let mut confusion = [[0usize; 2]; 2];
         let mut list = vec![];
         for (s, &f) in trials.iter().zip(&outputs[0]) {

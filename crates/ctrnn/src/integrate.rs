@@ -27,8 +27,9 @@ use crate::vector::{Group, Portable, Vector};
 /// every row of the kernel has two independent dependency chains in flight.
 pub const LANES: usize = 16;
 
-/// Rows between two looks at the cancel flag.
-const CANCEL_CHECK_ROWS: usize = 64;
+/// Integration steps (rows times substeps) between two looks at the cancel flag, so that Ctrl-C
+/// is seen within milliseconds however many substeps a row has.
+const CANCEL_CHECK_STEPS: usize = 1024;
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -399,10 +400,16 @@ impl<const L: usize> Lanes<L> {
         let mut fresh = std::mem::take(&mut self.scratch.fresh);
         self.scratch.held = false;
         let (mut work, state) = self.work::<V>();
+        let check_rows = (CANCEL_CHECK_STEPS / integ.substeps.max(1)).max(1);
+        let mut rows_to_check = 0;
         for t in 0..steps {
-            if t % CANCEL_CHECK_ROWS == 0 && cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
-                return Err(Error::Interrupted);
+            if rows_to_check == 0 {
+                if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                    return Err(Error::Interrupted);
+                }
+                rows_to_check = check_rows;
             }
+            rows_to_check -= 1;
             row(t, inputs);
             let v = V::rows_mut(state.as_flattened_mut());
             work.step(v, V::rows(inputs.as_flattened()), integ, fresh);

@@ -60,7 +60,7 @@ CONFIDENCE = 0.95
 
 THRESHOLDS = {"sequence": 0.9, "landmark": 0.95, "nav1d": 0.95}
 """Each task's success threshold: the rate its rule needs (``SUCCESS_FRACTION`` in
-``crates/tasks/src/sequence.rs``, ``SUCCESS_RATE`` in ``nav1d/task.rs`` and ``landmark/task.rs``)."""
+``crates/tasks/src/sequence/scoring.rs``, ``SUCCESS_RATE`` in ``nav1d/task.rs`` and ``landmark/task.rs``)."""
 
 DEFAULT_TRIALS = {"sequence": 1000, "landmark": 500, "nav1d": 1000}
 """``dnnevo evaluate``'s default trial counts: trials per target, trials per landmark, chains.

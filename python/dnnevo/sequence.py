@@ -1,7 +1,7 @@
 """Sequence learning (paper §5): trial timings, recorded trials, the success assessment and the
 "switch" test, for a network and an :class:`EvolutionConfig` of the ``sequence`` task.
 
-Success rule (from ``crates/tasks/src/sequence.rs``): on fresh random timings, a network learns a
+Success rule (from ``crates/tasks/src/sequence/``): on fresh random timings, a network learns a
 target when, in at least 90% of trials, every trigger from index ``2 * len(target)`` on is
 correct (the mean output over the trigger window is on the target bit's side of 0.5). It
 succeeds on B when it learns every target in B.

@@ -59,13 +59,13 @@ impl Diverged {
         Ok(())
     }
 
-    /// The error, with the lane's network numbered from `first`.
-    pub(crate) fn error(self, first: usize) -> Error {
+    /// The error, naming the network that `network(lane)` says ran on the lane.
+    pub(crate) fn error(self, network: impl FnOnce(usize) -> usize) -> Error {
         Error::InvalidArgument(format!(
             "integration diverged: state[{}] of network {} became {}; use a smaller dt \
              (Euler needs dt / tau well below 2)",
             self.neuron,
-            first + self.lane,
+            network(self.lane),
             self.value
         ))
     }

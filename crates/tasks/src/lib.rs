@@ -16,6 +16,7 @@
 
 mod common;
 pub mod landmark;
+mod lanes;
 pub mod nav1d;
 pub mod registry;
 pub mod sequence;

@@ -3,15 +3,14 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{
-    Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, Validation, LANES,
-};
+use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES};
 use rayon::prelude::*;
 use serde::Serialize;
 use sim2d::{Echo, Sim, SimSpec, World, WorldSpec};
 
 use super::config::{config_error, LandmarkConfig};
 use crate::common::{check_inputs, config_from_params, interrupted, Diverged, Memo};
+use crate::lanes::{by_block, by_pair, pairs};
 
 /// The fraction of fresh trials a network must classify right to have solved the task.
 pub const SUCCESS_RATE: f64 = 0.95;
@@ -251,31 +250,20 @@ impl LandmarkTask {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<Vec<f64>>> {
         self.check(networks)?;
-        if networks.is_empty() {
-            return Ok(vec![]);
-        }
-        let mut population = Population::new(networks)?;
-        let per_block = population
-            .blocks_mut()
-            .par_iter_mut()
-            .enumerate()
-            .map(|(b, block)| {
-                let mut out = vec![vec![0.0; trials.len()]; block.len()];
-                for (t, trial) in trials.iter().enumerate() {
-                    if interrupted(cancel) {
-                        return Err(Error::Interrupted);
-                    }
-                    let f = self
-                        .run_lanes(block, [trial.input.as_slice(); LANES], |_| {})
-                        .map_err(|d| d.error(b * LANES))?;
-                    for (l, row) in out.iter_mut().enumerate() {
-                        row[t] = f[l];
-                    }
+        by_block(
+            networks,
+            trials.len(),
+            cancel,
+            |len| vec![vec![0.0; trials.len()]; len],
+            |out, _, block, t| {
+                let f = self.run_lanes(block, [trials[t].input.as_slice(); LANES], |_| {})?;
+                for (l, row) in out.iter_mut().enumerate() {
+                    row[t] = f[l];
                 }
-                Ok(out)
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(per_block.concat())
+                Ok(())
+            },
+            |out| out,
+        )
     }
 
     /// Each network's final classifier output on each trial (`out[p][t]`), with (network,
@@ -290,9 +278,7 @@ impl LandmarkTask {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<Vec<f64>>> {
         self.check(networks)?;
-        let mut pairs: Vec<(usize, usize)> = (0..networks.len())
-            .flat_map(|p| (0..trials.len()).map(move |t| (p, t)))
-            .collect();
+        let mut pairs = pairs(networks.len(), trials.len());
         // A stable sort: pairs of one length keep their order, so unvaried sets group as before.
         pairs.sort_by_key(|&(_, t)| trials[t].input.len());
         let mut groups: Vec<&[(usize, usize)]> = vec![];
@@ -308,28 +294,15 @@ impl LandmarkTask {
             groups.push(group);
             rest = tail;
         }
-        let results = groups
-            .par_iter()
-            .map(|group| {
-                if interrupted(cancel) {
-                    return Err(Error::Interrupted);
-                }
-                // Padding lanes repeat the group's first pair.
-                let pick = |l: usize| group[if l < group.len() { l } else { 0 }];
-                let refs: [&Network; LANES] = std::array::from_fn(|l| &networks[pick(l).0]);
-                let mut lanes = Lanes::<LANES>::new(&refs)?;
-                let inputs = std::array::from_fn(|l| trials[pick(l).1].input.as_slice());
-                let f = self
-                    .run_lanes(&mut lanes, inputs, |_| {})
-                    .map_err(|d| d.error(group[0].0))?;
-                Ok(f[..group.len()].to_vec())
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let refs: Vec<&Network> = networks.iter().collect();
+        let results = by_pair(&refs, &groups, cancel, |lanes, lane_pairs, len| {
+            let inputs = lane_pairs.map(|(_, t)| trials[t].input.as_slice());
+            let f = self.run_lanes(lanes, inputs, |_| {})?;
+            Ok(f[..len].to_vec())
+        })?;
         let mut out = vec![vec![0.0; trials.len()]; networks.len()];
-        for (group, f) in groups.iter().zip(results) {
-            for (&(p, t), y) in group.iter().zip(f) {
-                out[p][t] = y;
-            }
+        for (&(p, t), y) in pairs.iter().zip(results) {
+            out[p][t] = y;
         }
         Ok(out)
     }
@@ -368,7 +341,7 @@ impl LandmarkTask {
             .run_lanes(&mut lanes, [sensing.input.as_slice()], |lanes| {
                 outputs.push((0..n).map(|i| lanes.output(i)[0]).collect());
             })
-            .map_err(|d| d.error(0))?;
+            .map_err(|d| d.error(|_| 0))?;
         Ok(Record {
             sensing,
             outputs,

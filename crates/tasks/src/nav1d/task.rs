@@ -3,15 +3,13 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{
-    Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, Validation, LANES,
-};
-use rayon::prelude::*;
+use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES};
 use serde::Serialize;
 
 use super::config::{Nav1dConfig, Objective};
 use super::world::{run_chains, Condition, Environment, Side};
-use crate::common::{check_inputs, config_from_params, interrupted};
+use crate::common::{check_inputs, config_from_params};
+use crate::lanes::{by_block, by_pair, pairs};
 
 /// The fraction of scored trials a network must get right on fresh conditions to have solved its
 /// objective.
@@ -260,45 +258,35 @@ impl Nav1dTask {
             return Ok(vec![]);
         }
         let chains = self.chains(seed, generation);
-        let mut population = Population::new(networks)?;
-        let per_block = population
-            .blocks_mut()
-            .par_iter_mut()
-            .enumerate()
-            .map(|(b, block)| {
-                let mut sum = [0.0; LANES];
-                let mut count = 0usize;
-                for chain in &chains {
-                    if interrupted(cancel) {
-                        return Err(Error::Interrupted);
-                    }
-                    let outcome = run_chains(
-                        &self.config,
-                        block,
-                        [chain.as_slice(); LANES],
-                        true,
-                        |_, _, _| {},
-                    )
-                    .map_err(|d| d.error(b * LANES))?;
-                    for (t, condition) in chain.iter().enumerate() {
-                        let mut scored = false;
-                        for l in 0..LANES {
-                            let (r, c) = (outcome.reached[t][l], outcome.classification[t][l]);
-                            if let Some((score, _)) = self.judge(t, condition, r, c) {
-                                sum[l] += score;
-                                scored = true;
-                            }
+        by_block(
+            networks,
+            chains.len(),
+            cancel,
+            |len| ([0.0; LANES], 0usize, len),
+            |(sum, count, _), _, block, c| {
+                let chain = &chains[c];
+                let outcome = run_chains(
+                    &self.config,
+                    block,
+                    [chain.as_slice(); LANES],
+                    true,
+                    |_, _, _| {},
+                )?;
+                for (t, condition) in chain.iter().enumerate() {
+                    let mut scored = false;
+                    for l in 0..LANES {
+                        let (r, c) = (outcome.reached[t][l], outcome.classification[t][l]);
+                        if let Some((score, _)) = self.judge(t, condition, r, c) {
+                            sum[l] += score;
+                            scored = true;
                         }
-                        count += usize::from(scored);
                     }
+                    *count += usize::from(scored);
                 }
-                Ok(sum[..block.len()]
-                    .iter()
-                    .map(|s| s / count as f64)
-                    .collect::<Vec<f64>>())
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(per_block.concat())
+                Ok(())
+            },
+            |(sum, count, len)| sum[..len].iter().map(|s| s / count as f64).collect(),
+        )
     }
 
     /// Runs `net` through each of `chains` (all of the same length), [`LANES`] chains at a time in
@@ -329,39 +317,26 @@ impl Nav1dTask {
                 first.len()
             )));
         }
-        let pairs: Vec<(usize, usize)> = (0..nets.len())
-            .flat_map(|n| (0..chains.len()).map(move |e| (n, e)))
-            .collect();
-        let groups = pairs
-            .par_chunks(LANES)
-            .map(|group| {
-                if interrupted(cancel) {
-                    return Err(Error::Interrupted);
-                }
-                // Padding lanes repeat the group's last pair.
-                let pick = |l: usize| group[l.min(group.len() - 1)];
-                let refs: [&Network; LANES] = std::array::from_fn(|l| nets[pick(l).0]);
-                let mut lanes = Lanes::<LANES>::new(&refs)?;
-                let lane_chains = std::array::from_fn(|l| chains[pick(l).1].as_slice());
-                let outcome = run_chains(&self.config, &mut lanes, lane_chains, true, |_, _, _| {})
-                    .map_err(|d| d.error(group[0].0))?;
-                Ok(group
-                    .iter()
-                    .enumerate()
-                    .map(|(l, &(_, e))| {
-                        let chain = &chains[e];
-                        Episode {
-                            environment: chain.first().map_or(Environment::Far, |c| c.environment),
-                            conditions: chain.clone(),
-                            reached: outcome.reached.iter().map(|r| r[l]).collect(),
-                            classification: outcome.classification.iter().map(|c| c[l]).collect(),
-                        }
-                    })
-                    .collect::<Vec<_>>())
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(groups
-            .concat()
+        let pairs = pairs(nets.len(), chains.len());
+        let groups: Vec<&[(usize, usize)]> = pairs.chunks(LANES).collect();
+        let episodes = by_pair(nets, &groups, cancel, |lanes, lane_pairs, len| {
+            let lane_chains = lane_pairs.map(|(_, e)| chains[e].as_slice());
+            let outcome = run_chains(&self.config, lanes, lane_chains, true, |_, _, _| {})?;
+            Ok(lane_pairs[..len]
+                .iter()
+                .enumerate()
+                .map(|(l, &(_, e))| {
+                    let chain = &chains[e];
+                    Episode {
+                        environment: chain.first().map_or(Environment::Far, |c| c.environment),
+                        conditions: chain.clone(),
+                        reached: outcome.reached.iter().map(|r| r[l]).collect(),
+                        classification: outcome.classification.iter().map(|c| c[l]).collect(),
+                    }
+                })
+                .collect())
+        })?;
+        Ok(episodes
             .chunks(chains.len())
             .map(<[Episode]>::to_vec)
             .collect())
@@ -486,7 +461,7 @@ impl Nav1dTask {
                 (landmark, ticks) = (0.0, 0);
             },
         )
-        .map_err(|d| d.error(0))?;
+        .map_err(|d| d.error(|_| 0))?;
         rec.reached = outcome.reached.iter().map(|r| r[0]).collect();
         rec.classification = outcome.classification.iter().map(|c| c[0]).collect();
         lanes.lane_state(0, &mut rec.final_state);

@@ -2,13 +2,11 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{
-    Error, Lanes, Layout, Network, Population, Purpose, Result, Stream, Task, Validation, LANES,
-};
-use rayon::prelude::*;
+use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES};
 use serde::{Deserialize, Serialize};
 
-use crate::common::{check_inputs, interrupted};
+use crate::common::check_inputs;
+use crate::lanes::{by_block, by_pair, pairs};
 
 use super::config::*;
 use super::scoring::*;
@@ -176,46 +174,38 @@ impl SequenceTask {
                 .map(|t| self.timings(seed, generation, t))
                 .collect()
         };
-        let mut population = Population::new(networks)?;
-        let per_block = population
-            .blocks_mut()
-            .par_iter_mut()
-            .enumerate()
-            .map(|(b, block)| {
-                let first = b * LANES;
-                // Lane-major: [lane][trial][trigger].
-                let mut out = vec![0.0; block.len() * n_trials * k];
-                for t in 0..n_trials {
-                    if interrupted(cancel) {
-                        return Err(Error::Interrupted);
-                    }
-                    let own: Vec<Vec<(usize, usize)>>;
-                    let timings: [&[(usize, usize)]; LANES] = if config.independent_conditions {
-                        // Padding lanes repeat the block's first network, and its timings.
-                        own = (0..LANES)
-                            .map(|l| {
-                                let lane = if l < block.len() { l } else { 0 };
-                                self.timings_of(seed, generation, first + lane, t)
-                            })
-                            .collect();
-                        std::array::from_fn(|l| own[l].as_slice())
-                    } else {
-                        [common[t].as_slice(); LANES]
-                    };
-                    let bits = &self.bits[t / config.trials_per_target];
-                    let outcome = run_lanes(config, block, bits, timings, true, false, |_, _| {})
-                        .map_err(|d| d.error(first))?;
-                    for l in 0..block.len() {
-                        let at = (l * n_trials + t) * k;
-                        for (dst, r) in out[at..at + k].iter_mut().zip(&outcome.r) {
-                            *dst = r[l];
-                        }
+        // Lane-major within a block: [lane][trial][trigger].
+        let r = by_block(
+            networks,
+            n_trials,
+            cancel,
+            |len| vec![0.0; len * n_trials * k],
+            |out, first, block, t| {
+                let own: Vec<Vec<(usize, usize)>>;
+                let timings: [&[(usize, usize)]; LANES] = if config.independent_conditions {
+                    // Padding lanes repeat the block's first network, and its timings.
+                    own = (0..LANES)
+                        .map(|l| {
+                            let lane = if l < block.len() { l } else { 0 };
+                            self.timings_of(seed, generation, first + lane, t)
+                        })
+                        .collect();
+                    std::array::from_fn(|l| own[l].as_slice())
+                } else {
+                    [common[t].as_slice(); LANES]
+                };
+                let bits = &self.bits[t / config.trials_per_target];
+                let outcome = run_lanes(config, block, bits, timings, true, false, |_, _| {})?;
+                for l in 0..block.len() {
+                    let at = (l * n_trials + t) * k;
+                    for (dst, r) in out[at..at + k].iter_mut().zip(&outcome.r) {
+                        *dst = r[l];
                     }
                 }
-                Ok(out)
-            })
-            .collect::<Result<Vec<Vec<f64>>>>()?;
-        let r = per_block.concat();
+                Ok(())
+            },
+            |out| out,
+        )?;
         let mean_r: Vec<f64> = r.chunks(k).map(mean).collect();
         let base = self.bases(&mean_r);
         let fitness = mean_r
@@ -364,7 +354,7 @@ impl SequenceTask {
                 outputs.push(rates);
             },
         )
-        .map_err(|d| d.error(0))?;
+        .map_err(|d| d.error(|_| 0))?;
         let targets: Vec<u8> = (0..timing.len()).map(|k| bits[k % bits.len()]).collect();
         let r: Vec<f64> = outcome.r.iter().map(|x| x[0]).collect();
         let mean_output: Vec<f64> = outcome.mean_output.iter().map(|x| x[0]).collect();
@@ -467,41 +457,20 @@ impl SequenceTask {
             let timings: Vec<Vec<(usize, usize)>> = (0..per_target)
                 .map(|j| self.fresh_timings(purpose, seed, i * per_target + j))
                 .collect();
-            let pairs: Vec<(usize, usize)> = (0..nets.len())
-                .flat_map(|n| (0..per_target).map(move |j| (n, j)))
-                .collect();
-            let groups = pairs
-                .par_chunks(LANES)
-                .map(|group| {
-                    if interrupted(cancel) {
-                        return Err(Error::Interrupted);
-                    }
-                    // Padding lanes repeat the group's first pair.
-                    let pick = |l: usize| group[if l < group.len() { l } else { 0 }];
-                    let refs: [&Network; LANES] = std::array::from_fn(|l| nets[pick(l).0]);
-                    let lane_timings = std::array::from_fn(|l| timings[pick(l).1].as_slice());
-                    let mut lanes = Lanes::<LANES>::new(&refs)?;
-                    let outcome = run_lanes(
-                        config,
-                        &mut lanes,
-                        bits,
-                        lane_timings,
-                        true,
-                        false,
-                        |_, _| {},
-                    )
-                    .map_err(|d| d.error(group[0].0))?;
-                    Ok((0..group.len())
-                        .map(|l| {
-                            let r: Vec<f64> = outcome.r.iter().map(|x| x[l]).collect();
-                            let ok = (from..config.triggers)
-                                .all(|k| correct(bits[k % bits.len()], outcome.mean_output[k][l]));
-                            (performance(&r, base), ok)
-                        })
-                        .collect::<Vec<_>>())
-                })
-                .collect::<Result<Vec<_>>>()?;
-            let judged = groups.concat();
+            let pairs = pairs(nets.len(), per_target);
+            let groups: Vec<&[(usize, usize)]> = pairs.chunks(LANES).collect();
+            let judged = by_pair(nets, &groups, cancel, |lanes, lane_pairs, len| {
+                let lane_timings = lane_pairs.map(|(_, j)| timings[j].as_slice());
+                let outcome = run_lanes(config, lanes, bits, lane_timings, true, false, |_, _| {})?;
+                Ok((0..len)
+                    .map(|l| {
+                        let r: Vec<f64> = outcome.r.iter().map(|x| x[l]).collect();
+                        let ok = (from..config.triggers)
+                            .all(|k| correct(bits[k % bits.len()], outcome.mean_output[k][l]));
+                        (performance(&r, base), ok)
+                    })
+                    .collect())
+            })?;
             for (n, trials) in judged.chunks(per_target).enumerate() {
                 out[n].push(trials.to_vec());
             }

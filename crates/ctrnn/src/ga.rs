@@ -74,13 +74,7 @@ impl FromStr for Selection {
 
     /// Parses `"proportional"` or `"rank"`.
     fn from_str(s: &str) -> Result<Self> {
-        match s {
-            "proportional" => Ok(Selection::Proportional),
-            "rank" => Ok(Selection::Rank),
-            _ => Err(Error::Config(format!(
-                "selection is \"{s}\"; it must be \"proportional\" or \"rank\""
-            ))),
-        }
+        crate::names::parse_name("selection", s).map_err(Error::Config)
     }
 }
 

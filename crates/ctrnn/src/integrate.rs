@@ -45,13 +45,7 @@ pub enum Method {
 impl std::str::FromStr for Method {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        match s {
-            "euler" => Ok(Method::Euler),
-            "rk4" => Ok(Method::Rk4),
-            _ => Err(Error::InvalidArgument(format!(
-                "method is {s:?}; expected \"euler\" or \"rk4\""
-            ))),
-        }
+        crate::names::parse_name("method", s).map_err(Error::InvalidArgument)
     }
 }
 

@@ -22,6 +22,7 @@ pub mod genome;
 pub mod integrate;
 pub mod io;
 pub mod math;
+pub mod names;
 pub mod network;
 pub mod population;
 pub mod rng;

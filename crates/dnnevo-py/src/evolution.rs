@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex};
 
 use ctrnn::evolve::Stats;
 use ctrnn::genome::{self, Layout};
+use ctrnn::names::parse_name;
 use ctrnn::{Evolution, Fill, GaConfig, Task};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -98,15 +99,7 @@ impl PyEvolution {
         let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
         let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
         let config = config_from_json(config)?;
-        let fill = match fill {
-            "mutants" => Fill::Mutants,
-            "random" => Fill::Random,
-            other => {
-                return Err(ConfigError::new_err(format!(
-                    "fill is {other:?}; expected \"mutants\" or \"random\""
-                )))
-            }
-        };
+        let fill: Fill = parse_name("fill", fill).map_err(ConfigError::new_err)?;
         let seeds = match seeds.filter(|s| !s.is_none()) {
             Some(s) if s.len()? > 0 => networks_from(s)?,
             _ => Vec::new(),

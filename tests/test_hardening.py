@@ -284,7 +284,7 @@ def test_sweep_force_clears_the_old_sweeps_other_seeds(pristine: Path, tmp_path:
     assert r.returncode == 0, r.stderr
     # Seed 7 was the old sweep's alone and is gone; seed 8 keeps only what was not dnnevo's.
     assert sorted(p.name for p in out.iterdir()) == [".dnnevo.lock", "seed-0", "seed-8", "summary.csv",
-                                                      "summary.json"]
+                                                      "summary.json", "sweep.json"]
     assert sorted(p.name for p in (out / "seed-8").iterdir()) == [".dnnevo.lock", "notes.txt"]
     assert "old" not in (out / "summary.csv").read_text()
 

@@ -5,16 +5,21 @@ conditions, and the statistics of :mod:`dnnevo.sweep` printed and written to ``s
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import shutil
 from pathlib import Path
+from typing import Any
 
 from dnnevo import presets, seeding, sweep
 from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
-from dnnevo.rundir import LOCK_NAME, RunDir
+from dnnevo.rundir import LOCK_NAME, RunDir, RunFileError, first_difference, short, write_atomic
+
+SETTINGS_FILE = "sweep.json"
+"""The settings a sweep folder was begun with, so that running the command again continues it."""
 
 EXAMPLE = """examples:
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
@@ -29,9 +34,13 @@ champions (best.json) that pass on fresh conditions from seed BASE + seed (--eva
 'dnnevo evaluate' judges. Each final champion is also judged on the same conditions at a 10x
 finer step and with RK4 ('dnnevo evaluate --dt-check'); one that fails there where it did not at
 the run's step is counted as a step artefact (--no-dt-check skips the check). Writes
-OUT/summary.csv (a row per seed, then a row 'all') and OUT/summary.json. --force starts the sweep
-afresh: the old summary goes, and so do the old sweep's seed-N run folders (files dnnevo did not
-write are kept)."""
+OUT/summary.csv (a row per seed, then a row 'all') and OUT/summary.json.
+
+A sweep records its settings in OUT/sweep.json first. Running the same command again continues
+it: finished seeds are judged again without evolving, stopped ones resume from their checkpoints,
+and seeds not yet begun are run; more seeds may be added. Other settings are refused, naming the
+first that differs. --force starts the sweep afresh: the old summary goes, and so do the old
+sweep's seed-N run folders (files dnnevo did not write are kept)."""
 
 
 def sweep_command(args: argparse.Namespace) -> int:
@@ -41,11 +50,37 @@ def sweep_command(args: argparse.Namespace) -> int:
         raise ConfigError(f"task {config.task!r} has no success rule, so a sweep cannot judge it")
     for seed in args.seeds:  # before any run, so a bad --eval-seed costs nothing
         nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
+    trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
+    how = seeding.Seeding.from_args(args)
+    settings = {"preset": args.preset, "eval_seed": args.eval_seed, "eval_trials": trials,
+                "dt_check": args.dt_check, "seeding": how.info() if how else None,
+                "config": config.to_dict()}
+    manifest = args.out / SETTINGS_FILE
     with RunDir(args.out).writing(create=True) as folder:
-        folder.create(force=args.force, extra=sweep.SUMMARY_FILES)
-        if args.force:
-            _clear_other_seeds(args.out, args.seeds)
-        return _sweep(args, config)
+        resuming = not args.force and (manifest.exists() or manifest.is_symlink())
+        if resuming:
+            _check_settings(manifest, settings)
+        else:
+            folder.create(force=args.force, extra=(*sweep.SUMMARY_FILES, SETTINGS_FILE))
+            if args.force:
+                _clear_other_seeds(args.out, args.seeds)
+            write_atomic(manifest, json.dumps(settings, indent=1) + "\n")
+        return _sweep(args, config, how, trials, resuming)
+
+
+def _check_settings(manifest: Path, settings: dict[str, Any]) -> None:
+    """The folder's sweep.json must hold this command's settings (any seeds)."""
+    try:
+        found = json.loads(manifest.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise RunFileError(f"{manifest}: unreadable ({e}); pass --force to start the sweep afresh") from None
+    if not isinstance(found, dict):
+        raise RunFileError(f"{manifest}: expected a JSON object of settings; pass --force to start afresh")
+    diff = first_difference(found, json.loads(json.dumps(settings)))
+    if diff is not None:
+        raise ConfigError(
+            f"{manifest.parent} holds a sweep with {diff[0]} = {short(diff[1])}, not {short(diff[2])}; "
+            "run the same command to continue it, or choose another --out, or pass --force")
 
 
 def _clear_other_seeds(out: Path, seeds: list[int]) -> None:
@@ -63,14 +98,21 @@ def _clear_other_seeds(out: Path, seeds: list[int]) -> None:
             shutil.rmtree(p)
 
 
-def _sweep(args: argparse.Namespace, config: EvolutionConfig) -> int:
-    trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
-    how = seeding.Seeding.from_args(args)
+def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seeding | None,
+           trials: int, resuming: bool) -> int:
     runs = []
     for seed in args.seeds:
-        result = sweep.run_seed(config, seed, args.out / f"seed-{seed}", threads=args.threads,
-                                force=args.force, eval_seed_base=args.eval_seed, eval_trials=trials,
-                                dt_check=args.dt_check, seeding=how)
+        out = args.out / f"seed-{seed}"
+        resume = resuming and (out / "checkpoint.json").exists()
+        if resume:
+            done = len(RunDir(out).read_checkpoint().history)
+            print(f"seed {seed}: " + ("finished; judging its champion again" if done >= config.generations
+                                      else f"resuming at generation {done}"))
+        # A seed folder without a checkpoint holds no run yet: it starts afresh.
+        result = sweep.run_seed(config, seed, out, threads=args.threads,
+                                force=args.force or (resuming and not resume),
+                                eval_seed_base=args.eval_seed, eval_trials=trials,
+                                dt_check=args.dt_check, seeding=how, resume=resume)
         runs.append(result)
         if result.interrupted:
             break
@@ -81,7 +123,8 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig) -> int:
     paths = summary.write(args.out, info)
     print("\n".join(lines(summary, args.eval_seed, trials, UNITS[config.task])))
     if runs[-1].interrupted:
-        print(f"interrupted during seed {runs[-1].seed}; the statistics cover the {len(runs)} seed(s) run")
+        print(f"interrupted during seed {runs[-1].seed}; the statistics cover the {len(runs)} seed(s) run; "
+              "run the same command again to continue the sweep")
     print(f"wrote {', '.join(map(str, paths))}")
     return 0
 

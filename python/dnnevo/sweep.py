@@ -34,7 +34,7 @@ from dnnevo import stats
 from dnnevo.assess import Assessment, assess
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
-from dnnevo.rundir import RunDir, write_atomic
+from dnnevo.rundir import RunDir, RunFileError, first_difference, short, write_atomic
 from dnnevo.seeding import Seeding
 from dnnevo.stats import Verdict
 from dnnevo.stepcheck import StepCheck, step_check
@@ -104,21 +104,35 @@ class SeedResult:
 def run_seed(
     config: EvolutionConfig, seed: int, out: Path, *, threads: int | None = None, force: bool = False,
     eval_seed_base: int = EVAL_SEED_BASE, eval_trials: int | None = None, dt_check: bool = True,
-    seeding: Seeding | None = None,
+    seeding: Seeding | None = None, resume: bool = False,
 ) -> SeedResult:
     """Runs ``config`` with ``seed`` into ``out``, then judges the final champion (``out /
     best.json``) on fresh conditions from :func:`eval_seed` with ``eval_trials`` (default: the
     task's :data:`~dnnevo.assess.DEFAULT_TRIALS`), and, with ``dt_check``, checks it at finer
     steps on the same conditions (:func:`~dnnevo.stepcheck.step_check`). With ``seeding`` the
-    first population starts from earlier runs' networks (:mod:`dnnevo.seeding`)."""
+    first population starts from earlier runs' networks (:mod:`dnnevo.seeding`). With ``resume``
+    the run in ``out`` (same config and seed, else a :class:`RunFileError`) is continued from its
+    checkpoint, or only judged if it has finished; its wall time then counts every session."""
     from dnnevo.evolve import evolve
+    from dnnevo.evolve import resume as resume_run
 
     t0 = time.perf_counter()
-    seeds = seeding.networks(config.size, seed) if seeding else None
-    info = seeding.info() if seeding else None
-    result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force,
-                    seeds=seeds, run_info=info)
-    wall = time.perf_counter() - t0
+    if resume:
+        found, table = RunDir(out).read_config()
+        diff = first_difference(config.to_dict(), found.to_dict())
+        if diff is None and table.get("seed") != seed:
+            diff = ("run.seed", seed, table.get("seed", "(missing)"))
+        if diff is not None:
+            raise RunFileError(f"{out}: the run's {diff[0]} is {short(diff[2])}; this sweep's is "
+                               f"{short(diff[1])}")
+        result = resume_run(out, threads=threads)
+        wall = float(result.history["elapsed_s"][-1]) if len(result.history["elapsed_s"]) else 0.0
+    else:
+        seeds = seeding.networks(config.size, seed) if seeding else None
+        info = seeding.info() if seeding else None
+        result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force,
+                        seeds=seeds, run_info=info)
+        wall = time.perf_counter() - t0
     champion = RunDir(out).read_best(config, {"seed": seed})
     fresh = eval_seed(seed, eval_seed_base)
     final = assess(config, champion, eval_trials, seed=fresh)

@@ -1,0 +1,60 @@
+"""``dnnevo sweep`` run again on its folder continues the sweep, with the same results as a sweep
+that was never stopped, and refuses other settings."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from cli_helpers import assert_one_line_error, run_cli
+
+import dnnevo
+from dnnevo import presets
+
+OVERRIDES = ["population=12", "generations=8"]
+ARGS = ["sequence-1bit", "--quick", *(a for o in OVERRIDES for a in ("--set", o)),
+        "--eval-trials", "5", "--no-dt-check"]
+
+
+def sweep(out: Path, seeds: str) -> str:
+    r = run_cli("sweep", *ARGS, "--seeds", seeds, "--out", out)
+    assert r.returncode == 0, r.stderr
+    return r.stdout
+
+
+def results(out: Path) -> list[dict[str, Any]]:
+    """summary.json's seeds without their wall times, which differ from run to run."""
+    runs = json.loads((out / "summary.json").read_text())["runs"]
+    return [{k: v for k, v in r.items() if k != "wall_s"} for r in runs]
+
+
+def test_a_stopped_sweep_continues_to_the_same_results(tmp_path: Path) -> None:
+    whole = tmp_path / "whole"
+    sweep(whole, "0-2")
+    # A sweep stopped during seed 1: seed 0 finished, seed 1 at generation 3 of 8, seed 2 not begun.
+    parts = tmp_path / "parts"
+    sweep(parts, "0")
+    config = presets.get("sequence-1bit", quick=True, overrides=OVERRIDES)
+    dnnevo.evolve(config.task, config, seed=1, out=parts / "seed-1", progress=False,
+                  callback=lambda stats, ga: ga.generation >= 3)
+    assert len(dnnevo.rundir.RunDir(parts / "seed-1").read_checkpoint().history) == 3
+    printed = sweep(parts, "0-2")
+    assert "seed 0: finished; judging its champion again" in printed
+    assert "seed 1: resuming at generation 3" in printed
+    assert results(parts) == results(whole)
+    for seed in range(3):
+        best = f"seed-{seed}/best.json"
+        assert (parts / best).read_bytes() == (whole / best).read_bytes()
+
+
+def test_other_settings_are_refused_in_one_line(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    sweep(out, "0")
+    r = run_cli("sweep", *ARGS, "--set", "elitism=2", "--seeds", "0", "--out", out)
+    assert_one_line_error(r, "holds a sweep with config.elitism = 0, not 2")
+    (out / "sweep.json").write_text("{not json")
+    assert_one_line_error(run_cli("sweep", *ARGS, "--seeds", "0", "--out", out), "sweep.json: unreadable")
+    # --force starts afresh whatever the folder held.
+    assert run_cli("sweep", *ARGS, "--set", "elitism=2", "--seeds", "0", "--out", out, "--force").returncode == 0
+    assert json.loads((out / "sweep.json").read_text())["config"]["elitism"] == 2

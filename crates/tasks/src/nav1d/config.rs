@@ -4,7 +4,7 @@
 use ctrnn::{Error, Integrator, Method, Result};
 use serde::{Deserialize, Serialize};
 
-use super::world::Environment;
+use super::environment::Environment;
 
 /// What an evaluation scores.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

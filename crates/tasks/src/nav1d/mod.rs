@@ -36,14 +36,16 @@
 //! ```
 
 mod config;
+mod environment;
 mod system;
 mod task;
 pub mod world;
 
 pub use config::{Nav1dConfig, Objective, World};
+pub use environment::Environment;
 pub use system::{Part, System, SystemAssessment, SystemEpisode};
 pub use task::{Assessment, Episode, Nav1dTask, Record, SUCCESS_CHAINS, SUCCESS_RATE};
-pub use world::{Condition, Environment, Side};
+pub use world::{Condition, Side};
 
 #[cfg(test)]
 mod tests;

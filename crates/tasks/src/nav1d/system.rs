@@ -9,8 +9,9 @@ use ctrnn::{Error, Network, Result};
 use serde::Serialize;
 
 use super::config::{Nav1dConfig, Objective};
+use super::environment::Environment;
 use super::task::{Nav1dTask, Record};
-use super::world::{Condition, Environment};
+use super::world::Condition;
 
 /// One subnetwork of the system: its task (which says which neurons are its motors) and itself.
 #[derive(Clone, Debug)]

@@ -7,7 +7,8 @@ use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Valida
 use serde::Serialize;
 
 use super::config::{Nav1dConfig, Objective};
-use super::world::{run_chains, Condition, Environment, Side};
+use super::environment::Environment;
+use super::world::{run_chains, Condition, Side};
 use crate::common::{check_inputs, config_from_params};
 use crate::lanes::{by_block, by_pair, pairs};
 

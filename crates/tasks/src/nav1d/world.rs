@@ -28,17 +28,8 @@ use ctrnn::{Integrator, Lanes, Stream};
 use serde::{Deserialize, Serialize};
 
 use super::config::Nav1dConfig;
+use super::environment::Environment;
 use crate::common::Diverged;
-
-/// Where the landmark is relative to the goal.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Environment {
-    /// The landmark is on the other side of the start from the goal.
-    Far,
-    /// The landmark is on the goal's side.
-    Near,
-}
 
 /// One end of the line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

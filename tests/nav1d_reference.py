@@ -1,6 +1,6 @@
 """An independent, plain NumPy reference for a chain of one-dimensional navigation trials (paper §4).
 
-Written from the task's description (READING.md, "The network" and "One-dimensional
+Written from the task's description (docs/paper.md, "The network" and "One-dimensional
 navigation"), not from the Rust code, so that tests can check dnnevo against a second
 implementation. It does not import dnnevo.
 
@@ -54,7 +54,7 @@ DEFAULTS = {
     "right_motor": 1,
     "classifier": 2,
 }
-"""The task's defaults (READING.md), used for any key ``params`` leaves out."""
+"""The task's defaults (docs/paper.md), used for any key ``params`` leaves out."""
 
 
 def rate(x):

@@ -1,6 +1,6 @@
 """An independent, plain NumPy reference for the CTRNN equation of dnnevo.
 
-Written straight from the model (docs / READING.md, "The network"), not from the Rust code, so
+Written straight from the model (docs/paper.md, "The network"), not from the Rust code, so
 that the tests can check dnnevo against a second implementation. It does not import dnnevo.
 
 The model, for N neurons and M sensors::

@@ -1,6 +1,6 @@
 """An independent, plain NumPy reference for one trial of the sequence-learning task (paper §5).
 
-Written from the task's description (READING.md, "The network" and "Sequence learning"), not
+Written from the task's description (docs/paper.md, "The network" and "Sequence learning"), not
 from the Rust code, so that tests and benchmarks can check dnnevo against a second
 implementation. It does not import dnnevo.
 

@@ -23,7 +23,7 @@ from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 RAY_TOL = 1e-4
 """parry2d casts rays in f32: distances of a few metres carry an error of about 1e-6 m."""
 RADIUS = 0.265
-"""The Nomad 200's radius (READING.md: a disc about 0.53 m across)."""
+"""The Nomad 200's radius (docs/paper.md: a disc about 0.53 m across)."""
 D0 = 0.5
 """The sonar input is min(1, D0 / range)."""
 MAX_RANGE = 6.5

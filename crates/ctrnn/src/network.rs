@@ -1,6 +1,7 @@
 //! A continuous-time recurrent neural network: its parameters, its state, and their validation.
 //!
-//! The model (paper §2.1, with the sigmoid misprint corrected as in READING.md) is
+//! The model (paper §2.1, with the sigmoid misprint corrected as in `docs/paper.md`, "The
+//! network") is
 //!
 //! ```text
 //! tau_i dv_i/dt = -v_i + sum_j weights[i][j] f(v_j - theta_j) + sum_k sensor_weights[i][k] I_k

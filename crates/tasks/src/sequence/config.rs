@@ -81,7 +81,7 @@ impl<'de> Deserialize<'de> for PerfBase {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Clamp {
-    /// Per trial, then averaged: READING.md's formula. An output stuck at 0 scores 1 on every
+    /// Per trial, then averaged: the formula of `docs/paper.md`, "Sequence learning". An output stuck at 0 scores 1 on every
     /// 0* trial and 0 on every 1* trial, so 0.5 on B = {0*, 1*}.
     #[default]
     Trial,

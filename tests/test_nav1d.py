@@ -6,7 +6,6 @@ command line, and the errors.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
@@ -17,22 +16,14 @@ from hypothesis import strategies as st
 
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
+import nav1d_reference as ref
+
 import dnnevo
 from dnnevo.stats import wilson
 from dnnevo import assess, nav1d, presets
 from dnnevo.config import apply_overrides
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 
-
-def _load_reference():
-    path = Path(__file__).with_name("nav1d_reference.py")
-    spec = importlib.util.spec_from_file_location("dnnevo_tests_nav1d_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-ref = _load_reference()
 
 TOL = dict(rtol=1e-9, atol=1e-9)
 PRESETS = ["nav1d-far", "nav1d-near", "nav1d-classifier"]
@@ -442,8 +433,6 @@ def reference_system(parts, conditions, persist):
 
 
 # -- the command line, end to end --------------------------------------------------------------
-
-
 
 
 @pytest.fixture(scope="module")

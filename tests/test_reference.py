@@ -7,9 +7,7 @@ Runs are kept short enough (a few hundred steps) that rounding differences canno
 
 from __future__ import annotations
 
-import importlib.util
 import itertools
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,19 +15,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
+import reference as ref
+
 import dnnevo
 
-
-
-def _load_reference():
-    path = Path(__file__).with_name("reference.py")
-    spec = importlib.util.spec_from_file_location("dnnevo_tests_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-ref = _load_reference()
 
 TOL = dict(rtol=1e-12, atol=1e-12)
 SIZES = [1, 2, 5, 10, 30]
@@ -37,7 +26,7 @@ N_INPUTS = [0, 1, 3]
 METHODS = ["euler", "rk4"]
 SUBSTEPS = [1, 5]
 T = 40  # input rows per run
-P = 11  # networks per population: more than one block of 8, with a remainder
+P = dnnevo.LANES + 3  # networks per population: more than one block, with a ragged remainder
 
 
 # ---------------------------------------------------------------------------------------------
@@ -45,7 +34,7 @@ P = 11  # networks per population: more than one block of 8, with a remainder
 
 
 def random_arrays(rng, n, m, *, state=True):
-    """Parameters drawn uniformly over the READING.md ranges, plus a random start state."""
+    """Parameters drawn uniformly over the ranges of docs/paper.md, plus a random start state."""
     return dict(
         tau=rng.uniform(0.5, 10.0, n),
         theta=rng.uniform(-16.0, 16.0, n),

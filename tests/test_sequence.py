@@ -6,25 +6,15 @@ One trial (R values and the output trace), the trial timings, the batched fitnes
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+import sequence_reference as ref
+
 import dnnevo
 import dnnevo.sequence as seq
 
-
-def _load_reference():
-    path = Path(__file__).with_name("sequence_reference.py")
-    spec = importlib.util.spec_from_file_location("dnnevo_tests_sequence_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-ref = _load_reference()
 
 TOL = 1e-9
 

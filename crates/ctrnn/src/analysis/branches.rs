@@ -24,9 +24,9 @@ use std::sync::atomic::AtomicBool;
 
 use serde::Serialize;
 
-use super::bifurcation::{At, Event, EventKind};
 use super::cycles::{follow, same_cycle, Cycle, CycleSearch};
 use super::equilibria::newton;
+use super::events::{At, Event, EventKind};
 use crate::error::Result;
 
 /// Bisection steps that locate a lost cycle's end between two input values.

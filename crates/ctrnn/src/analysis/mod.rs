@@ -29,14 +29,16 @@ mod bifurcation;
 mod branches;
 mod cycles;
 mod equilibria;
+mod events;
 mod field;
 mod stability;
 #[cfg(test)]
 mod tests;
 
-pub use bifurcation::{bifurcation, Bifurcation, Event, EventKind, Sweep, CRITICAL};
+pub use bifurcation::{bifurcation, Bifurcation, Sweep};
 pub use branches::{CycleBranch, CycleEnd, CycleEndKind, CYCLE_BISECTIONS};
 pub use cycles::{limit_cycles, Cycle, CycleSearch, TRIVIAL_MULTIPLIER};
 pub use equilibria::{equilibria, Equilibrium, EquilibriumSearch, RETRY_STARTS};
+pub use events::{Event, EventKind, CRITICAL};
 pub use field::{jacobian, vector_field};
 pub use stability::{Stability, MARGINAL};

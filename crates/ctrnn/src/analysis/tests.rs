@@ -527,7 +527,7 @@ fn a_cycle_branch_is_followed_and_one_lost_is_located_by_bisection() {
     let branch = &b.branches[0];
     let last = b.values[branch.last];
     let settings = cycle_sweep(0.0, 2.0, 24).cycles.unwrap();
-    let at = super::bifurcation::At::new(&net, &[0.0], 0, EquilibriumSearch::default());
+    let at = super::events::At::new(&net, &[0.0], 0, EquilibriumSearch::default());
     let end = super::branches::locate(
         &at,
         &settings,

@@ -159,7 +159,8 @@ impl LandmarkConfig {
                 return config(format!("{name} is {value}; it must be in [0, {hi}]"));
             }
         }
-        self.training.validate(self)?;
+        self.training.validate()?;
+        self.validate_training()?;
         self.integrator.validate().map_err(|e| match e {
             Error::InvalidArgument(msg) => Error::Config(format!("integrator: {msg}")),
             other => other,
@@ -171,6 +172,51 @@ impl LandmarkConfig {
             longest as u128,
             self.integrator.substeps,
         )
+    }
+
+    /// How `training`'s ranges fit the rest of the config: trial counts and lengths, robot-like
+    /// training, and a follower and sonar that stay valid at both ends of the ranges.
+    fn validate_training(&self) -> Result<()> {
+        let t = &self.training;
+        let err = |msg: String| Err(Error::Config(format!("training.{msg}")));
+        if t.ideal_trials_per_landmark > self.trials_per_landmark {
+            return err(format!(
+                "ideal_trials_per_landmark is {}; it must be at most trials_per_landmark ({})",
+                t.ideal_trials_per_landmark, self.trials_per_landmark
+            ));
+        }
+        if t.trial_seconds >= self.trial_seconds {
+            return err(format!(
+                "trial_seconds is {}; it must be below the trial's own length, trial_seconds ({})",
+                t.trial_seconds, self.trial_seconds
+            ));
+        }
+        if t.is_off() {
+            return Ok(());
+        }
+        if self.train_robot_like {
+            return Err(Error::Config(
+                "training varies the training trials, and train_robot_like is true; training is \
+                 either robot-like or varied, so set train_robot_like = false or leave training \
+                 empty"
+                    .into(),
+            ));
+        }
+        // The follower and the sonar must be valid at both ends of their ranges.
+        for sign in [-1.0, 1.0] {
+            let mut sim = self.sim.clone();
+            sim.follower.wall_distance += sign * t.follower_distance;
+            sim.follower.speed *= 1.0 + sign * t.follower_speed;
+            sim.sonars[0].cone_deg += sign * t.cone_deg;
+            if let Err(e) = sim.validate() {
+                return err(format!(
+                    "follower_distance, follower_speed or cone_deg reach too far: at their {} \
+                     end, {e}",
+                    if sign < 0.0 { "lower" } else { "upper" }
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Robot steps per trial: `trial_seconds / sim.dt`, rounded.

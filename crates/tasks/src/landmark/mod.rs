@@ -33,6 +33,7 @@
 mod config;
 mod task;
 mod training;
+mod trials;
 
 pub use config::{LandmarkConfig, RobotLike};
 pub use task::{

@@ -15,7 +15,8 @@ use pyo3::types::{PyAny, PyDict};
 use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FitnessError, IntoPy};
-use crate::network::{networks_from, PyNetwork};
+use crate::network::PyNetwork;
+use crate::population::networks_from;
 
 /// The GA's state: population, generation and champion. See `dnnevo.GeneticAlgorithm`.
 #[pyclass(module = "dnnevo._core", name = "Evolution")]

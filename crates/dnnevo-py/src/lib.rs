@@ -12,6 +12,8 @@ mod json;
 mod landmark;
 mod nav1d;
 mod network;
+mod population;
+mod pyjson;
 mod sequence;
 
 use pyo3::prelude::*;
@@ -42,7 +44,9 @@ mod _core {
         nav1d_system_assess, nav1d_system_record,
     };
     #[pymodule_export]
-    use super::network::{compose, run_population, PyNetwork, PyTrace};
+    use super::network::{compose, PyNetwork, PyTrace};
+    #[pymodule_export]
+    use super::population::run_population;
     #[pymodule_export]
     use super::sequence::{sequence_assess, sequence_timings, sequence_trial};
 

@@ -1,0 +1,177 @@
+//! Populations from Python (a sequence of Networks, or stacked parameter arrays) and
+//! `dnnevo.run_population`.
+
+use ctrnn::{Inputs, Population};
+use numpy::PyArrayDyn;
+use pyo3::prelude::*;
+use pyo3::types::{PyAny, PyDict};
+
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, AnyInt, Dense};
+use crate::detach::detached;
+use crate::errors::IntoPy;
+use crate::network::PyNetwork;
+use crate::network::{integrator, net_err};
+
+/// Extracts a population: a sequence of Networks, or a dict of stacked parameter arrays.
+pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
+    if let Ok(d) = obj.cast::<PyDict>() {
+        return stacked(d);
+    }
+    Ok(network_objects(obj)?
+        .iter()
+        .map(|net| net.inner.clone())
+        .collect())
+}
+
+/// Packs a population for the integrator straight from its Python form (as [`networks_from`]),
+/// without copying each `Network` first.
+fn population_from(obj: &Bound<'_, PyAny>) -> PyResult<Population> {
+    if let Ok(d) = obj.cast::<PyDict>() {
+        return Population::new(&stacked(d)?).py_err();
+    }
+    let objects = network_objects(obj)?;
+    let refs: Vec<&ctrnn::Network> = objects.iter().map(|net| &net.inner).collect();
+    Population::new(&refs).py_err()
+}
+
+/// Borrows every item of a non-empty sequence of Networks.
+fn network_objects<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Vec<PyRef<'py, PyNetwork>>> {
+    let mut nets = Vec::new();
+    for (p, item) in obj
+        .try_iter()
+        .map_err(|_| arg_err("networks must be a sequence of Network or a dict of arrays".into()))?
+        .enumerate()
+    {
+        let item = item?;
+        let net = item.cast::<PyNetwork>().map_err(|_| {
+            arg_err(format!(
+                "networks[{p}] is a {}; expected a dnnevo.Network",
+                item.get_type()
+                    .name()
+                    .map(|n| n.to_string())
+                    .unwrap_or_default()
+            ))
+        })?;
+        nets.push(net.borrow());
+    }
+    if nets.is_empty() {
+        return Err(arg_err(
+            "networks is empty; expected at least 1 network".into(),
+        ));
+    }
+    Ok(nets)
+}
+
+/// A population from stacked arrays: tau (P, N), theta (P, N), weights (P, N, N),
+/// sensor_weights (P, N, M) and optionally state (P, N).
+fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
+    const KEYS: [&str; 5] = ["tau", "theta", "weights", "sensor_weights", "state"];
+    for key in d.keys() {
+        let name = key.str()?.to_string();
+        if !key.is_instance_of::<pyo3::types::PyString>() || !KEYS.contains(&name.as_str()) {
+            return Err(net_err(format!(
+                "the dict has an unknown key {}; expected {}",
+                key.repr()?,
+                KEYS.join(", ")
+            )));
+        }
+    }
+    let get = |key: &str, ndim: usize, shape: &str| -> PyResult<Option<Dense>> {
+        match d.get_item(key)? {
+            None => Ok(None),
+            Some(v) => {
+                let x = dense(&v, key, net_err)?;
+                x.expect_ndim(ndim, key, shape, net_err)?;
+                Ok(Some(x))
+            }
+        }
+    };
+    let need = |key: &str, ndim: usize, shape: &str| -> PyResult<Dense> {
+        get(key, ndim, shape)?
+            .ok_or_else(|| net_err(format!("the dict has no {key:?} array; expected {shape}")))
+    };
+    let tau = need("tau", 2, "(P, N)")?;
+    let (p_len, n) = (tau.shape[0], tau.shape[1]);
+    let theta = need("theta", 2, "(P, N)")?;
+    let weights = need("weights", 3, "(P, N, N)")?;
+    let sensor = need("sensor_weights", 3, "(P, N, M)")?;
+    let state = get("state", 2, "(P, N)")?;
+    let m = sensor.shape[2];
+    let check = |x: &Dense, key: &str, want: &[usize]| -> PyResult<()> {
+        if x.shape == want {
+            Ok(())
+        } else {
+            Err(net_err(format!(
+                "{key} has shape {}; expected {}",
+                shape_str(&x.shape),
+                shape_str(want)
+            )))
+        }
+    };
+    check(&theta, "theta", &[p_len, n])?;
+    check(&weights, "weights", &[p_len, n, n])?;
+    check(&sensor, "sensor_weights", &[p_len, n, m])?;
+    if let Some(s) = &state {
+        check(s, "state", &[p_len, n])?;
+    }
+    (0..p_len)
+        .map(|p| {
+            let row = |x: &Dense, len: usize| x.data[p * len..(p + 1) * len].to_vec();
+            ctrnn::Network::new(
+                row(&tau, n),
+                row(&theta, n),
+                row(&weights, n * n),
+                row(&sensor, n * m),
+                state.as_ref().map(|s| row(s, n)),
+            )
+            .map_err(|e| {
+                net_err(format!(
+                    "network {p}: {}",
+                    e.to_string().trim_start_matches("invalid network: ")
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Integrates P networks of the same shape together; see `dnnevo.run_population`.
+#[pyfunction]
+#[pyo3(signature = (networks, inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", record=true), text_signature = "(networks, inputs, *, dt=0.1, substeps=1, method='euler', record=True)")]
+pub fn run_population<'py>(
+    py: Python<'py>,
+    networks: &Bound<'py, PyAny>,
+    inputs: &Bound<'py, PyAny>,
+    dt: f64,
+    substeps: AnyInt,
+    method: &str,
+    record: bool,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let integ = integrator(dt, &substeps, method)?;
+    let mut pop = population_from(networks)?;
+    let (p_len, n, m) = (pop.len(), pop.size(), pop.n_inputs());
+    let x = dense(inputs, "inputs", arg_err)?;
+    let (steps, shared) = match x.shape.as_slice() {
+        [t, k] if *k == m => (*t, true),
+        [p, t, k] if *p == p_len && *k == m => (*t, false),
+        _ => {
+            return Err(arg_err(format!(
+                "inputs has shape {}; expected (T, M) or (P, T, M) with P = {p_len}, M = {m}",
+                shape_str(&x.shape)
+            )))
+        }
+    };
+    let cost = (p_len * steps * n * n * integ.substeps) as f64;
+    let out = detached(py, cost, |cancel| {
+        let inputs = if shared {
+            Inputs::Shared(&x.data)
+        } else {
+            Inputs::PerNetwork(&x.data)
+        };
+        pop.run(inputs, steps, &integ, record, Some(cancel))
+    })?;
+    if record {
+        to_numpy(py, out, &[p_len, steps, n])
+    } else {
+        to_numpy(py, out, &[p_len, n])
+    }
+}

@@ -8,10 +8,12 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "GA_DEFAULTS",
     "LANES",
     "MAX_COUNT",
     "MUTATION_SCALE",
     "RETRY_STARTS",
+    "TASK_INTEGRATOR",
     "Evolution",
     "Network",
     "Trace",
@@ -46,6 +48,8 @@ __all__ = [
 
 __version__: str
 LANES: int
+GA_DEFAULTS: str
+TASK_INTEGRATOR: str
 MAX_COUNT: int
 MUTATION_SCALE: float
 RETRY_STARTS: int

@@ -8,6 +8,7 @@ so a run can always be repeated from its folder.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import tomllib
 from collections.abc import Mapping
@@ -26,6 +27,11 @@ MUTATIONS = ("uniform", "creep")
 FILLS = ("mutants", "random")
 METHODS = ("euler", "rk4")
 
+_GA: dict[str, Any] = json.loads(_core.GA_DEFAULTS)
+"""The Rust core's GA defaults: the defaults below are read from them, so the two cannot drift."""
+_STEP: dict[str, Any] = json.loads(_core.TASK_INTEGRATOR)
+"""The tasks' default integration (one time step: 10 Euler steps of 0.1), from the core."""
+
 #: Settings added after run folders began to carry a config digest. At their defaults they are
 #: left out of the digest (``rundir.config_digest``), so folders written before them still resume.
 LATER_SETTINGS = ("mutation", "mutation_scale")
@@ -35,10 +41,10 @@ LATER_SETTINGS = ("mutation", "mutation_scale")
 class Ranges:
     """Allowed interval of each parameter kind; genes are drawn and resampled uniformly in it."""
 
-    tau: tuple[float, float] = (0.5, 10.0)
-    theta: tuple[float, float] = (-16.0, 16.0)
-    weights: tuple[float, float] = (-16.0, 16.0)
-    sensor_weights: tuple[float, float] = (-16.0, 16.0)
+    tau: tuple[float, float] = tuple(_GA["ranges"]["tau"])  # type: ignore[assignment]
+    theta: tuple[float, float] = tuple(_GA["ranges"]["theta"])  # type: ignore[assignment]
+    weights: tuple[float, float] = tuple(_GA["ranges"]["weights"])  # type: ignore[assignment]
+    sensor_weights: tuple[float, float] = tuple(_GA["ranges"]["sensor_weights"])  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -58,9 +64,9 @@ class Ranges:
 class IntegratorConfig:
     """How networks are integrated: each input row is held for ``substeps`` steps of ``dt``."""
 
-    method: str = "euler"
-    dt: float = 0.1
-    substeps: int = 10
+    method: str = _STEP["method"]
+    dt: float = _STEP["dt"]
+    substeps: int = _STEP["substeps"]
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -82,23 +88,23 @@ class EvolutionConfig:
 
     task: str = "sequence"
     """Built-in task name (see ``dnnevo tasks``); ignored when ``evolve`` gets a Python callable."""
-    population: int = 100
+    population: int = _GA["population"]
     generations: int = 100
-    crossover_rate: float = 0.5
-    mutation_rate: float = 0.025
+    crossover_rate: float = _GA["crossover_rate"]
+    mutation_rate: float = _GA["mutation_rate"]
     """Probability that each gene of a child mutates (a per-gene rate)."""
-    mutation: str = "uniform"
+    mutation: str = _GA["mutation"]
     """``"uniform"``: a mutated gene is redrawn over its range (the paper's); ``"creep"``: it moves
     by a bell-shaped step of ``mutation_scale`` times its range's width, reflected at the ends."""
-    mutation_scale: float = _core.MUTATION_SCALE
+    mutation_scale: float = _GA["mutation_scale"]
     """With ``mutation = "creep"``: the step's standard deviation as a fraction of the range."""
-    elitism: int = 0
+    elitism: int = _GA["elitism"]
     """How many of the best individuals are copied unchanged (0 = the paper's GA)."""
-    validation_candidates: int = 10
+    validation_candidates: int = _GA["validation_candidates"]
     """How many of each generation's best individuals by training fitness are re-scored on the
     task's validation set (fresh conditions, fixed for the run) to choose the champion; 0 chooses
     the champion by training fitness, as the paper does. Evolution itself is unchanged."""
-    selection: str = "proportional"
+    selection: str = _GA["selection"]
     """``"proportional"`` (the paper's) or ``"rank"``."""
     fill: str = "mutants"
     """With seed networks: fill the rest of the population with ``"mutants"`` or ``"random"``."""

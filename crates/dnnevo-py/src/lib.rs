@@ -58,6 +58,16 @@ mod _core {
         m.add("LANES", ctrnn::LANES)?;
         m.add("MAX_COUNT", tasks::MAX_COUNT)?;
         m.add("MUTATION_SCALE", ctrnn::ga::MUTATION_SCALE)?;
+        // Python's config classes take their defaults from these, so the two cannot drift.
+        let json = |v: serde_json::Result<String>| v.expect("defaults always serialise");
+        m.add(
+            "GA_DEFAULTS",
+            json(serde_json::to_string(&ctrnn::GaConfig::default())),
+        )?;
+        m.add(
+            "TASK_INTEGRATOR",
+            json(serde_json::to_string(&tasks::TIME_STEP)),
+        )?;
         m.add("RETRY_STARTS", ctrnn::analysis::RETRY_STARTS)?;
         Ok(())
     }

@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
-use ctrnn::{Error, Lanes, Result};
+use ctrnn::{Error, Integrator, Lanes, Method, Result};
 use serde::de::DeserializeOwned;
 
 /// Reads a task config from a JSON object of its fields (`null` means all defaults). Unknown or
@@ -131,6 +131,14 @@ impl<K, V> std::fmt::Debug for Memo<K, V> {
 /// The paper's counts are in the tens to thousands; a count past this is a typing error that
 /// would otherwise make a task allocate terabytes and abort the process.
 pub const MAX_COUNT: usize = 1 << 20;
+
+/// One of the paper's time steps, every task's default integration: 10 forward-Euler steps of
+/// 0.1 with the inputs held (`docs/paper.md`, "The network").
+pub const TIME_STEP: Integrator = Integrator {
+    method: Method::Euler,
+    dt: 0.1,
+    substeps: 10,
+};
 
 /// The most time steps one trial may last, whatever settings it is derived from: 2^24. The
 /// paper's longest trial is about 1,000 time steps.

@@ -21,7 +21,7 @@ pub mod nav1d;
 pub mod registry;
 pub mod sequence;
 
-pub use common::MAX_COUNT;
+pub use common::{MAX_COUNT, TIME_STEP};
 pub use registry::{build, names};
 pub use sequence::{
     performance, Aggregate, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask,

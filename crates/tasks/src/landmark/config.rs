@@ -1,7 +1,9 @@
 //! The settings of the landmark-recognition experiment: the network, the two worlds, the robot
 //! trial, and the "robot-like" conditions of the stand-in for the paper's real-robot test.
 
-use ctrnn::{Error, Integrator, Method, Result};
+use ctrnn::{Error, Integrator, Result};
+
+use crate::common::TIME_STEP;
 use serde::{Deserialize, Serialize};
 use sim2d::{SimSpec, WorldSpec};
 
@@ -89,11 +91,7 @@ impl Default for LandmarkConfig {
             train_robot_like: false,
             robot_like: RobotLike::default(),
             training: Training::default(),
-            integrator: Integrator {
-                method: Method::Euler,
-                dt: 0.1,
-                substeps: 10,
-            },
+            integrator: TIME_STEP,
         }
     }
 }

@@ -1,7 +1,9 @@
 //! The settings of the one-dimensional navigation experiments: the world's geometry and timing,
 //! which neurons are motors and classifier, and what an evaluation scores.
 
-use ctrnn::{Error, Integrator, Method, Result};
+use ctrnn::{Error, Integrator, Result};
+
+use crate::common::TIME_STEP;
 use serde::{Deserialize, Serialize};
 
 use super::environment::Environment;
@@ -147,11 +149,7 @@ impl Default for Nav1dConfig {
             validation_chains: 40,
             start_jitter: 0.0,
             landmark_jitter: 0.0,
-            integrator: Integrator {
-                method: Method::Euler,
-                dt: 0.1,
-                substeps: 10,
-            },
+            integrator: TIME_STEP,
             world: World::Continuous,
         }
     }

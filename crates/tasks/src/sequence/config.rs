@@ -2,10 +2,10 @@
 
 use std::fmt;
 
-use ctrnn::{Error, Integrator, Method, Result};
+use ctrnn::{Error, Integrator, Result};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use crate::common::config_from_params;
+use crate::common::{config_from_params, TIME_STEP};
 
 /// What the two sensors are, for error messages.
 pub(super) const SENSORS: &str = "trigger, reinforcement";
@@ -159,11 +159,7 @@ impl Default for SequenceConfig {
             perf_base: PerfBase::default(),
             clamp: Clamp::Trial,
             aggregate: Aggregate::Mean,
-            integrator: Integrator {
-                method: Method::Euler,
-                dt: 0.1,
-                substeps: 10,
-            },
+            integrator: TIME_STEP,
             independent_conditions: false,
             validation_trials: 32,
         }

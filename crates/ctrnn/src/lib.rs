@@ -25,7 +25,6 @@ pub mod math;
 pub mod names;
 pub mod network;
 pub mod population;
-pub mod rng;
 mod rows;
 pub mod validation;
 mod vector;
@@ -37,5 +36,7 @@ pub use genome::{Layout, Ranges};
 pub use integrate::{Integrator, Lanes, Method, LANES};
 pub use network::{compose, compose_with, Network};
 pub use population::{Block, Inputs, Population};
-pub use rng::{Purpose, Stream};
+/// The random streams, from the `streams` crate (kept here under their old path).
+pub use streams as rng;
+pub use streams::{Purpose, Stream};
 pub use validation::Validation;

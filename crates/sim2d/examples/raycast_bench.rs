@@ -6,8 +6,8 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use ctrnn::rng::{Purpose, Stream};
 use sim2d::{Echo, Sim, SimSpec, World, WorldSpec};
+use streams::{Purpose, Stream};
 
 fn main() -> Result<(), sim2d::Error> {
     let world = World::new(&WorldSpec::landmark(2)?)?;

@@ -13,12 +13,12 @@
 //! | a trial at a fixed time step | [`Sim`] (`sim.rs`) |
 //!
 //! Randomness (start poses, sonar noise, jitter) comes only from a caller's
-//! [`ctrnn::rng::Stream`], so a trial is reproducible to the bit.
+//! [`streams::Stream`], so a trial is reproducible to the bit.
 //!
 //! # Example
 //! A 45 s trial in the world of landmark 1, feeding the left sonar's input to a model:
 //! ```
-//! use ctrnn::rng::{Purpose, Stream};
+//! use streams::{Purpose, Stream};
 //! use sim2d::{Echo, Sim, SimSpec, World, WorldSpec};
 //!
 //! let world = World::new(&WorldSpec::landmark(1)?)?;

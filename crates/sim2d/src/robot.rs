@@ -200,9 +200,9 @@ impl RobotSpec {
 mod tests {
     use super::*;
     use crate::world_spec::WorldSpec;
-    use ctrnn::rng::{Purpose, Stream};
     use proptest::prelude::*;
     use std::f64::consts::FRAC_PI_2;
+    use streams::{Purpose, Stream};
 
     fn landmark(n: u32) -> World {
         World::new(&WorldSpec::landmark(n).unwrap()).unwrap()

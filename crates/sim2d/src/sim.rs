@@ -5,7 +5,7 @@
 //! [`Sim::run`] runs many steps and can record poses and echoes into a caller's [`Trace`].
 //! Neither allocates, except for the caller's trace growing.
 
-use ctrnn::rng::Stream;
+use streams::Stream;
 
 use crate::error::{check_range, Error};
 use crate::pose::Pose;
@@ -86,7 +86,7 @@ impl Trace {
 ///
 /// # Example
 /// ```
-/// use ctrnn::rng::{Purpose, Stream};
+/// use streams::{Purpose, Stream};
 /// use sim2d::{Echo, Sim, SimSpec, World, WorldSpec};
 /// let world = World::new(&WorldSpec::landmark(2)?)?;
 /// let mut stream = Stream::new(7, 0, Purpose::Trial, 0, 0);
@@ -254,7 +254,7 @@ impl<'w> Sim<'w> {
 mod tests {
     use super::*;
     use crate::world_spec::WorldSpec;
-    use ctrnn::rng::Purpose;
+    use streams::Purpose;
 
     fn noisy_spec() -> SimSpec {
         SimSpec {

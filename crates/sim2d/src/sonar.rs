@@ -8,7 +8,7 @@
 //! reflected away and returns nothing. The echo is the nearest return, plus Gaussian noise of
 //! `noise_sd`, clamped to `[min_range, max_range]`.
 
-use ctrnn::rng::Stream;
+use streams::Stream;
 
 use crate::error::{check_finite, check_range, Error};
 use crate::pose::Pose;
@@ -114,7 +114,7 @@ impl Default for Echo {
 ///
 /// # Example
 /// ```
-/// use ctrnn::rng::{Purpose, Stream};
+/// use streams::{Purpose, Stream};
 /// use sim2d::{Pose, Sonar, SonarSpec, World, WorldSpec};
 /// let world = World::new(&WorldSpec::landmark(1)?)?;
 /// let sonar = Sonar::new(&SonarSpec::default())?;
@@ -243,7 +243,7 @@ pub fn input(range: f64, d0: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::world_spec::{BoxSpec, StartRegion, WorldSpec};
-    use ctrnn::rng::Purpose;
+    use streams::Purpose;
 
     const TOL: f64 = 2e-5;
 

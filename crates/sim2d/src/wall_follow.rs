@@ -318,8 +318,8 @@ mod tests {
     use super::*;
     use crate::sim::{Sim, SimSpec};
     use crate::world_spec::WorldSpec;
-    use ctrnn::rng::{Purpose, Stream};
     use std::f64::consts::TAU;
+    use streams::{Purpose, Stream};
 
     /// What one run did. A lap is one full counter-clockwise turn of the robot's position around
     /// the room's centre, counted from the moment the follower reached a wall.

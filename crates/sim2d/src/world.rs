@@ -7,10 +7,10 @@
 
 use std::f64::consts::PI;
 
-use ctrnn::rng::Stream;
 use parry2d::math::{Isometry, Point, Real, Vector};
 use parry2d::query::{PointQuery, Ray, RayCast};
 use parry2d::shape::Cuboid;
+use streams::Stream;
 
 use crate::error::{check_range, Error};
 use crate::pose::Pose;
@@ -218,7 +218,7 @@ impl World {
     ///
     /// # Example
     /// ```
-    /// use ctrnn::rng::{Purpose, Stream};
+    /// use streams::{Purpose, Stream};
     /// let world = sim2d::World::new(&sim2d::WorldSpec::landmark(2)?)?;
     /// let mut s = Stream::new(0, 0, Purpose::Trial, 0, 0);
     /// let pose = world.random_pose(0.265, 0.05, &mut s)?;
@@ -261,7 +261,7 @@ impl World {
 mod tests {
     use super::*;
     use crate::world_spec::{BoxSpec, StartRegion};
-    use ctrnn::rng::Purpose;
+    use streams::Purpose;
 
     const TOL: f64 = 2e-5; // f32 arithmetic in parry2d
 

@@ -19,8 +19,8 @@
 //! (`crates/sim2d/worlds/landmark1.toml` and `landmark2.toml`) and are returned by
 //! [`WorldSpec::landmark`].
 
-use ctrnn::rng::Stream;
 use serde::{Deserialize, Serialize};
+use streams::Stream;
 
 use crate::error::{check_finite, check_range, Error};
 
@@ -225,7 +225,7 @@ impl WorldSpec {
     ///
     /// # Example
     /// ```
-    /// use ctrnn::rng::{Purpose, Stream};
+    /// use streams::{Purpose, Stream};
     /// let base = sim2d::WorldSpec::landmark(2)?;
     /// let mut s = Stream::new(1, 0, Purpose::Trial, 0, 0);
     /// let j = base.jittered(&mut s, 0.05, 0.1)?;
@@ -286,7 +286,7 @@ impl BoxSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ctrnn::rng::Purpose;
+    use streams::Purpose;
 
     #[test]
     fn shipped_worlds_parse_and_match_the_paper_defaults() {

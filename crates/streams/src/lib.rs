@@ -1,4 +1,4 @@
-//! One deterministic random stream per work unit.
+//! One deterministic random stream per work unit: the random numbers of every dnnevo crate.
 //!
 //! Every random draw in an evolution run comes from a [`Stream`] derived from the tuple
 //! `(seed, generation, purpose, individual, trial)`, never from a thread-local or global generator.
@@ -16,7 +16,7 @@
 //!
 //! # Example
 //! ```
-//! use ctrnn::rng::{Purpose, Stream};
+//! use streams::{Purpose, Stream};
 //! let mut a = Stream::new(42, 3, Purpose::Reproduce, 7, 0);
 //! let mut b = Stream::new(42, 3, Purpose::Reproduce, 7, 0);
 //! assert_eq!(a.next_u64(), b.next_u64());

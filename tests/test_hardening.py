@@ -337,6 +337,11 @@ def test_kill_at_random_moments_then_resume_is_bit_identical(tmp_path: Path) -> 
         assert "Traceback" not in err, err
         if (out / "checkpoint.json").exists():
             progress.append(len(RunDir(out).read_checkpoint().history))
+            if progress[-1] == 200 and not any(0 < n < 200 for n in progress):
+                # The machine got quicker than during the reference run, so a whole run fit
+                # before the kill: start again with kill times over a shorter span.
+                shutil.rmtree(out)
+                span = max(0.5, span / 2)
     assert any(0 < n < 200 for n in progress), progress  # some kills landed mid-run
     r = run_cli("resume", out) if (out / "checkpoint.json").exists() else run_cli(*start)
     assert r.returncode == 0, r.stderr

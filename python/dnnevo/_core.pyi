@@ -8,12 +8,11 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
-    "GA_DEFAULTS",
     "LANES",
     "MAX_COUNT",
     "MUTATION_SCALE",
     "RETRY_STARTS",
-    "TASK_INTEGRATOR",
+    "RUN_DEFAULTS",
     "Evolution",
     "Network",
     "Trace",
@@ -21,6 +20,7 @@ __all__ = [
     "analysis_bifurcation",
     "analysis_cycles",
     "analysis_equilibria",
+    "check_config",
     "compose",
     "decode",
     "encode",
@@ -43,13 +43,11 @@ __all__ = [
     "sim2d_landmark_world",
     "task_layout",
     "task_names",
-    "task_success",
 ]
 
 __version__: str
 LANES: int
-GA_DEFAULTS: str
-TASK_INTEGRATOR: str
+RUN_DEFAULTS: str
 MAX_COUNT: int
 MUTATION_SCALE: float
 RETRY_STARTS: int
@@ -152,11 +150,8 @@ class Evolution:
     def __new__(
         cls,
         config: str,
-        size: int,
-        n_inputs: int,
         seed: int,
         seeds: Sequence[Network] | None = None,
-        fill: str = "mutants",
     ) -> Evolution: ...
     @property
     def generation(self) -> int: ...
@@ -169,27 +164,25 @@ class Evolution:
     def genomes(self) -> _Array: ...
     def networks(self) -> list[Network]: ...
     def tell(self, fitness: npt.ArrayLike) -> dict[str, float]: ...
-    def step(
-        self, task: str, params: str, threads: int | None = None
-    ) -> tuple[dict[str, float], _Array]: ...
+    def step(self, threads: int | None = None) -> tuple[dict[str, float], _Array]: ...
+    def champion_success(self, seed: int) -> bool | None: ...
     def champion(self) -> tuple[Network, float, int] | None: ...
     def champion_validation(self) -> tuple[float, float] | None: ...
     def to_json(self) -> str: ...
     @staticmethod
-    def from_json(text: str) -> Evolution: ...
+    def from_json(text: str, config: str) -> Evolution: ...
 
+def check_config(config: str) -> None: ...
 def evaluate(
-    task: str,
-    params: str,
+    config: str,
     population: npt.ArrayLike | Sequence[Network],
     *,
     generation: int,
     seed: int,
     threads: int | None = None,
 ) -> _Array: ...
-def task_layout(task: str, params: str) -> tuple[int, int]: ...
+def task_layout(config: str) -> tuple[int, int]: ...
 def task_names() -> list[str]: ...
-def task_success(task: str, params: str, net: Network, seed: int) -> bool | None: ...
 def decode(size: int, n_inputs: int, genes: npt.ArrayLike) -> Network: ...
 def encode(net: Network) -> _Array: ...
 def sequence_timings(

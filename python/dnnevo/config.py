@@ -22,15 +22,10 @@ from dnnevo.errors import ConfigError
 
 __all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides"]
 
-SELECTIONS = ("proportional", "rank")
-MUTATIONS = ("uniform", "creep")
-FILLS = ("mutants", "random")
-METHODS = ("euler", "rk4")
-
-_GA: dict[str, Any] = json.loads(_core.GA_DEFAULTS)
-"""The Rust core's GA defaults: the defaults below are read from them, so the two cannot drift."""
-_STEP: dict[str, Any] = json.loads(_core.TASK_INTEGRATOR)
-"""The tasks' default integration (one time step: 10 Euler steps of 0.1), from the core."""
+_DEFAULTS: dict[str, Any] = json.loads(_core.RUN_DEFAULTS)
+"""The Rust core's defaults for a run (``tasks::RunConfig``): every default below is read from
+them, and every value is checked there (:meth:`EvolutionConfig.__post_init__`), so Python and Rust
+cannot drift. Python checks types only."""
 
 #: Settings added after run folders began to carry a config digest. At their defaults they are
 #: left out of the digest (``rundir.config_digest``), so folders written before them still resume.
@@ -41,10 +36,10 @@ LATER_SETTINGS = ("mutation", "mutation_scale")
 class Ranges:
     """Allowed interval of each parameter kind; genes are drawn and resampled uniformly in it."""
 
-    tau: tuple[float, float] = tuple(_GA["ranges"]["tau"])  # type: ignore[assignment]
-    theta: tuple[float, float] = tuple(_GA["ranges"]["theta"])  # type: ignore[assignment]
-    weights: tuple[float, float] = tuple(_GA["ranges"]["weights"])  # type: ignore[assignment]
-    sensor_weights: tuple[float, float] = tuple(_GA["ranges"]["sensor_weights"])  # type: ignore[assignment]
+    tau: tuple[float, float] = tuple(_DEFAULTS["ranges"]["tau"])  # type: ignore[assignment]
+    theta: tuple[float, float] = tuple(_DEFAULTS["ranges"]["theta"])  # type: ignore[assignment]
+    weights: tuple[float, float] = tuple(_DEFAULTS["ranges"]["weights"])  # type: ignore[assignment]
+    sensor_weights: tuple[float, float] = tuple(_DEFAULTS["ranges"]["sensor_weights"])  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -53,28 +48,22 @@ class Ranges:
                 lo, hi = (float(v) for v in value)
             except (TypeError, ValueError):
                 raise ConfigError(f"ranges.{f.name} is {value!r}; expected [low, high]") from None
-            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-                raise ConfigError(f"ranges.{f.name} is [{lo}, {hi}]; expected finite low < high")
             object.__setattr__(self, f.name, (lo, hi))
-        if self.tau[0] <= 0:
-            raise ConfigError(f"ranges.tau starts at {self.tau[0]}; time constants must be > 0")
 
 
 @dataclass(frozen=True)
 class IntegratorConfig:
     """How networks are integrated: each input row is held for ``substeps`` steps of ``dt``."""
 
-    method: str = _STEP["method"]
-    dt: float = _STEP["dt"]
-    substeps: int = _STEP["substeps"]
+    method: str = _DEFAULTS["integrator"]["method"]
+    """``"euler"`` or ``"rk4"``."""
+    dt: float = _DEFAULTS["integrator"]["dt"]
+    substeps: int = _DEFAULTS["integrator"]["substeps"]
 
     def __post_init__(self) -> None:
-        if self.method not in METHODS:
-            raise ConfigError(f"integrator.method is {self.method!r}; expected one of {METHODS}")
-        if not (isinstance(self.dt, int | float) and math.isfinite(self.dt) and self.dt > 0):
-            raise ConfigError(f"integrator.dt is {self.dt!r}; it must be a number > 0")
-        if not (isinstance(self.substeps, int) and self.substeps >= 1):
-            raise ConfigError(f"integrator.substeps is {self.substeps!r}; it must be an integer >= 1")
+        _check_type(self, "method", str, "integrator.")
+        _check_type(self, "dt", float, "integrator.")
+        _check_type(self, "substeps", int, "integrator.")
 
 
 @dataclass(frozen=True)
@@ -86,31 +75,31 @@ class EvolutionConfig:
     True
     """
 
-    task: str = "sequence"
+    task: str = _DEFAULTS["task"]
     """Built-in task name (see ``dnnevo tasks``); ignored when ``evolve`` gets a Python callable."""
-    population: int = _GA["population"]
-    generations: int = 100
-    crossover_rate: float = _GA["crossover_rate"]
-    mutation_rate: float = _GA["mutation_rate"]
+    population: int = _DEFAULTS["population"]
+    generations: int = _DEFAULTS["generations"]
+    crossover_rate: float = _DEFAULTS["crossover_rate"]
+    mutation_rate: float = _DEFAULTS["mutation_rate"]
     """Probability that each gene of a child mutates (a per-gene rate)."""
-    mutation: str = _GA["mutation"]
+    mutation: str = _DEFAULTS["mutation"]
     """``"uniform"``: a mutated gene is redrawn over its range (the paper's); ``"creep"``: it moves
     by a bell-shaped step of ``mutation_scale`` times its range's width, reflected at the ends."""
-    mutation_scale: float = _GA["mutation_scale"]
+    mutation_scale: float = _DEFAULTS["mutation_scale"]
     """With ``mutation = "creep"``: the step's standard deviation as a fraction of the range."""
-    elitism: int = _GA["elitism"]
+    elitism: int = _DEFAULTS["elitism"]
     """How many of the best individuals are copied unchanged (0 = the paper's GA)."""
-    validation_candidates: int = _GA["validation_candidates"]
+    validation_candidates: int = _DEFAULTS["validation_candidates"]
     """How many of each generation's best individuals by training fitness are re-scored on the
     task's validation set (fresh conditions, fixed for the run) to choose the champion; 0 chooses
     the champion by training fitness, as the paper does. Evolution itself is unchanged."""
-    selection: str = _GA["selection"]
+    selection: str = _DEFAULTS["selection"]
     """``"proportional"`` (the paper's) or ``"rank"``."""
-    fill: str = "mutants"
+    fill: str = _DEFAULTS["fill"]
     """With seed networks: fill the rest of the population with ``"mutants"`` or ``"random"``."""
-    size: int = 5
+    size: int = _DEFAULTS["size"]
     """Neurons per network."""
-    n_inputs: int = 2
+    n_inputs: int = _DEFAULTS["n_inputs"]
     """Sensors per network; a built-in task checks it matches."""
     integrator: IntegratorConfig = field(default_factory=IntegratorConfig)
     ranges: Ranges = field(default_factory=Ranges)
@@ -118,44 +107,22 @@ class EvolutionConfig:
     """Task-specific settings, passed to the task as they are."""
 
     def __post_init__(self) -> None:
-        def integer(name: str, low: int) -> None:
-            value = getattr(self, name)
-            if not (isinstance(value, int) and not isinstance(value, bool) and value >= low):
-                raise ConfigError(f"{name} is {value!r}; it must be an integer >= {low}")
-
-        integer("population", 2)
-        integer("generations", 1)
-        integer("elitism", 0)
-        integer("validation_candidates", 0)
-        integer("size", 1)
-        integer("n_inputs", 0)
-        for name in ("crossover_rate", "mutation_rate"):
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and 0.0 <= value <= 1.0):
-                raise ConfigError(f"{name} is {value!r}; it must be in [0, 1]")
-        if self.mutation not in MUTATIONS:
-            raise ConfigError(f"mutation is {self.mutation!r}; expected one of {MUTATIONS}")
-        scale = self.mutation_scale
-        if not (isinstance(scale, int | float) and not isinstance(scale, bool) and 0.0 < scale <= 1.0):
-            raise ConfigError(f"mutation_scale is {scale!r}; it must be in (0, 1]")
-        if self.elitism >= self.population:
-            raise ConfigError(
-                f"elitism is {self.elitism}; it must be < population ({self.population})"
-            )
-        if self.selection not in SELECTIONS:
-            raise ConfigError(f"selection is {self.selection!r}; expected one of {SELECTIONS}")
-        if self.fill not in FILLS:
-            raise ConfigError(f"fill is {self.fill!r}; expected one of {FILLS}")
-        if not isinstance(self.task, str) or not self.task:
-            raise ConfigError(f"task is {self.task!r}; expected a task name")
+        for name, kind in _TYPES.items():
+            _check_type(self, name, kind)
         if isinstance(self.integrator, Mapping):
             object.__setattr__(self, "integrator", _build(IntegratorConfig, self.integrator, "integrator"))
         if isinstance(self.ranges, Mapping):
             object.__setattr__(self, "ranges", _build(Ranges, self.ranges, "ranges"))
+        if not isinstance(self.integrator, IntegratorConfig):
+            raise ConfigError(f"integrator is {self.integrator!r}; expected a table")
+        if not isinstance(self.ranges, Ranges):
+            raise ConfigError(f"ranges is {self.ranges!r}; expected a table")
         if not isinstance(self.task_params, Mapping):
             raise ConfigError(f"task_params is {self.task_params!r}; expected a table")
         object.__setattr__(self, "task_params", dict(self.task_params))
-        _check_finite(self.task_params, "task_params")
+        d = self.to_dict()
+        _check_finite(d, "")
+        _core.check_config(json.dumps(d))
 
     # -- conversions -------------------------------------------------------------------------
 
@@ -187,19 +154,9 @@ class EvolutionConfig:
         d.pop("run", None)
         return cls.from_dict(d)
 
-    def ga_json(self) -> dict[str, Any]:
-        """The GA settings in the form the Rust core reads."""
-        return {
-            "population": self.population,
-            "crossover_rate": float(self.crossover_rate),
-            "mutation_rate": float(self.mutation_rate),
-            "mutation": self.mutation,
-            "mutation_scale": float(self.mutation_scale),
-            "elitism": self.elitism,
-            "selection": self.selection,
-            "validation_candidates": self.validation_candidates,
-            "ranges": {k: list(v) for k, v in dataclasses.asdict(self.ranges).items()},
-        }
+    def to_json(self) -> str:
+        """The config as JSON text, the form the Rust core reads."""
+        return json.dumps(self.to_dict())
 
     def task_json(self) -> dict[str, Any]:
         """The built-in task's parameters: size and integrator, then ``task_params``."""
@@ -208,6 +165,31 @@ class EvolutionConfig:
             "integrator": dataclasses.asdict(self.integrator),
             **self.task_params,
         }
+
+
+_TYPES: dict[str, type] = {
+    "task": str, "population": int, "generations": int, "crossover_rate": float,
+    "mutation_rate": float, "mutation": str, "mutation_scale": float, "elitism": int,
+    "validation_candidates": int, "selection": str, "fill": str, "size": int, "n_inputs": int,
+}
+"""The type of each plain field of :class:`EvolutionConfig`; the values are checked in Rust."""
+
+
+def _check_type(obj: Any, name: str, kind: type, prefix: str = "") -> None:
+    """``obj.name`` has the type ``kind``: a str; an int (not a bool) >= 0; or a float, which an
+    int may stand for."""
+    value = getattr(obj, name)
+    if kind is str:
+        ok = isinstance(value, str)
+        expected = "a string"
+    elif kind is int:
+        ok = isinstance(value, int) and not isinstance(value, bool) and value >= 0
+        expected = "an integer >= 0"
+    else:
+        ok = isinstance(value, int | float) and not isinstance(value, bool)
+        expected = "a number"
+    if not ok:
+        raise ConfigError(f"{prefix}{name} is {value!r}; expected {expected}")
 
 
 def _check_finite(value: Any, where: str) -> None:
@@ -219,7 +201,7 @@ def _check_finite(value: Any, where: str) -> None:
         if isinstance(v, float) and not math.isfinite(v):
             raise ConfigError(f"{at} is {v}; every number must be finite")
         if isinstance(v, Mapping):
-            stack.extend((x, f"{at}.{k}") for k, x in v.items())
+            stack.extend((x, f"{at}.{k}" if at else str(k)) for k, x in v.items())
         elif isinstance(v, list | tuple):
             stack.extend((x, f"{at}[{i}]") for i, x in enumerate(v))
 

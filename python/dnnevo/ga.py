@@ -12,7 +12,6 @@
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from typing import Any, NamedTuple
 
@@ -57,14 +56,7 @@ class GeneticAlgorithm:
         self.config = config or EvolutionConfig()
         if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not 0 <= seed < 2**64:
             raise ConfigError(f"seed is {seed!r}; it must be an integer in [0, 2**64)")
-        self._evo = _core.Evolution(
-            json.dumps(self.config.ga_json()),
-            self.config.size,
-            self.config.n_inputs,
-            int(seed),
-            list(seeds or []),
-            self.config.fill,
-        )
+        self._evo = _core.Evolution(self.config.to_json(), int(seed), list(seeds or []))
 
     @property
     def seed(self) -> int:
@@ -90,8 +82,14 @@ class GeneticAlgorithm:
         next, as ``dnnevo.evolve`` does each generation (the task is built once and kept). The
         GIL is released; Ctrl-C stops the scoring and raises ``KeyboardInterrupt``, leaving the
         population as it was. ``threads`` is the Rust worker count (default: all cores)."""
-        stats, fitness = self._evo.step(self.config.task, json.dumps(self.config.task_json()), threads)
+        stats, fitness = self._evo.step(threads)
         return Scored(stats, fitness)
+
+    def best_succeeds(self, seed: int) -> bool | None:
+        """Whether :attr:`best` meets the built-in task's success rule on fresh conditions drawn
+        from ``seed`` (the task built for :meth:`step` is reused); None when there is no best yet
+        or the task has no rule."""
+        return self._evo.champion_success(seed)
 
     @property
     def best(self) -> _core.Network | None:
@@ -127,8 +125,9 @@ class GeneticAlgorithm:
             raise ConfigError(f"a GA state is a dict with 'config' and 'evolution'; got {got}")
         if not isinstance(state["evolution"], str):
             raise ConfigError("the GA state's 'evolution' must be JSON text from state_dict()")
-        self.config = EvolutionConfig.from_dict(state["config"])
-        self._evo = _core.Evolution.from_json(state["evolution"])
+        config = EvolutionConfig.from_dict(state["config"])
+        self._evo = _core.Evolution.from_json(state["evolution"], config.to_json())
+        self.config = config
 
     @classmethod
     def from_state_dict(cls, state: dict[str, Any]) -> GeneticAlgorithm:

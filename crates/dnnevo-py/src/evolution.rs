@@ -6,11 +6,11 @@ use std::sync::{Arc, Mutex};
 
 use ctrnn::evolve::Stats;
 use ctrnn::genome::{self, Layout};
-use ctrnn::names::parse_name;
-use ctrnn::{Evolution, Fill, GaConfig, Task};
+use ctrnn::{Evolution, Task};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict};
+use tasks::RunConfig;
 
 use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint};
 use crate::detach::detached;
@@ -18,20 +18,35 @@ use crate::errors::{ConfigError, FitnessError, IntoPy};
 use crate::network::PyNetwork;
 use crate::population::networks_from;
 
-/// The GA's state: population, generation and champion. See `dnnevo.GeneticAlgorithm`.
+/// The GA's state: population, generation and champion, with the run's settings. See
+/// `dnnevo.GeneticAlgorithm`.
 #[pyclass(module = "dnnevo._core", name = "Evolution")]
 pub struct PyEvolution {
     inner: Evolution,
-    /// The task `step` last built, with its name and parameters: a run builds its task once, so
-    /// that what the task computes once per run (its validation set) is kept.
-    task: Option<(String, String, Box<dyn Task>)>,
+    /// The run's settings, validated once when the run began or was restored.
+    run: RunConfig,
+    /// The built-in task, built at the first `step` or `champion_success` and kept: a run builds
+    /// its task once, so that what the task computes once per run (its validation set) is kept.
+    task: Option<Box<dyn Task>>,
 }
 
-fn config_from_json(text: &str) -> PyResult<GaConfig> {
-    let config: GaConfig = serde_json::from_str(text)
-        .map_err(|e| ConfigError::new_err(format!("GA settings: {e}")))?;
-    config.validate().py_err()?;
-    Ok(config)
+/// Reads and validates a run's settings (`dnnevo.EvolutionConfig.to_dict()` as JSON).
+fn run_config(text: &str) -> PyResult<RunConfig> {
+    RunConfig::from_json(text).py_err()
+}
+
+/// The first field where `found` (the GA state's) differs from `expected` (the config's).
+fn first_difference<T: serde::Serialize>(found: &T, expected: &T) -> Option<String> {
+    let (serde_json::Value::Object(f), serde_json::Value::Object(e)) = (
+        serde_json::to_value(found).ok()?,
+        serde_json::to_value(expected).ok()?,
+    ) else {
+        return None;
+    };
+    e.iter().find_map(|(key, want)| {
+        let got = f.get(key).unwrap_or(&serde_json::Value::Null);
+        (got != want).then(|| format!("{key} ({got} in the GA state, {want} in the config)"))
+    })
 }
 
 fn stats_dict<'py>(py: Python<'py>, s: &Stats) -> PyResult<Bound<'py, PyDict>> {
@@ -43,13 +58,6 @@ fn stats_dict<'py>(py: Python<'py>, s: &Stats) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("min", s.min)?;
     d.set_item("best_index", s.best_index)?;
     Ok(d)
-}
-
-/// Builds a built-in task from its name and JSON parameters.
-fn build_task(name: &str, params: &str) -> PyResult<Box<dyn Task>> {
-    let params: serde_json::Value = serde_json::from_str(params)
-        .map_err(|e| ConfigError::new_err(format!("task parameters: {e}")))?;
-    tasks::registry::build(name, &params).py_err()
 }
 
 /// A rayon pool per requested thread count, built once; `None` is rayon's global pool.
@@ -82,32 +90,39 @@ fn on_pool<T: Send>(threads: Option<&Arc<rayon::ThreadPool>>, f: impl FnOnce() -
     }
 }
 
+impl PyEvolution {
+    /// The run's built-in task, built on first use.
+    fn task(&mut self) -> PyResult<&dyn Task> {
+        if self.task.is_none() {
+            self.task = Some(self.run.build_task().py_err()?);
+        }
+        Ok(self.task.as_deref().expect("the task was just built"))
+    }
+}
+
 #[pymethods]
 impl PyEvolution {
-    /// A new run. `config` is the GA settings as JSON (population, crossover_rate, mutation_rate,
-    /// elitism, selection, ranges); `seeds` are networks placed first in the initial population.
+    /// A new run. `config` is the run's settings as JSON (`EvolutionConfig.to_dict()`), checked
+    /// here; `seeds` are networks placed first in the initial population.
     #[new]
-    #[pyo3(signature = (config, size, n_inputs, seed, seeds=None, fill="mutants"))]
+    #[pyo3(signature = (config, seed, seeds=None))]
     fn new(
         config: &str,
-        size: &Bound<'_, PyAny>,
-        n_inputs: &Bound<'_, PyAny>,
         seed: &Bound<'_, PyAny>,
         seeds: Option<&Bound<'_, PyAny>>,
-        fill: &str,
     ) -> PyResult<Self> {
-        let size: usize = uint(size, "size", "[1, 2**64)")?;
-        let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
         let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
-        let config = config_from_json(config)?;
-        let fill: Fill = parse_name("fill", fill).map_err(ConfigError::new_err)?;
+        let run = run_config(config)?;
         let seeds = match seeds.filter(|s| !s.is_none()) {
             Some(s) if s.len()? > 0 => networks_from(s)?,
             _ => Vec::new(),
         };
-        let layout = Layout { size, n_inputs };
-        let inner = Evolution::new(layout, config, seed, &seeds, fill).py_err()?;
-        Ok(PyEvolution { inner, task: None })
+        let inner = Evolution::new(run.layout(), run.ga(), seed, &seeds, run.fill).py_err()?;
+        Ok(PyEvolution {
+            inner,
+            run,
+            task: None,
+        })
     }
 
     /// The generation the current population belongs to.
@@ -162,33 +177,41 @@ impl PyEvolution {
         stats_dict(py, &stats)
     }
 
-    /// Scores the current population with a built-in task and breeds the next generation.
-    /// Returns the statistics and the fitness values. Releases the GIL; Ctrl-C interrupts.
-    #[pyo3(signature = (task, params, threads=None))]
+    /// Scores the current population with the run's built-in task and breeds the next
+    /// generation. Returns the statistics and the fitness values. Releases the GIL; Ctrl-C
+    /// interrupts.
+    #[pyo3(signature = (threads=None))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
-        task: &str,
-        params: &str,
         threads: Option<usize>,
     ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyArrayDyn<f64>>)> {
-        if !matches!(&self.task, Some((n, p, _)) if n == task && p == params) {
-            self.task = Some((
-                task.to_owned(),
-                params.to_owned(),
-                build_task(task, params)?,
-            ));
-        }
-        let Some((_, _, task)) = &self.task else {
+        let pool = pool(threads)?;
+        self.task()?;
+        let (Some(task), inner) = (self.task.as_deref(), &mut self.inner) else {
             unreachable!("the task was just built")
         };
-        let pool = pool(threads)?;
-        let inner = &mut self.inner;
         let (stats, fitness) = detached(py, f64::INFINITY, |cancel| {
-            on_pool(pool.as_ref(), || inner.step(task.as_ref(), Some(cancel)))
+            on_pool(pool.as_ref(), || inner.step(task, Some(cancel)))
         })?;
         let n = fitness.len();
         Ok((stats_dict(py, &stats)?, to_numpy(py, fitness, &[n])?))
+    }
+
+    /// Whether the champion meets the run's built-in task's success criterion on fresh
+    /// conditions from `seed`; None when there is no champion or the task has no criterion.
+    fn champion_success(
+        &mut self,
+        py: Python<'_>,
+        seed: &Bound<'_, PyAny>,
+    ) -> PyResult<Option<bool>> {
+        let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
+        let Some(c) = &self.inner.champion else {
+            return Ok(None);
+        };
+        let net = genome::decode(self.inner.layout, &c.genes).py_err()?;
+        let task = self.task()?;
+        py.detach(|| task.succeeds(&net, seed)).py_err()
     }
 
     /// The fitness of the best individual so far, or None.
@@ -217,24 +240,41 @@ impl PyEvolution {
         self.inner.to_json()
     }
 
-    /// Restores a state written by `to_json`.
+    /// Restores a state written by `to_json`, with the run's settings (`config`, as for `new`),
+    /// which must agree with the state's own GA settings and layout.
     #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
+    fn from_json(text: &str, config: &str) -> PyResult<Self> {
+        let inner = Evolution::from_json(text).py_err()?;
+        let run = run_config(config)?;
+        let difference = first_difference(&inner.config, &run.ga())
+            .or_else(|| first_difference(&inner.layout, &run.layout()));
+        if let Some(d) = difference {
+            return Err(ConfigError::new_err(format!(
+                "the GA state disagrees with its config at {d}"
+            )));
+        }
         Ok(PyEvolution {
-            inner: Evolution::from_json(text).py_err()?,
+            inner,
+            run,
             task: None,
         })
     }
 }
 
-/// Scores networks or genomes with a built-in task: a pure function of (task, parameters,
+/// Checks a run's settings (`EvolutionConfig.to_dict()` as JSON); the first problem is a
+/// `ConfigError` that names its field.
+#[pyfunction]
+pub fn check_config(config: &str) -> PyResult<()> {
+    run_config(config).map(|_| ())
+}
+
+/// Scores networks or genomes with a run's built-in task: a pure function of (config,
 /// genomes, generation, seed), bit-identical to the scores inside a run.
 #[pyfunction]
-#[pyo3(signature = (task, params, population, *, generation, seed, threads=None))]
+#[pyo3(signature = (config, population, *, generation, seed, threads=None))]
 pub fn evaluate<'py>(
     py: Python<'py>,
-    task: &str,
-    params: &str,
+    config: &str,
     population: &Bound<'py, PyAny>,
     generation: &Bound<'py, PyAny>,
     seed: &Bound<'py, PyAny>,
@@ -246,7 +286,7 @@ pub fn evaluate<'py>(
         Some(t) => Some(uint(t, "threads", "[1, 2**64)")?),
         None => None,
     };
-    let task = build_task(task, params)?;
+    let task = run_config(config)?.build_task().py_err()?;
     let layout = task.layout();
     let nets = if population.cast::<PyDict>().is_err() && population.hasattr("shape")? {
         let g = dense(population, "genomes", arg_err)?;
@@ -278,27 +318,11 @@ pub fn evaluate<'py>(
     to_numpy(py, fitness, &[n])
 }
 
-/// (size, n_inputs) of the networks a built-in task drives.
+/// (size, n_inputs) of the networks a run's built-in task drives.
 #[pyfunction]
-pub fn task_layout(task: &str, params: &str) -> PyResult<(usize, usize)> {
-    let layout = build_task(task, params)?.layout();
+pub fn task_layout(config: &str) -> PyResult<(usize, usize)> {
+    let layout = run_config(config)?.build_task().py_err()?.layout();
     Ok((layout.size, layout.n_inputs))
-}
-
-/// Whether `net` meets the built-in task's success criterion on fresh conditions from `seed`
-/// (None when the task has none).
-#[pyfunction]
-pub fn task_success(
-    py: Python<'_>,
-    task: &str,
-    params: &str,
-    net: &PyNetwork,
-    seed: &Bound<'_, PyAny>,
-) -> PyResult<Option<bool>> {
-    let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
-    let task = build_task(task, params)?;
-    let net = &net.inner;
-    py.detach(|| task.succeeds(net, seed)).py_err()
 }
 
 /// The names of the built-in tasks.

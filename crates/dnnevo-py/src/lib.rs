@@ -32,7 +32,7 @@ mod _core {
     use super::analysis::{analysis_bifurcation, analysis_cycles, analysis_equilibria};
     #[pymodule_export]
     use super::evolution::{
-        decode, encode, evaluate, task_layout, task_names, task_success, PyEvolution,
+        check_config, decode, encode, evaluate, task_layout, task_names, PyEvolution,
     };
     #[pymodule_export]
     use super::landmark::{
@@ -59,15 +59,8 @@ mod _core {
         m.add("MAX_COUNT", tasks::MAX_COUNT)?;
         m.add("MUTATION_SCALE", ctrnn::ga::MUTATION_SCALE)?;
         // Python's config classes take their defaults from these, so the two cannot drift.
-        let json = |v: serde_json::Result<String>| v.expect("defaults always serialise");
-        m.add(
-            "GA_DEFAULTS",
-            json(serde_json::to_string(&ctrnn::GaConfig::default())),
-        )?;
-        m.add(
-            "TASK_INTEGRATOR",
-            json(serde_json::to_string(&tasks::TIME_STEP)),
-        )?;
+        let defaults = serde_json::to_string(&tasks::RunConfig::default());
+        m.add("RUN_DEFAULTS", defaults.expect("defaults always serialise"))?;
         m.add("RETRY_STARTS", ctrnn::analysis::RETRY_STARTS)?;
         Ok(())
     }

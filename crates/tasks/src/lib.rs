@@ -19,10 +19,12 @@ pub mod landmark;
 mod lanes;
 pub mod nav1d;
 pub mod registry;
+mod run_config;
 pub mod sequence;
 
 pub use common::{MAX_COUNT, TIME_STEP};
 pub use registry::{build, names};
+pub use run_config::RunConfig;
 pub use sequence::{
     performance, Aggregate, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask,
     TargetReport, TrialRecord,

@@ -1,0 +1,258 @@
+//! One evolution run's settings, as `dnnevo.EvolutionConfig` writes them: the one place they are
+//! checked and the one place their defaults live.
+//!
+//! Python's `EvolutionConfig` checks types only and takes its defaults from
+//! [`RunConfig::default`]; every value check happens in [`RunConfig::validate`], so the two sides
+//! cannot disagree about what a valid run is.
+//!
+//! # Example
+//! ```
+//! let config = tasks::RunConfig::from_json(r#"{"population": 20, "generations": 5}"#)?;
+//! assert_eq!(config.ga().population, 20);
+//! assert_eq!(config.layout().size, 5);
+//! let e = tasks::RunConfig::from_json(r#"{"elitism": 200}"#).err().unwrap().to_string();
+//! assert!(e.contains("elitism is 200; it must be below population = 100"), "{e}");
+//! # Ok::<(), ctrnn::Error>(())
+//! ```
+
+use ctrnn::ga::MutationKind;
+use ctrnn::{Error, Fill, GaConfig, Integrator, Layout, Ranges, Result, Selection, Task};
+use serde::{Deserialize, Serialize};
+
+use crate::common::{config_from_params, TIME_STEP};
+
+/// Everything an evolution run needs besides its seed. Missing fields take their defaults;
+/// unknown fields are an error.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RunConfig {
+    /// The task's name: a built-in task ([`crate::names`]), or a caller's own (Python's
+    /// `python:module.function`), which only the caller can build. Default `"sequence"`.
+    pub task: String,
+    /// Individuals per generation. Default 100.
+    pub population: usize,
+    /// Generations to run (at least 1). Default 100.
+    pub generations: u64,
+    /// See [`GaConfig::crossover_rate`]. Default 0.5.
+    pub crossover_rate: f64,
+    /// See [`GaConfig::mutation_rate`] (a per-gene rate). Default 0.025.
+    pub mutation_rate: f64,
+    /// See [`GaConfig::mutation`]. Default uniform, the paper's.
+    pub mutation: MutationKind,
+    /// See [`GaConfig::mutation_scale`].
+    pub mutation_scale: f64,
+    /// See [`GaConfig::elitism`]. Default 0, the paper's.
+    pub elitism: usize,
+    /// See [`GaConfig::validation_candidates`]. Default 10.
+    pub validation_candidates: usize,
+    /// See [`GaConfig::selection`]. Default proportional, the paper's.
+    pub selection: Selection,
+    /// With seed networks, how the rest of the population is filled. Default mutants.
+    pub fill: Fill,
+    /// Neurons per network (at least 1). Default 5.
+    pub size: usize,
+    /// Sensors per network; a built-in task checks it matches. Default 2.
+    pub n_inputs: usize,
+    /// How a built-in task integrates its networks. Default [`TIME_STEP`].
+    pub integrator: Integrator,
+    /// Gene ranges. Default [`Ranges::default`].
+    pub ranges: Ranges,
+    /// The task's own settings, passed to it as they are.
+    pub task_params: serde_json::Map<String, serde_json::Value>,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        let ga = GaConfig::default();
+        RunConfig {
+            task: "sequence".into(),
+            population: ga.population,
+            generations: 100,
+            crossover_rate: ga.crossover_rate,
+            mutation_rate: ga.mutation_rate,
+            mutation: ga.mutation,
+            mutation_scale: ga.mutation_scale,
+            elitism: ga.elitism,
+            validation_candidates: ga.validation_candidates,
+            selection: ga.selection,
+            fill: Fill::default(),
+            size: 5,
+            n_inputs: 2,
+            integrator: TIME_STEP,
+            ranges: ga.ranges,
+            task_params: serde_json::Map::new(),
+        }
+    }
+}
+
+/// The settings a task's parameters may not hold, because the run config sets them.
+const SET_BY_RUN: [&str; 2] = ["size", "integrator"];
+
+impl RunConfig {
+    /// Reads and validates a config from JSON text. Errors name the field (`integrator.dt`).
+    pub fn from_json(text: &str) -> Result<Self> {
+        let value: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| Error::Config(format!("config: not valid JSON: {e}")))?;
+        let config: RunConfig = config_from_params("config", &value)?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Checks every value; the first problem is an [`Error::Config`] that names its field.
+    pub fn validate(&self) -> Result<()> {
+        if self.task.is_empty() {
+            return Err(Error::Config("task is empty; expected a task name".into()));
+        }
+        if self.generations == 0 {
+            return Err(Error::Config(
+                "generations is 0; it must be at least 1".into(),
+            ));
+        }
+        if self.size == 0 {
+            return Err(Error::Config("size is 0; it must be at least 1".into()));
+        }
+        self.ga().validate()?;
+        self.integrator.validate().map_err(|e| match e {
+            Error::InvalidArgument(m) => Error::Config(format!("integrator.{m}")),
+            other => other,
+        })?;
+        if let Some(key) = SET_BY_RUN
+            .iter()
+            .find(|k| self.task_params.contains_key(**k))
+        {
+            return Err(Error::Config(format!(
+                "task_params.{key} is set; set {key} at the top level of the config"
+            )));
+        }
+        Ok(())
+    }
+
+    /// The genetic algorithm's part.
+    pub fn ga(&self) -> GaConfig {
+        GaConfig {
+            population: self.population,
+            crossover_rate: self.crossover_rate,
+            mutation_rate: self.mutation_rate,
+            mutation: self.mutation,
+            mutation_scale: self.mutation_scale,
+            elitism: self.elitism,
+            selection: self.selection,
+            ranges: self.ranges,
+            validation_candidates: self.validation_candidates,
+        }
+    }
+
+    /// The networks' shape.
+    pub fn layout(&self) -> Layout {
+        Layout {
+            size: self.size,
+            n_inputs: self.n_inputs,
+        }
+    }
+
+    /// The parameters a built-in task is built from: `size`, `integrator`, then `task_params`.
+    pub fn task_params(&self) -> serde_json::Value {
+        let mut params = self.task_params.clone();
+        params.insert("size".into(), self.size.into());
+        let integrator = serde_json::to_value(self.integrator).expect("settings always serialise");
+        params.insert("integrator".into(), integrator);
+        serde_json::Value::Object(params)
+    }
+
+    /// Builds the built-in task this config names; a caller's own task name is an error.
+    pub fn build_task(&self) -> Result<Box<dyn Task>> {
+        crate::build(&self.task, &self.task_params())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn error(json: &str) -> String {
+        RunConfig::from_json(json).err().unwrap().to_string()
+    }
+
+    #[test]
+    fn defaults_are_valid_and_match_the_ga_and_the_tasks() {
+        let config = RunConfig::from_json("{}").unwrap();
+        assert_eq!(config, RunConfig::default());
+        assert_eq!(config.ga(), GaConfig::default());
+        assert_eq!(config.integrator, TIME_STEP);
+        let round = serde_json::to_string(&config).unwrap();
+        assert_eq!(RunConfig::from_json(&round).unwrap(), config);
+    }
+
+    #[test]
+    fn every_bad_value_names_its_field() {
+        for (json, fragment) in [
+            (r#"{"population": 1}"#, "population is 1"),
+            (
+                r#"{"crossover_rate": 1.5}"#,
+                "crossover_rate is 1.5; it must be in [0, 1]",
+            ),
+            (r#"{"mutation_rate": -0.1}"#, "mutation_rate is -0.1"),
+            (
+                r#"{"mutation_scale": 0}"#,
+                "mutation_scale is 0; it must be in (0, 1]",
+            ),
+            (r#"{"elitism": 100}"#, "elitism is 100"),
+            (r#"{"generations": 0}"#, "generations is 0"),
+            (r#"{"size": 0}"#, "size is 0"),
+            (r#"{"task": ""}"#, "task is empty"),
+            (
+                r#"{"selection": "tournament"}"#,
+                "selection: unknown variant `tournament`",
+            ),
+            (
+                r#"{"mutation": "gauss"}"#,
+                "mutation: unknown variant `gauss`",
+            ),
+            (r#"{"fill": "zeros"}"#, "fill: unknown variant `zeros`"),
+            (r#"{"integrator": {"dt": 0}}"#, "missing field `method`"),
+            (
+                r#"{"integrator": {"method": "euler", "dt": 0, "substeps": 1}}"#,
+                "integrator.dt is 0",
+            ),
+            (
+                r#"{"integrator": {"method": "rk2", "dt": 0.1, "substeps": 1}}"#,
+                "integrator.method: unknown variant `rk2`",
+            ),
+            (r#"{"populaton": 3}"#, "unknown field `populaton`"),
+            (
+                r#"{"population": -1}"#,
+                "population: invalid value: integer `-1`",
+            ),
+            (r#"{"task_params": {"size": 3}}"#, "task_params.size is set"),
+            ("[1]", "the parameters must be a JSON object"),
+            ("{", "not valid JSON"),
+        ] {
+            let e = error(json);
+            assert!(e.contains(fragment), "{json}: {e}");
+        }
+        let tau = r#"{"ranges": {"tau": [0, 1], "theta": [-1, 1], "weights": [-1, 1],
+                      "sensor_weights": [-1, 1]}}"#;
+        assert!(
+            error(tau).contains("ranges.tau is (0, 1)"),
+            "{}",
+            error(tau)
+        );
+    }
+
+    #[test]
+    fn the_task_gets_the_runs_size_and_integrator() {
+        let json = r#"{"size": 7, "task_params": {"targets": ["0", "1"]}}"#;
+        let config = RunConfig::from_json(json).unwrap();
+        assert_eq!(config.build_task().unwrap().layout().size, 7);
+        let params = config.task_params();
+        assert_eq!(params["integrator"]["substeps"], 10);
+        assert_eq!(params["targets"][1], "1");
+        let own = RunConfig {
+            task: "python:m.f".into(),
+            ..RunConfig::default()
+        };
+        assert!(own.validate().is_ok());
+        let e = own.build_task().err().unwrap().to_string();
+        assert!(e.contains("unknown task \"python:m.f\""), "{e}");
+    }
+}

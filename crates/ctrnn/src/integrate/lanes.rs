@@ -1,0 +1,392 @@
+//! [`Lanes`]: `L` networks of the same shape packed parameter by parameter, side by side, and
+//! stepped together by the kernel.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::error::{Error, Result};
+use crate::math::sigmoid;
+use crate::network::Network;
+use crate::rows::Rows;
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+use crate::vector::Avx512;
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+use crate::vector::Group;
+use crate::vector::{Portable, Vector};
+
+use super::kernel::{rates, weight_order, Work};
+use super::Integrator;
+
+/// How many networks a population block steps together: two AVX-512 registers of f64, so that
+/// every row of the kernel has two independent dependency chains in flight.
+pub const LANES: usize = 16;
+
+/// Integration steps (rows times substeps) between two looks at the cancel flag, so that Ctrl-C
+/// is seen within milliseconds however many substeps a row has.
+const CANCEL_CHECK_STEPS: usize = 1024;
+
+/// Calls `self.method::<V>(args)` with `V` the lane vector type for `L` lanes: AVX-512 registers
+/// where the build's target CPU has them and `L` is 8 or 16, plain lanes otherwise.
+macro_rules! with_backend {
+    ($self:ident . $method:ident ( $($arg:expr),* )) => {{
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+        if L == 8 {
+            return $self.$method::<Avx512>($($arg),*);
+        }
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+        if L == 16 {
+            return $self.$method::<Group<Avx512, 2>>($($arg),*);
+        }
+        $self.$method::<Portable<L>>($($arg),*)
+    }};
+}
+
+/// `L` networks of the same shape, laid out for stepping together.
+#[derive(Clone, Debug)]
+pub struct Lanes<const L: usize> {
+    size: usize,
+    n_inputs: usize,
+    len: usize,
+    tau: Rows<L>,
+    theta: Rows<L>,
+    weights: Rows<L>,
+    sensor_weights: Rows<L>,
+    state: Rows<L>,
+    scratch: Scratch<L>,
+}
+
+/// Work arrays, reused from step to step so that stepping allocates nothing.
+#[derive(Clone, Debug)]
+struct Scratch<const L: usize> {
+    dt: f64,
+    /// dt / tau, and its half and sixth for RK4.
+    h: Rows<L>,
+    h2: Rows<L>,
+    h6: Rows<L>,
+    /// Sensor drive S I of the current row.
+    ext: Rows<L>,
+    /// Whether `ext` is the sensor drive of the last [`Lanes::step_row`], for
+    /// [`Lanes::step_held`].
+    held: bool,
+    /// Firing rates.
+    out: Rows<L>,
+    /// Whether `out` holds the firing rates of the current state, computed by
+    /// [`Lanes::outputs`]; the next step then starts from them instead of computing them again.
+    fresh: bool,
+    /// RK4's first three slopes (the fourth is used as soon as it is known).
+    k: [Rows<L>; 3],
+    probe: Rows<L>,
+}
+
+impl<const L: usize> Lanes<L> {
+    /// Packs up to `L` networks of the same shape. Unused lanes repeat the first network, so they
+    /// stay finite; their results are ignored.
+    pub fn new(nets: &[&Network]) -> Result<Self> {
+        let first = nets.first().ok_or_else(|| {
+            Error::InvalidArgument("a population needs at least 1 network".into())
+        })?;
+        if nets.len() > L {
+            return Err(Error::InvalidArgument(format!(
+                "{} networks do not fit in {L} lanes",
+                nets.len()
+            )));
+        }
+        let (n, m) = (first.size(), first.n_inputs());
+        for (p, net) in nets.iter().enumerate() {
+            if (net.size(), net.n_inputs()) != (n, m) {
+                return Err(Error::InvalidArgument(format!(
+                    "network {p} has N = {}, M = {}; every network of a population must have N = {n}, M = {m}",
+                    net.size(),
+                    net.n_inputs()
+                )));
+            }
+        }
+        // Row r of an array holds value order[r] of every network; padding lanes repeat the first.
+        let gather = |get: fn(&Network) -> &[f64], order: &mut dyn Iterator<Item = usize>| {
+            let sources: [&[f64]; L] = std::array::from_fn(|l| get(nets.get(l).unwrap_or(first)));
+            let len = get(first).len();
+            Rows::from_rows(len, order.map(|q| std::array::from_fn(|l| sources[l][q])))
+        };
+        let zeros = Rows::zeros;
+        Ok(Lanes {
+            size: n,
+            n_inputs: m,
+            len: nets.len(),
+            tau: gather(Network::tau, &mut (0..n)),
+            theta: gather(Network::theta, &mut (0..n)),
+            weights: gather(Network::weights, &mut weight_order(n)),
+            sensor_weights: gather(Network::sensor_weights, &mut (0..n * m)),
+            state: gather(Network::state, &mut (0..n)),
+            scratch: Scratch {
+                dt: f64::NAN,
+                h: zeros(n),
+                h2: zeros(n),
+                h6: zeros(n),
+                ext: zeros(n),
+                held: false,
+                out: zeros(n),
+                fresh: false,
+                k: [zeros(n), zeros(n), zeros(n)],
+                probe: zeros(n),
+            },
+        })
+    }
+
+    /// Number of real (not padding) networks.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// Whether there are no real networks (never true for a constructed value).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+    /// Neurons per network.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+    /// Sensors per network.
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs
+    }
+
+    /// State of neuron `i` in every lane.
+    pub fn state(&self, i: usize) -> &[f64; L] {
+        &self.state[i]
+    }
+    /// Firing rate `f(v_i - theta_i)` of neuron `i` in every lane.
+    pub fn output(&self, i: usize) -> [f64; L] {
+        std::array::from_fn(|l| sigmoid(self.state[i][l] - self.theta[i][l]))
+    }
+    /// Every neuron's firing rate in every lane, `outputs()[i][l] = f(v_i - theta_i)`, with the
+    /// same bits as [`output`](Self::output). Computed once per state, in the lane vectors of a
+    /// step; the next step starts from these rates instead of computing them again, so reading
+    /// them after every step costs nothing.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Integrator, Lanes, Network};
+    /// let net = Network::new(vec![1.0], vec![0.5], vec![0.0], vec![1.0], None).unwrap();
+    /// let mut lanes = Lanes::<1>::new(&[&net]).unwrap();
+    /// lanes.step_row(&[[1.0]], &Integrator::default());
+    /// let one = lanes.output(0);
+    /// assert_eq!(lanes.outputs()[0], one);
+    /// ```
+    pub fn outputs(&mut self) -> &[[f64; L]] {
+        if !self.scratch.fresh {
+            self.compute_outputs();
+            self.scratch.fresh = true;
+        }
+        &self.scratch.out
+    }
+
+    fn compute_outputs(&mut self) {
+        with_backend!(self.compute_outputs_with())
+    }
+
+    fn compute_outputs_with<V: Vector>(&mut self) {
+        rates::<V>(
+            V::rows(self.theta.as_flattened()),
+            V::rows(self.state.as_flattened()),
+            V::rows_mut(self.scratch.out.as_flattened_mut()),
+        );
+    }
+
+    /// Sets every lane's state to zero.
+    pub fn reset(&mut self) {
+        self.scratch.fresh = false;
+        self.state.fill([0.0; L]);
+    }
+    /// Sets the state of lane `l` (length N).
+    pub fn set_lane_state(&mut self, l: usize, state: &[f64]) {
+        self.scratch.fresh = false;
+        for (row, &v) in self.state.iter_mut().zip(state) {
+            row[l] = v;
+        }
+    }
+    /// Copies the state of lane `l` into `into` (length N).
+    pub fn lane_state(&self, l: usize, into: &mut [f64]) {
+        copy_lane(&self.state, l, into);
+    }
+
+    /// Makes the step sizes match `dt`.
+    #[inline(always)]
+    pub(super) fn prepare(&mut self, dt: f64) {
+        if self.scratch.dt.to_bits() != dt.to_bits() {
+            self.set_step_sizes(dt);
+        }
+    }
+
+    #[cold]
+    fn set_step_sizes(&mut self, dt: f64) {
+        let s = &mut self.scratch;
+        s.dt = dt;
+        for i in 0..self.size {
+            for l in 0..L {
+                let h = dt / self.tau[i][l];
+                s.h[i][l] = h;
+                s.h2[i][l] = 0.5 * h;
+                s.h6[i][l] = h / 6.0;
+            }
+        }
+    }
+
+    /// Holds `inputs` (one `[f64; L]` per sensor) for `integ.substeps` steps of `integ.dt`.
+    /// `integ` must be valid.
+    #[inline(always)]
+    pub fn step_row(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
+        debug_assert_eq!(inputs.len(), self.n_inputs);
+        self.prepare(integ.dt);
+        with_backend!(self.step_row_with(inputs, integ))
+    }
+
+    #[inline(always)]
+    pub(super) fn step_row_with<V: Vector>(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
+        let fresh = std::mem::take(&mut self.scratch.fresh);
+        self.scratch.held = true;
+        let (mut work, state) = self.work::<V>();
+        work.step(
+            V::rows_mut(state.as_flattened_mut()),
+            V::rows(inputs.as_flattened()),
+            integ,
+            fresh,
+        );
+    }
+
+    /// [`step_row`](Self::step_row) with the inputs of the last `step_row` call, held: the same
+    /// bits, without computing their sensor drive again. A world that moves one integration step
+    /// at a time mostly holds its inputs.
+    ///
+    /// # Panics
+    /// If `step_row` has not been called on these lanes, or [`run_rows`](Self::run_rows) has
+    /// been called since.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Integrator, Lanes, Network};
+    /// let net = Network::new(vec![1.0], vec![0.5], vec![0.0], vec![1.0], None).unwrap();
+    /// let (mut a, integ) = (Lanes::<1>::new(&[&net]).unwrap(), Integrator::default());
+    /// let mut b = a.clone();
+    /// a.step_row(&[[1.0]], &integ);
+    /// a.step_row(&[[1.0]], &integ);
+    /// b.step_row(&[[1.0]], &integ);
+    /// b.step_held(&integ);
+    /// assert_eq!(a.state(0), b.state(0));
+    /// ```
+    #[inline(always)]
+    pub fn step_held(&mut self, integ: &Integrator) {
+        assert!(
+            self.scratch.held,
+            "step_held needs a step_row before it, with no run_rows in between"
+        );
+        self.prepare(integ.dt);
+        with_backend!(self.step_held_with(integ))
+    }
+
+    #[inline(always)]
+    fn step_held_with<V: Vector>(&mut self, integ: &Integrator) {
+        let fresh = std::mem::take(&mut self.scratch.fresh);
+        let (mut work, state) = self.work::<V>();
+        work.integrate(V::rows_mut(state.as_flattened_mut()), integ, fresh);
+    }
+
+    /// Runs `steps` input rows. `row(t, inputs)` fills the sensors of row `t`; after each row
+    /// `record(t, state)` may read the state (one `[f64; L]` per neuron). Stops with
+    /// [`Error::Interrupted`] when `cancel` is set.
+    pub fn run_rows(
+        &mut self,
+        steps: usize,
+        integ: &Integrator,
+        cancel: Option<&AtomicBool>,
+        row: impl FnMut(usize, &mut [[f64; L]]),
+        record: impl FnMut(usize, &[[f64; L]]),
+    ) -> Result<()> {
+        self.prepare(integ.dt);
+        with_backend!(self.run_rows_with(steps, integ, cancel, row, record))?;
+        self.check_finite()
+    }
+
+    #[inline(always)]
+    fn run_rows_with<V: Vector>(
+        &mut self,
+        steps: usize,
+        integ: &Integrator,
+        cancel: Option<&AtomicBool>,
+        mut row: impl FnMut(usize, &mut [[f64; L]]),
+        mut record: impl FnMut(usize, &[[f64; L]]),
+    ) -> Result<()> {
+        let mut inputs = Rows::<L>::zeros(self.n_inputs);
+        // The row views are taken once: taken row by row, they cost 10% at N = 5.
+        let inputs: &mut [[f64; L]] = &mut inputs;
+        let mut fresh = std::mem::take(&mut self.scratch.fresh);
+        self.scratch.held = false;
+        let (mut work, state) = self.work::<V>();
+        let check_rows = (CANCEL_CHECK_STEPS / integ.substeps.max(1)).max(1);
+        let mut rows_to_check = 0;
+        for t in 0..steps {
+            if rows_to_check == 0 {
+                if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                    return Err(Error::Interrupted);
+                }
+                rows_to_check = check_rows;
+            }
+            rows_to_check -= 1;
+            row(t, inputs);
+            let v = V::rows_mut(state.as_flattened_mut());
+            work.step(v, V::rows(inputs.as_flattened()), integ, fresh);
+            fresh = false;
+            record(t, state);
+        }
+        Ok(())
+    }
+
+    /// Every array a step uses but the state, viewed as rows of `V`; and the state.
+    #[inline(always)]
+    fn work<V: Vector>(&mut self) -> (Work<'_, V>, &mut [[f64; L]]) {
+        fn rows<V: Vector, const L: usize>(x: &[[f64; L]]) -> &[V::Row] {
+            V::rows(x.as_flattened())
+        }
+        fn rows_mut<V: Vector, const L: usize>(x: &mut [[f64; L]]) -> &mut [V::Row] {
+            V::rows_mut(x.as_flattened_mut())
+        }
+        let s = &mut self.scratch;
+        let [k1, k2, k3] = &mut s.k;
+        let work = Work {
+            theta: rows::<V, L>(&self.theta),
+            weights: rows::<V, L>(&self.weights),
+            sensor_weights: rows::<V, L>(&self.sensor_weights),
+            h: rows::<V, L>(&s.h),
+            h2: rows::<V, L>(&s.h2),
+            h6: rows::<V, L>(&s.h6),
+            ext: rows_mut::<V, L>(&mut s.ext),
+            out: rows_mut::<V, L>(&mut s.out),
+            k: [
+                rows_mut::<V, L>(k1),
+                rows_mut::<V, L>(k2),
+                rows_mut::<V, L>(k3),
+            ],
+            probe: rows_mut::<V, L>(&mut s.probe),
+        };
+        (work, &mut self.state)
+    }
+
+    /// An Euler step with `dt / tau > 2` oscillates with growing amplitude; say so rather than
+    /// return infinities.
+    fn check_finite(&self) -> Result<()> {
+        for (i, row) in self.state.iter().enumerate() {
+            if let Some(l) = (0..self.len).find(|&l| !row[l].is_finite()) {
+                return Err(Error::InvalidArgument(format!(
+                    "integration diverged: state[{i}] of network {l} in its block became {}; \
+                     use a smaller dt (dt / tau = {} here; Euler needs it well below 2)",
+                    row[l], self.scratch.h[i][l]
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Copies lane `l` of `rows` (one value per row) into `into`.
+pub fn copy_lane<const L: usize>(rows: &[[f64; L]], l: usize, into: &mut [f64]) {
+    for (dst, row) in into.iter_mut().zip(rows) {
+        *dst = row[l];
+    }
+}

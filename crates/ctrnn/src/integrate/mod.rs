@@ -1,0 +1,412 @@
+//! Forward Euler and classical RK4 for one network or a block of networks stepped together.
+//!
+//! The kernel works on [`Lanes`]: `L` networks of the same shape, stored parameter by parameter
+//! with the networks side by side (`theta[i][lane]`), so that one step is straight-line
+//! arithmetic over rows of `L` values, one per network. A single network is `Lanes<1>` and a
+//! population block is `Lanes<LANES>`. The kernel is written once over the crate's lane vectors:
+//! where the build's target CPU has AVX-512F a block keeps each row in 512-bit registers (8 lanes
+//! each), elsewhere it runs lane by lane. Every path performs the same operations in the same
+//! order, which is why single networks and populations agree bit for bit.
+//!
+//! One Euler step of size `dt`, with `h = dt / tau`:
+//! `v += h * (-v + W f(v - theta) + S I)`. Each row of inputs is held for `substeps` steps.
+//!
+//! The parts: the settings ([`Integrator`], [`Method`]), the packing of networks into lanes
+//! ([`Lanes`]), and the step itself (`kernel.rs`).
+
+use std::sync::atomic::AtomicBool;
+
+use crate::error::{Error, Result};
+use crate::network::Network;
+
+mod kernel;
+mod lanes;
+mod settings;
+
+pub use lanes::{copy_lane, Lanes, LANES};
+pub use settings::{Integrator, Method};
+
+impl Network {
+    /// Integrates the network through `steps` rows of `inputs` (row-major `steps x n_inputs`),
+    /// each held for `integ.substeps` steps, and returns the state after every row
+    /// (row-major `steps x size`). The network keeps the final state.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Integrator, Network};
+    /// let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    /// let states = net.run(&[1.0, 1.0], 2, &Integrator::default()).unwrap();
+    /// // v += 0.1 * (-v + 1): 0.1, then 0.19
+    /// assert!((states[0] - 0.1).abs() < 1e-15 && (states[1] - 0.19).abs() < 1e-15);
+    /// ```
+    pub fn run(&mut self, inputs: &[f64], steps: usize, integ: &Integrator) -> Result<Vec<f64>> {
+        self.run_cancellable(inputs, steps, integ, None)
+    }
+
+    /// [`Network::run`] that stops with [`Error::Interrupted`] once `cancel` is set.
+    pub fn run_cancellable(
+        &mut self,
+        inputs: &[f64],
+        steps: usize,
+        integ: &Integrator,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        integ.validate()?;
+        let (n, m) = (self.size(), self.n_inputs());
+        check_inputs(inputs, steps * m, "steps x n_inputs")?;
+        let mut lanes = Lanes::<1>::new(&[self])?;
+        let mut states = vec![0.0; steps * n];
+        lanes.run_rows(
+            steps,
+            integ,
+            cancel,
+            |t, row| {
+                for k in 0..m {
+                    row[k][0] = inputs[t * m + k];
+                }
+            },
+            |t, state| copy_lane(state, 0, &mut states[t * n..(t + 1) * n]),
+        )?;
+        lanes.lane_state(0, self.state_mut());
+        Ok(states)
+    }
+}
+
+/// Checks an input array's length and that every value is finite.
+pub(crate) fn check_inputs(inputs: &[f64], want: usize, shape: &str) -> Result<()> {
+    if inputs.len() != want {
+        return Err(Error::InvalidArgument(format!(
+            "inputs have {} values; expected {shape} = {want}",
+            inputs.len()
+        )));
+    }
+    match inputs.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(Error::InvalidArgument(format!(
+            "inputs contain {} at flat index {k}; every input must be finite",
+            inputs[k]
+        ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::kernel::weight_order;
+    use super::*;
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    use crate::vector::{Avx512, Group, Portable, Vector};
+
+    fn sig(x: f64) -> f64 {
+        1.0 / (1.0 + (-x).exp())
+    }
+
+    #[test]
+    fn euler_step_matches_hand_calculation() {
+        // N = 2, M = 1, one step from v = (0.5, -1) with input 2.
+        let mut net = Network::new(
+            vec![1.0, 2.0],
+            vec![0.25, -0.5],
+            vec![1.0, -2.0, 0.5, 3.0],
+            vec![0.3, -0.7],
+            Some(vec![0.5, -1.0]),
+        )
+        .unwrap();
+        let integ = Integrator::default();
+        let s = net.run(&[2.0], 1, &integ).unwrap();
+        let f0 = sig(0.5 - 0.25);
+        let f1 = sig(-1.0 + 0.5);
+        let d0 = -0.5 + (1.0 * f0 - 2.0 * f1) + 0.3 * 2.0;
+        let d1 = 1.0 + (0.5 * f0 + 3.0 * f1) - 0.7 * 2.0;
+        let want = [0.5 + 0.1 / 1.0 * d0, -1.0 + 0.1 / 2.0 * d1];
+        for i in 0..2 {
+            assert!((s[i] - want[i]).abs() < 1e-15, "{} vs {}", s[i], want[i]);
+        }
+        assert_eq!(net.state(), &s[..]);
+    }
+
+    /// With W = 0 and constant input, v(t) = c + (v0 - c) e^{-t / tau} with c = S I.
+    fn rk4_error(dt: f64) -> f64 {
+        let tau = [0.7, 1.3, 4.0];
+        let mut net = Network::new(
+            tau.to_vec(),
+            vec![0.0; 3],
+            vec![0.0; 9],
+            vec![1.0, -2.0, 0.5],
+            Some(vec![2.0, 1.0, -3.0]),
+        )
+        .unwrap();
+        let t_end = 2.0;
+        let steps = (t_end / dt).round() as usize;
+        let integ = Integrator {
+            method: Method::Rk4,
+            dt,
+            substeps: steps,
+        };
+        let s = net.run(&[1.5], 1, &integ).unwrap();
+        let c = [1.5, -3.0, 0.75];
+        let v0 = [2.0, 1.0, -3.0];
+        (0..3)
+            .map(|i| (s[i] - (c[i] + (v0[i] - c[i]) * (-t_end / tau[i]).exp())).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn rk4_converges_with_order_four() {
+        let (e1, e2) = (rk4_error(0.2), rk4_error(0.1));
+        let order = (e1 / e2).log2();
+        assert!(
+            (3.8..4.2).contains(&order),
+            "order {order}, errors {e1} {e2}"
+        );
+    }
+
+    #[test]
+    fn euler_converges_with_order_one() {
+        let err = |dt: f64| {
+            let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+            let integ = Integrator {
+                method: Method::Euler,
+                dt,
+                substeps: (1.0 / dt).round() as usize,
+            };
+            let s = net.run(&[1.0], 1, &integ).unwrap();
+            (s[0] - (1.0 - (-1.0f64).exp())).abs()
+        };
+        let order = (err(0.01) / err(0.005)).log2();
+        assert!((0.95..1.05).contains(&order), "order {order}");
+    }
+
+    #[test]
+    fn bad_arguments_are_errors() {
+        let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+        let bad_dt = Integrator {
+            dt: -0.1,
+            ..Integrator::default()
+        };
+        assert!(net
+            .run(&[1.0], 1, &bad_dt)
+            .unwrap_err()
+            .to_string()
+            .contains("dt"));
+        let zero = Integrator {
+            substeps: 0,
+            ..Integrator::default()
+        };
+        assert!(net.run(&[1.0], 1, &zero).is_err());
+        assert!(net.run(&[1.0, 2.0], 1, &Integrator::default()).is_err());
+        assert!(net.run(&[f64::NAN], 1, &Integrator::default()).is_err());
+        assert!("rk5".parse::<Method>().is_err());
+    }
+
+    #[test]
+    fn divergence_is_reported_not_returned() {
+        let mut net =
+            Network::new(vec![0.5], vec![0.0], vec![0.0], vec![1.0], Some(vec![1.0])).unwrap();
+        let huge = Integrator {
+            dt: 5.0,
+            substeps: 1000,
+            ..Integrator::default()
+        };
+        let e = net.run(&[0.0], 1, &huge).unwrap_err().to_string();
+        assert!(e.contains("diverged"), "{e}");
+    }
+
+    #[test]
+    fn weights_are_stored_by_row_groups() {
+        // 6 x 6 with ROWS = 4: rows 0-3 column by column, then rows 4 and 5 as they are.
+        let order: Vec<usize> = weight_order(6).collect();
+        assert_eq!(order[..8], [0, 6, 12, 18, 1, 7, 13, 19]);
+        assert_eq!(order[20..24], [5, 11, 17, 23]);
+        assert_eq!(order[24..], (24..36).collect::<Vec<_>>()[..]);
+        // Fewer rows than a group: row-major.
+        assert_eq!(
+            weight_order(3).collect::<Vec<_>>(),
+            (0..9).collect::<Vec<_>>()
+        );
+    }
+
+    /// Random networks of one shape, from a fixed seed.
+    fn random_networks(count: usize, n: usize, m: usize, seed: u64) -> Vec<Network> {
+        use crate::rng::{Purpose, Stream};
+        let mut rng = Stream::new(seed, 0, Purpose::Init, 0, 0);
+        let mut draw = |count: usize, lo: f64, hi: f64| -> Vec<f64> {
+            (0..count).map(|_| rng.range(lo, hi)).collect()
+        };
+        (0..count)
+            .map(|_| {
+                let (tau, theta) = (draw(n, 0.5, 10.0), draw(n, -16.0, 16.0));
+                let (w, s, v) = (
+                    draw(n * n, -16.0, 16.0),
+                    draw(n * m, -16.0, 16.0),
+                    draw(n, -5.0, 5.0),
+                );
+                Network::new(tau, theta, w, s, Some(v)).unwrap()
+            })
+            .collect()
+    }
+
+    /// Steps one block with vector backend `V` and with the portable backend: same bits.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    fn backends_agree<V: Vector<Row = R>, R, const L: usize>() {
+        for (n, m) in [
+            (1, 0),
+            (3, 1),
+            (4, 2),
+            (5, 2),
+            (7, 3),
+            (10, 2),
+            (13, 1),
+            (30, 2),
+        ] {
+            let nets = random_networks(L, n, m, (n * 10 + m) as u64);
+            let refs: Vec<&Network> = nets.iter().collect();
+            for method in [Method::Euler, Method::Rk4] {
+                let integ = Integrator {
+                    method,
+                    dt: 0.05,
+                    substeps: 3,
+                };
+                let mut fast = Lanes::<L>::new(&refs).unwrap();
+                let mut portable = fast.clone();
+                for t in 0..20 {
+                    let inputs: Vec<[f64; L]> = (0..m)
+                        .map(|k| std::array::from_fn(|l| ((t * 7 + k * 3 + l) % 5) as f64 - 2.0))
+                        .collect();
+                    fast.prepare(integ.dt);
+                    fast.step_row_with::<V>(&inputs, &integ);
+                    portable.prepare(integ.dt);
+                    portable.step_row_with::<Portable<L>>(&inputs, &integ);
+                }
+                for i in 0..n {
+                    let (a, b) = (fast.state(i), portable.state(i));
+                    assert!(
+                        a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                        "N = {n}, M = {m}, {method:?}, neuron {i}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    fn avx512_blocks_match_the_portable_kernel_bit_for_bit() {
+        backends_agree::<Avx512, [f64; 8], 8>();
+        backends_agree::<Group<Avx512, 2>, [[f64; 8]; 2], 16>();
+    }
+
+    #[test]
+    fn reading_the_outputs_between_steps_changes_nothing() {
+        let nets = random_networks(LANES, 5, 2, 3);
+        let refs: Vec<&Network> = nets.iter().collect();
+        for method in [Method::Euler, Method::Rk4] {
+            let integ = Integrator {
+                method,
+                dt: 0.1,
+                substeps: 3,
+            };
+            let mut plain = Lanes::<LANES>::new(&refs).unwrap();
+            let mut read = plain.clone();
+            let same = |a: &Lanes<LANES>, b: &Lanes<LANES>| {
+                (0..5).all(|i| {
+                    let (x, y) = (a.state(i), b.state(i));
+                    x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+                })
+            };
+            for t in 0..30 {
+                // Rates read after row 9 and row 19 must not survive the reset and the new state.
+                if t == 10 {
+                    plain.reset();
+                    read.reset();
+                }
+                if t == 20 {
+                    plain.set_lane_state(3, &[1.0; 5]);
+                    read.set_lane_state(3, &[1.0; 5]);
+                }
+                let inputs = [[(t % 3) as f64; LANES], [1.0 - (t % 2) as f64; LANES]];
+                plain.step_row(&inputs, &integ);
+                read.step_row(&inputs, &integ);
+                assert!(same(&plain, &read), "{method:?}, row {t}");
+                if t % 4 != 2 {
+                    let out: Vec<[f64; LANES]> = read.outputs().to_vec();
+                    for (i, row) in out.iter().enumerate() {
+                        let want = read.output(i);
+                        assert!(row
+                            .iter()
+                            .zip(&want)
+                            .all(|(a, b)| a.to_bits() == b.to_bits()));
+                    }
+                }
+            }
+            let mut rows = read.clone();
+            let _ = rows.outputs();
+            let record = |_: usize, _: &[[f64; LANES]]| {};
+            rows.run_rows(5, &integ, None, |_, r| r[0][0] = 1.0, record)
+                .unwrap();
+            plain
+                .run_rows(5, &integ, None, |_, r| r[0][0] = 1.0, record)
+                .unwrap();
+            assert!(same(&plain, &rows), "{method:?}, run_rows");
+        }
+    }
+
+    #[test]
+    fn holding_the_inputs_is_stepping_them_again() {
+        let nets = random_networks(LANES, 5, 2, 4);
+        let refs: Vec<&Network> = nets.iter().collect();
+        for method in [Method::Euler, Method::Rk4] {
+            let integ = Integrator {
+                method,
+                dt: 0.1,
+                substeps: 2,
+            };
+            let mut again = Lanes::<LANES>::new(&refs).unwrap();
+            let (mut held, mut together) = (again.clone(), again.clone());
+            let same = |a: &Lanes<LANES>, b: &Lanes<LANES>| {
+                (0..5).all(|i| {
+                    let (x, y) = (a.state(i), b.state(i));
+                    x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+                })
+            };
+            for t in 0..12 {
+                let inputs = [[(t / 4) as f64; LANES], [0.5; LANES]];
+                again.step_row(&inputs, &integ);
+                if t % 4 == 0 {
+                    held.step_row(&inputs, &integ);
+                    // Four rows of the same inputs as one row of four times the steps.
+                    let four = Integrator {
+                        substeps: 4 * integ.substeps,
+                        ..integ
+                    };
+                    together.step_row(&inputs, &four);
+                } else {
+                    held.step_held(&integ);
+                }
+                if t % 3 == 0 {
+                    let _ = held.outputs();
+                }
+                assert!(same(&again, &held), "{method:?}, row {t}");
+                if t % 4 == 3 {
+                    assert!(same(&again, &together), "{method:?}, row {t}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "step_held needs a step_row before it")]
+    fn holding_needs_a_row() {
+        let net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+        Lanes::<1>::new(&[&net])
+            .unwrap()
+            .step_held(&Integrator::default());
+    }
+
+    #[test]
+    fn cancel_flag_interrupts() {
+        let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![], None).unwrap();
+        let flag = AtomicBool::new(true);
+        let r = net.run_cancellable(&[], 10, &Integrator::default(), Some(&flag));
+        assert!(matches!(r, Err(Error::Interrupted)));
+    }
+}

@@ -1,0 +1,73 @@
+//! Integration settings: the method, the step size and the steps per input row.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// The integration method.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Forward Euler, the paper's method (default).
+    #[default]
+    Euler,
+    /// Classical fourth-order Runge-Kutta.
+    Rk4,
+}
+
+impl std::str::FromStr for Method {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        crate::names::parse_name("method", s).map_err(Error::InvalidArgument)
+    }
+}
+
+impl Method {
+    /// The lower-case name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Euler => "euler",
+            Method::Rk4 => "rk4",
+        }
+    }
+}
+
+/// Integration settings: each input row is held for `substeps` steps of `dt`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Integrator {
+    /// Integration method. Default: Euler.
+    pub method: Method,
+    /// Step size in units of simulated time. Default: 0.1.
+    pub dt: f64,
+    /// Integration steps per input row. Default: 1.
+    pub substeps: usize,
+}
+
+impl Default for Integrator {
+    fn default() -> Self {
+        Integrator {
+            method: Method::Euler,
+            dt: 0.1,
+            substeps: 1,
+        }
+    }
+}
+
+impl Integrator {
+    /// Checks `dt` is finite and > 0 and `substeps >= 1`.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "dt is {}; it must be finite and > 0",
+                self.dt
+            )));
+        }
+        if self.substeps == 0 {
+            return Err(Error::InvalidArgument(
+                "substeps is 0; it must be >= 1".into(),
+            ));
+        }
+        Ok(())
+    }
+}

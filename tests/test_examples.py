@@ -13,6 +13,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "examples"))
 
 import incremental_plateau  # noqa: E402
+import trigger_answers  # noqa: E402
 
 
 def test_incremental_plateau(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -25,3 +26,17 @@ def test_incremental_plateau(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     assert lines[0] == "composite output identical to the 1-bit part's on 12 of 12 trials"
     assert len(lines) == 2 + 7 and lines[2].startswith("composite, cross weights 0")
     assert lines[-1].startswith("relay: w[0][5] = -16, theta[0] = -8")
+
+
+def test_trigger_answers(capsys: pytest.CaptureFixture[str]) -> None:
+    """The 1-bit champion, trial by trial: 0s for 0*, and 1s for 1* once it has switched."""
+    one_bit = ROOT / "tests" / "data" / "sequence-1bit-seed0-champion.json"
+    trigger_answers.main([str(one_bit), "--preset", "sequence-1bit", "--trials", "2"])
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split(":")[0] for line in lines] == ["  0* trial 0", "  0* trial 1", "  1* trial 0",
+                                                      "  1* trial 1"]
+    for line in lines:
+        wanted, answered, correct = (line.split(word + " ")[1].split()[0]
+                                     for word in ("wanted", "answered", "correct"))
+        assert len(wanted) == len(answered) == len(correct) >= 8
+        assert correct.endswith("++++") and answered.endswith(wanted[-4:])

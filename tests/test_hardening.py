@@ -370,6 +370,25 @@ def test_ctrl_c_during_start_up_is_one_line(tmp_path: Path) -> None:
         assert "Traceback" not in err and len(lines) <= 1, err
 
 
+def test_an_interrupt_wrapped_during_import_is_one_line() -> None:
+    """Python 3.11 turns a Ctrl-C that lands while a class is created into a RuntimeError from
+    ``__set_name__``: the start-up hook still reports it as an interrupt, and nothing else."""
+    code = (
+        "import dnnevo\n"
+        "for error in (KeyboardInterrupt, ValueError):\n"
+        "    try:\n"
+        "        try:\n"
+        "            raise error('inner')\n"
+        "        except BaseException as e:\n"
+        "            raise RuntimeError('wrapped') from e\n"
+        "    except RuntimeError as e:\n"
+        "        dnnevo._interrupted_import(type(e), e, e.__traceback__)\n"
+    )
+    err = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stderr
+    assert err.startswith("dnnevo: interrupted\nTraceback"), err
+    assert "ValueError: inner" in err and err.count("dnnevo: interrupted") == 1, err
+
+
 def _wall(command: list[str]) -> float:
     """Seconds ``command`` takes to run."""
     t0 = time.monotonic()

@@ -10,15 +10,24 @@
 
 from __future__ import annotations
 
-import sys as _sys
+from dnnevo import _startup
+
+_startup.defer_interrupts()  # the command's start-up: Ctrl-C waits for dnnevo.cli.main
+
+import sys as _sys  # noqa: E402
 from types import TracebackType as _TracebackType
 
 
 def _interrupted_import(kind: type[BaseException], value: BaseException,
                         tb: _TracebackType | None) -> None:
-    """While dnnevo imports (e.g. the ``dnnevo`` command starting up), Ctrl-C is one line."""
+    """While dnnevo imports (e.g. the ``dnnevo`` command starting up), Ctrl-C is one line. Python
+    may wrap the interrupt in another error (3.11 turns one raised while a class is created into a
+    RuntimeError from ``__set_name__``), so the whole chain of causes is looked at."""
     _sys.excepthook = _sys.__excepthook__
-    if issubclass(kind, KeyboardInterrupt):
+    seen: BaseException | None = value
+    while seen is not None and not isinstance(seen, KeyboardInterrupt):
+        seen = seen.__cause__ or seen.__context__
+    if issubclass(kind, KeyboardInterrupt) or seen is not None:
         _sys.stderr.write("dnnevo: interrupted\n")
     else:
         _sys.__excepthook__(kind, value, tb)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, presets, seeding, sweep
+from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, _startup, presets, seeding, sweep
 from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.rundir import RunDir, save_figure
@@ -270,6 +270,7 @@ def main(argv: list[str] | None = None) -> int:
     if sys.excepthook is dnnevo._interrupted_import:
         sys.excepthook = sys.__excepthook__
     try:
+        _startup.allow_interrupts()  # one pressed during start-up is raised here
         parser = build_parser()
         args = parser.parse_args(argv)
     except KeyboardInterrupt:
@@ -289,8 +290,9 @@ def main(argv: list[str] | None = None) -> int:
             raise
         sys.stderr.write(f"dnnevo: error: {e}\n")
         return 2
-    except KeyboardInterrupt:
-        sys.stderr.write("dnnevo: interrupted\n")
+    except KeyboardInterrupt as e:
+        # evolve's message says where a stopped run's checkpoint is, when it has one.
+        sys.stderr.write(f"dnnevo: {e}\n" if str(e) else "dnnevo: interrupted\n")
         return 130
     except Exception:
         # A bug: show it, but exit 2 as for any error, never 1 (evaluate's "fail").

@@ -425,8 +425,12 @@ def _loop(
     finally:
         if bar is not None:
             bar.close()
+    hint = f"interrupted {saved}. Resume with: dnnevo resume {run.path}" if run is not None else ""
+    if interrupted and ga.best is None:
+        # Stopped before any generation was scored: there is no result to return.
+        raise KeyboardInterrupt(hint)
     if interrupted and run is not None:
-        print(f"interrupted {saved}. Resume with: dnnevo resume {run.path}", file=sys.stderr)
+        print(hint, file=sys.stderr)
     return _result(ga, history, run, interrupted)
 
 

@@ -40,6 +40,7 @@ __all__ = [
     "fitness",
     "performance",
     "phases",
+    "run_chain",
     "run_trial",
     "run_trials",
     "stack_networks",
@@ -70,14 +71,32 @@ def phases(timing, trigger_steps=10, reinforcement_steps=10):
     return out
 
 
-def run_trial(tau, theta, weights, sensor_weights, pattern, timing, *, trigger_steps=10,
-              reinforcement_steps=10, dt=0.1, substeps=10, state=None):
+def run_trial(tau, theta, weights, sensor_weights, pattern, timing, **kw):
     """One trial of one network, written as plainly as possible.
 
     ``tau``, ``theta`` (N,), ``weights`` (N, N), ``sensor_weights`` (N, 2). Returns
     ``(r, output)``: R of each trigger (K,) and the output after every time step of the whole
-    trial (T,), the last gap included.
+    trial (T,), the last gap included. Keywords: ``trigger_steps``, ``reinforcement_steps``,
+    ``dt``, ``substeps`` and the starting ``state``.
     """
+    r, output, _ = _trial(tau, theta, weights, sensor_weights, pattern, timing, **kw)
+    return r, output
+
+
+def run_chain(tau, theta, weights, sensor_weights, links, **kw):
+    """Trials run one after another without a reset, each ``(pattern, timing)`` of ``links``
+    starting from the state the one before ended in (after its last gap); the first starts
+    from rest. Returns the R of each link's triggers."""
+    state, rs = None, []
+    for pattern, timing in links:
+        r, _, state = _trial(tau, theta, weights, sensor_weights, pattern, timing, state=state, **kw)
+        rs.append(r)
+    return rs
+
+
+def _trial(tau, theta, weights, sensor_weights, pattern, timing, *, trigger_steps=10,
+           reinforcement_steps=10, dt=0.1, substeps=10, state=None):
+    """``run_trial``'s work; also returns the state at the end."""
     tau = np.asarray(tau, dtype=np.float64)
     theta = np.asarray(theta, dtype=np.float64)
     w = np.asarray(weights, dtype=np.float64)
@@ -106,7 +125,7 @@ def run_trial(tau, theta, weights, sensor_weights, pattern, timing, *, trigger_s
         else:
             for _ in range(steps):
                 time_step(np.array([0.0, 0.0]))
-    return r, np.array(output)
+    return r, np.array(output), v
 
 
 def run_trials(params, pattern, timing, *, trigger_steps=10, reinforcement_steps=10, dt=0.1,

@@ -203,6 +203,26 @@ def test_evaluate_matches_reference_other_targets_and_generation_mean():
     assert np.ptp(got) > 0.0
 
 
+def test_chained_evaluation_matches_reference():
+    cfg = config(targets=["0", "1", "01", "10"], trials_per_target=2, chain=True, size=6)
+    p = cfg.task_params
+    generation, seed = 3, 5
+    order = seq.trial_order(cfg, seed, generation)
+    assert sorted(order) == list(range(8)) and order != sorted(order)
+    nets = [dnnevo.Network.random(6, 2, seed=40 + s) for s in range(5)]
+    got = dnnevo.evaluate("sequence", nets, generation=generation, seed=seed, config=cfg)
+    for net, fitness in zip(nets, got):
+        links = [(p["targets"][t // 2], seq.timings(cfg, seed, generation, t)) for t in order]
+        rs = ref.run_chain(*net_params(net), links, **protocol(cfg))
+        assert fitness == pytest.approx(np.mean(ref.performance(np.array(rs), 0.5)), abs=TOL)
+    # Without the chain every trial starts from rest, which scores differently.
+    apart = dnnevo.evaluate("sequence", nets, generation=generation, seed=seed,
+                            config=config(targets=["0", "1", "01", "10"], trials_per_target=2,
+                                          size=6))
+    assert not np.array_equal(apart, got)
+    assert seq.trial_order(config(), seed, generation) == [0, 1, 2, 3]
+
+
 def test_assess_reports_every_target():
     cfg = config()
     report = seq.assess(cfg, silent_network(), 4, 0)

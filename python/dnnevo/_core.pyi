@@ -39,6 +39,7 @@ __all__ = [
     "sequence_assess",
     "sequence_timings",
     "sequence_trial",
+    "sequence_trial_order",
     "sim2d_cast_rays",
     "sim2d_landmark_world",
     "task_layout",
@@ -188,6 +189,7 @@ def encode(net: Network) -> _Array: ...
 def sequence_timings(
     params: str, seed: int, generation: int, trial: int
 ) -> list[tuple[int, int]]: ...
+def sequence_trial_order(params: str, seed: int, generation: int) -> list[int]: ...
 def sequence_trial(
     params: str,
     net: Network,

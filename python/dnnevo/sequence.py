@@ -20,7 +20,7 @@ from dnnevo import _core
 from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 
-__all__ = ["TrialRecord", "assess", "run_trial", "switch_trial", "timings"]
+__all__ = ["TrialRecord", "assess", "run_trial", "switch_trial", "timings", "trial_order"]
 
 
 @dataclass(frozen=True)
@@ -48,6 +48,14 @@ def _params(config: EvolutionConfig) -> str:
 def timings(config: EvolutionConfig, seed: int, generation: int, trial: int) -> list[tuple[int, int]]:
     """The (delay, gap) of each trigger of ``trial`` in ``generation``, as evolution drew them."""
     return _core.sequence_timings(_params(config), seed, generation, trial)
+
+
+def trial_order(config: EvolutionConfig, seed: int, generation: int) -> list[int]:
+    """The order in which ``generation``'s trials run, as trial numbers (target-major: trial ``t``
+    is of target ``t // trials_per_target``). In order, unless ``task_params.chain`` is true:
+    then the trials run as one chain without a reset between them, in an order drawn per
+    generation."""
+    return _core.sequence_trial_order(_params(config), seed, generation)
 
 
 def run_trial(

@@ -48,7 +48,9 @@ mod _core {
     #[pymodule_export]
     use super::population::run_population;
     #[pymodule_export]
-    use super::sequence::{sequence_assess, sequence_timings, sequence_trial};
+    use super::sequence::{
+        sequence_assess, sequence_timings, sequence_trial, sequence_trial_order,
+    };
 
     use pyo3::prelude::*;
 

@@ -24,6 +24,13 @@ pub fn sequence_timings(
     Ok(task(params)?.timings(seed, generation, trial))
 }
 
+/// The order in which a generation's trials run (target-major trial numbers; shuffled when they
+/// are chained).
+#[pyfunction]
+pub fn sequence_trial_order(params: &str, seed: u64, generation: u64) -> PyResult<Vec<usize>> {
+    Ok(task(params)?.trial_order(seed, generation))
+}
+
 /// One trial of `pattern` (e.g. "01") with the given timings, recorded step by step, as JSON.
 /// With `reset` false the trial continues from the network's state.
 #[pyfunction]

@@ -140,6 +140,15 @@ pub struct SequenceConfig {
     /// Whether each individual draws its own timings (`Purpose::Trial` stream with its index)
     /// instead of sharing the generation's. Default false.
     pub independent_conditions: bool,
+    /// Whether an evaluation's trials run as one chain, without resetting the state between
+    /// them, in an order drawn for each generation ([`SequenceTask::trial_order`]): every trial
+    /// after the first starts where the one before it ended, after its last reinforcement and
+    /// gap, so a network must notice from the reinforcement that the target changed and switch,
+    /// as the paper's Fig. 5 shows its 2-bit network doing. Each trial is scored as without it.
+    /// Validation and assessment still start every trial from rest. Default false.
+    ///
+    /// [`SequenceTask::trial_order`]: super::SequenceTask::trial_order
+    pub chain: bool,
     /// Fresh trials per target in a run's validation set, on which the best candidates of each
     /// generation are judged by the success rule to choose the champion (at least 1). Default 32.
     pub validation_trials: usize,
@@ -161,6 +170,7 @@ impl Default for SequenceConfig {
             aggregate: Aggregate::Mean,
             integrator: TIME_STEP,
             independent_conditions: false,
+            chain: false,
             validation_trials: 32,
         }
     }

@@ -12,6 +12,10 @@ use super::config::*;
 use super::scoring::*;
 use super::trial::*;
 
+/// The trial number of the `Purpose::Trial` stream that draws a chained generation's trial order:
+/// one no trial's timings use.
+const ORDER_STREAM: u64 = u64::MAX;
+
 /// The sequence-learning task: a validated [`SequenceConfig`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SequenceTask {
@@ -143,8 +147,26 @@ impl SequenceTask {
         )
     }
 
-    /// Scores a generation: every network runs every trial, blocks of [`LANES`] networks in
-    /// parallel. `networks` may have any N but must all have the same N and M = 2.
+    /// The order in which generation `generation`'s trials run, as trial numbers (target-major:
+    /// trial `t` is of target `t / trials_per_target`). In order unless the trials are
+    /// [`chain`](SequenceConfig::chain)ed; then a permutation shared by every individual, drawn
+    /// from `Stream::new(seed, generation, Purpose::Trial, 0, ORDER_STREAM)`.
+    pub fn trial_order(&self, seed: u64, generation: u64) -> Vec<usize> {
+        let n = self.config.n_trials();
+        let mut order: Vec<usize> = (0..n).collect();
+        if self.config.chain {
+            let mut stream = Stream::new(seed, generation, Purpose::Trial, 0, ORDER_STREAM);
+            for i in (1..n).rev() {
+                let j = stream.below(i as u64 + 1) as usize;
+                order.swap(i, j);
+            }
+        }
+        order
+    }
+
+    /// Scores a generation: every network runs every trial, in
+    /// [`trial_order`](Self::trial_order), blocks of [`LANES`] networks in parallel. `networks`
+    /// may have any N but must all have the same N and M = 2.
     ///
     /// Stops with [`Error::Interrupted`] between trials once `cancel` is set.
     pub fn scores(
@@ -174,13 +196,22 @@ impl SequenceTask {
                 .map(|t| self.timings(seed, generation, t))
                 .collect()
         };
+        let order = self.trial_order(seed, generation);
         // Lane-major within a block: [lane][trial][trigger].
         let r = by_block(
             networks,
             n_trials,
             cancel,
             |len| vec![0.0; len * n_trials * k],
-            |out, first, block, t| {
+            |out, first, block, c| {
+                let t = order[c];
+                // A chain starts from rest, and each link runs to its end (its last
+                // reinforcement and gap) before the next begins; the last may stop early.
+                let (reset, full) = if config.chain {
+                    (c == 0, c + 1 < n_trials)
+                } else {
+                    (true, false)
+                };
                 let own: Vec<Vec<(usize, usize)>>;
                 let timings: [&[(usize, usize)]; LANES] = if config.independent_conditions {
                     // Padding lanes repeat the block's first network, and its timings.
@@ -195,7 +226,7 @@ impl SequenceTask {
                     [common[t].as_slice(); LANES]
                 };
                 let bits = &self.bits[t / config.trials_per_target];
-                let outcome = run_lanes(config, block, bits, timings, true, false, |_, _| {})?;
+                let outcome = run_lanes(config, block, bits, timings, reset, full, |_, _| {})?;
                 for l in 0..block.len() {
                     let at = (l * n_trials + t) * k;
                     for (dst, r) in out[at..at + k].iter_mut().zip(&outcome.r) {

@@ -407,6 +407,56 @@ fn continuing_without_reset_chains_trials() {
 }
 
 #[test]
+fn chained_trials_continue_from_the_trial_before() {
+    let config = SequenceConfig {
+        chain: true,
+        ..small()
+    };
+    let t = task(config.clone());
+    let nets = random_networks(19, 12);
+    let (seed, generation) = (3, 2);
+    let order = t.trial_order(seed, generation);
+    let mut sorted = order.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, (0..6).collect::<Vec<_>>(), "a permutation");
+    assert_ne!(
+        order, sorted,
+        "shuffled (this seed's order is not the identity)"
+    );
+    assert_ne!(
+        order,
+        t.trial_order(seed, generation + 1),
+        "drawn per generation"
+    );
+    let scores = t.scores(&nets, generation, seed, None).unwrap();
+    for (p, net) in nets.iter().enumerate() {
+        // By hand: each trial a whole record that starts from the last one's final state.
+        let mut state: Option<Vec<f64>> = None;
+        for &trial in &order {
+            let mut cont = net.clone();
+            cont.set_state(state.as_deref()).unwrap();
+            let timing = t.timings(seed, generation, trial);
+            let rec = t
+                .run_trial(&cont, trial / 2, &timing, state.is_none())
+                .unwrap();
+            let at = (p * 6 + trial) * 5;
+            assert_eq!(rec.r, scores.r[at..at + 5], "network {p}, trial {trial}");
+            state = Some(rec.final_state);
+        }
+    }
+    // Not the unchained scores: the state carried over changes the later trials.
+    let apart = task(SequenceConfig {
+        chain: false,
+        ..config
+    });
+    assert_eq!(apart.trial_order(seed, generation), sorted);
+    assert_ne!(
+        apart.scores(&nets, generation, seed, None).unwrap().r,
+        scores.r
+    );
+}
+
+#[test]
 fn assess_judges_the_warm_up_and_matches_run_trial() {
     let t = task(SequenceConfig::default());
     let low = constant(100.0);

@@ -15,7 +15,7 @@ import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
 import dnnevo
-from dnnevo import _cli_evaluate, assess, cli, presets, stats
+from dnnevo import _cli_evaluate, assess, cli, presets, sequence, stats
 from dnnevo.config import EvolutionConfig
 from dnnevo.rundir import RunDir
 
@@ -80,7 +80,15 @@ def test_evaluate_json_sequence(runs: dict[str, Path]) -> None:
         check_rate(rate, 0.9)
     assert d["verdict"] == assess.combine([r["verdict"] for r in d["rates"]])
     assert status == assess.EXIT_STATUS[d["verdict"]]
-    assert set(d["switch_test"]) == {"first", "second", "switch_after", "settled_after"}
+    switch = d["switch_test"]
+    assert (switch["switch_after"], switch["trials"]) == (8, 20)
+    assert [(p["first"], p["second"]) for p in switch["pairs"]] == [("0", "1"), ("1", "0")]
+    config = EvolutionConfig.from_toml((runs["sequence-1bit"] / "config.toml").read_text())
+    table = sequence.switch_table(config, dnnevo.Network.load(runs["sequence-1bit"] / "best.json"),
+                                  20, 4)
+    for p, s in zip(switch["pairs"], table, strict=True):
+        assert p["settled_after"] == list(s.settled_after)
+        assert p["settled"] == sum(k is not None for k in p["settled_after"])
     assert set(d["mean_performance"]) == {"0", "1"}
     same_as_api(runs["sequence-1bit"], d)
 

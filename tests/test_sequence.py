@@ -151,6 +151,32 @@ def silent_network(size=5):
                           weights=np.zeros((size, size)), sensor_weights=np.zeros((size, 2)))
 
 
+def test_switch_table_of_a_silent_network():
+    cfg = config(targets=["0", "1", "01"])
+    table = seq.switch_table(cfg, silent_network(), 6, 3)
+    pairs = {(s.first, s.second): s for s in table}
+    assert list(pairs) == [("0", "1"), ("0", "01"), ("1", "0"), ("1", "01"), ("01", "0"), ("01", "1")]
+    # Always 0: right at once on 0*, never on 1*; on (01)* the 1s after the switch are wrong.
+    for first in ("1", "01"):
+        assert pairs[(first, "0")].settled_after == (0,) * 6
+        assert pairs[(first, "0")].median_triggers == 0.0
+    for first, second in [("0", "1"), ("0", "01"), ("1", "01"), ("01", "1")]:
+        assert pairs[(first, second)].settled == 0 and pairs[(first, second)].median_triggers is None
+    # Trial j has fresh timings 2j and 2j + 1, never evolution's.
+    a, b, _ = seq.switch_trial(cfg, silent_network(), "1", "0",
+                               seq.fresh_timings(cfg, 3, 0) + seq.fresh_timings(cfg, 3, 1))
+    assert len(a.r) == 8 and len(b.r) == 12
+    assert seq.fresh_timings(cfg, 3, 0) != seq.timings(cfg, 3, 0, 0)
+    # A switch counts only when the answers stay right for SWITCH_HOLD triggers to the end. The
+    # second pattern continues the first's phase: after 8 triggers it is read from index 8 on.
+    assert seq.SWITCH_HOLD == 4
+    timing = seq.fresh_timings(cfg, 3, 0) + seq.fresh_timings(cfg, 3, 1)
+    for tail, settled in [("111111110000", 8), ("111111111000", None)]:
+        assert seq.switch_trial(cfg, silent_network(), "0", "0" * 8 + tail, timing)[2] == settled
+    with pytest.raises(ValueError, match="switch_after"):
+        seq.switch_table(cfg, silent_network(), 2, 3, switch_after=20)
+
+
 def test_constant_output_earns_all_or_nothing():
     cfg = config()
     net = silent_network()

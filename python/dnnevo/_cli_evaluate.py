@@ -86,7 +86,7 @@ def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:
         lines.append(f"integrated with dt = {i['dt']:g}, {i['substeps']} steps per time step "
                      "(--dt); the run was evolved with its config's step")
     if "switch_test" in extra:
-        lines.append(_cli_sequence.switch_line(extra["switch_test"]))
+        lines += _cli_sequence.switch_lines(extra["switch_test"])
     return lines
 
 

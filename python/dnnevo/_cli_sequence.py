@@ -12,8 +12,11 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.rundir import RunDir, save_figure
 
 
-def _targets(config: EvolutionConfig) -> list[str]:
-    return list(config.task_params.get("targets", ["0", "1"]))
+SWITCH_TRIALS = 20
+"""Fresh trials per ordered pair of targets in ``evaluate``'s switch test."""
+
+SWITCH_AFTER = 8
+"""Triggers of the first target before the switch, as in the paper's Fig. 5."""
 
 
 def preface(where: Path, a: Assessment) -> list[str]:
@@ -27,24 +30,40 @@ def preface(where: Path, a: Assessment) -> list[str]:
 
 
 def switch_test(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
-    """The paper's Fig. 5 test on the timings of trials 0 and 1 of ``seed``: the last target for
-    8 triggers, then the first without a reset. ``{"switch_test": {...}}``, or ``{}`` with one
-    target."""
-    targets = _targets(config)
-    if len(targets) < 2:
+    """The paper's Fig. 5 test for every ordered pair of targets, on :data:`SWITCH_TRIALS` fresh
+    trials of ``seed`` each: the first target for :data:`SWITCH_AFTER` triggers, then the second without a reset.
+    ``{"switch_test": {...}}``, or ``{}`` with one target."""
+    if len(sequence.target_list(config)) < 2:
         return {}
-    timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
-    _, _, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
-    return {"switch_test": {"first": targets[-1], "second": targets[0], "switch_after": 8,
-                            "settled_after": needed}}
+    table = sequence.switch_table(config, champion, SWITCH_TRIALS, seed, switch_after=SWITCH_AFTER)
+    return {"switch_test": {"switch_after": SWITCH_AFTER, "trials": SWITCH_TRIALS, "pairs": [
+        {"first": s.first, "second": s.second, "settled": s.settled,
+         "median_triggers": s.median_triggers, "settled_after": list(s.settled_after)}
+        for s in table]}}
 
 
-def switch_line(test: dict[str, Any]) -> str:
-    """The switch test in words."""
-    needed = test["settled_after"]
-    after = "never settled" if needed is None else f"settled after {needed} trigger(s)"
-    return (f"switch test ({test['first']}* for {test['switch_after']} triggers, then {test['second']}* "
-            f"without reset): {after}")
+def switch_lines(test: dict[str, Any]) -> list[str]:
+    """The switch test as a table: for each pair, the trials that settled on the second target,
+    and the median triggers after the switch they needed."""
+    pairs = test["pairs"]
+    names = list(dict.fromkeys(p["first"] for p in pairs))
+    cell = {(p["first"], p["second"]): p for p in pairs}
+
+    def text(p: dict[str, Any]) -> str:
+        median = "-" if p["median_triggers"] is None else f"{p['median_triggers']:g}"
+        return f"{p['settled']}/{test['trials']} ({median})"
+
+    corner = "from \\ to"
+    width = 2 + max(len(corner), *(len(text(p)) for p in pairs), *(len(n) + 1 for n in names))
+    lines = [f"switch test: {test['switch_after']} triggers of one target, then another without a "
+             f"reset; trials that settled on the new target, right from then on for at least "
+             f"{sequence.SWITCH_HOLD} triggers (median triggers needed), {test['trials']} fresh "
+             "trials each",
+             f"{corner:>{width}}" + "".join(f"{n + '*':>{width}}" for n in names)]
+    for a in names:
+        lines.append(f"{a + '*':>{width}}" + "".join(
+            f"{'-' if a == b else text(cell[(a, b)]):>{width}}" for b in names))
+    return lines
 
 
 def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
@@ -55,7 +74,7 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
     from dnnevo.plot import plot_sequence_trial
 
     champion = run.read_best(config, run.read_config()[1])
-    targets = _targets(config)
+    targets = sequence.target_list(config)
     fig, axes = plt.subplots(len(targets), 1, figsize=(9, 2.6 * len(targets)),
                              layout="constrained", squeeze=False)
     for k, (target, ax) in enumerate(zip(targets, axes[:, 0], strict=True)):

@@ -37,6 +37,7 @@ __all__ = [
     "nav1d_system_assess",
     "nav1d_system_record",
     "sequence_assess",
+    "sequence_fresh_timings",
     "sequence_timings",
     "sequence_trial",
     "sequence_trial_order",
@@ -189,6 +190,7 @@ def encode(net: Network) -> _Array: ...
 def sequence_timings(
     params: str, seed: int, generation: int, trial: int
 ) -> list[tuple[int, int]]: ...
+def sequence_fresh_timings(params: str, seed: int, trial: int) -> list[tuple[int, int]]: ...
 def sequence_trial_order(params: str, seed: int, generation: int) -> list[int]: ...
 def sequence_trial(
     params: str,

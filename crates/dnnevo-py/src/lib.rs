@@ -49,7 +49,8 @@ mod _core {
     use super::population::run_population;
     #[pymodule_export]
     use super::sequence::{
-        sequence_assess, sequence_timings, sequence_trial, sequence_trial_order,
+        sequence_assess, sequence_fresh_timings, sequence_timings, sequence_trial,
+        sequence_trial_order,
     };
 
     use pyo3::prelude::*;

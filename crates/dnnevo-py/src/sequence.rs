@@ -24,6 +24,16 @@ pub fn sequence_timings(
     Ok(task(params)?.timings(seed, generation, trial))
 }
 
+/// The (delay, gap) of every trigger of fresh trial `trial`, as `sequence_assess` draws them.
+#[pyfunction]
+pub fn sequence_fresh_timings(
+    params: &str,
+    seed: u64,
+    trial: usize,
+) -> PyResult<Vec<(usize, usize)>> {
+    Ok(task(params)?.assessment_timings(seed, trial))
+}
+
 /// The order in which a generation's trials run (target-major trial numbers; shuffled when they
 /// are chained).
 #[pyfunction]

@@ -15,9 +15,6 @@ from dnnevo.rundir import RunDir, save_figure
 SWITCH_TRIALS = 20
 """Fresh trials per ordered pair of targets in ``evaluate``'s switch test."""
 
-SWITCH_AFTER = 8
-"""Triggers of the first target before the switch, as in the paper's Fig. 5."""
-
 
 def preface(where: Path, a: Assessment) -> list[str]:
     """What ``evaluate`` ran, and the rule it judges by."""
@@ -31,12 +28,12 @@ def preface(where: Path, a: Assessment) -> list[str]:
 
 def switch_test(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
     """The paper's Fig. 5 test for every ordered pair of targets, on :data:`SWITCH_TRIALS` fresh
-    trials of ``seed`` each: the first target for :data:`SWITCH_AFTER` triggers, then the second without a reset.
-    ``{"switch_test": {...}}``, or ``{}`` with one target."""
+    trials of ``seed`` each: the first target for ``sequence.SWITCH_AFTER`` triggers, then the
+    second without a reset. ``{"switch_test": {...}}``, or ``{}`` with one target."""
     if len(sequence.target_list(config)) < 2:
         return {}
-    table = sequence.switch_table(config, champion, SWITCH_TRIALS, seed, switch_after=SWITCH_AFTER)
-    return {"switch_test": {"switch_after": SWITCH_AFTER, "trials": SWITCH_TRIALS, "pairs": [
+    table = sequence.switch_table(config, champion, SWITCH_TRIALS, seed)
+    return {"switch_test": {"switch_after": sequence.SWITCH_AFTER, "trials": SWITCH_TRIALS, "pairs": [
         {"first": s.first, "second": s.second, "settled": s.settled,
          "median_triggers": s.median_triggers, "settled_after": list(s.settled_after)}
         for s in table]}}
@@ -88,7 +85,7 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
         a, b, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
         fig, ax = plt.subplots(figsize=(11, 3), layout="constrained")
         plot_sequence_trial(a, ax=ax, follow=b, title=(
-            f"{targets[-1]}* for 8 triggers, then {targets[0]}* without reset "
+            f"{targets[-1]}* for {sequence.SWITCH_AFTER} triggers, then {targets[0]}* without reset "
             f"({'settled after ' + str(needed) + ' trigger(s)' if needed is not None else 'never settled'})"))
         save_figure(fig, run.path / "fig5-switch.png")
         plt.close(fig)

@@ -492,7 +492,7 @@ def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -
     if config.task == "sequence":
         from dnnevo import sequence
 
-        for k, target in enumerate(config.task_params.get("targets", ["0", "1"])):
+        for k, target in enumerate(sequence.target_list(config)):
             r = sequence.run_trial(config, net, target, sequence.timings(config, seed, 0, k))
             out.append((r.outputs, np.column_stack([r.trigger, r.reinforcement])))
     elif config.task == "landmark":

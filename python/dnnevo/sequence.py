@@ -20,7 +20,7 @@ from dnnevo import _core
 from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 
-__all__ = ["SWITCH_HOLD", "Switch", "TrialRecord", "assess", "fresh_timings", "run_trial", "switch_table", "switch_trial",
+__all__ = ["SWITCH_AFTER", "SWITCH_HOLD", "Switch", "TrialRecord", "assess", "fresh_timings", "run_trial", "switch_table", "switch_trial",
            "target_list", "timings", "trial_order"]
 
 
@@ -107,6 +107,10 @@ def assess(
                                             nonnegative("seed", seed)))
 
 
+SWITCH_AFTER = 8
+"""Triggers of the first target before the switch in the switch test, as in the paper's Fig. 5."""
+
+
 def switch_trial(
     config: EvolutionConfig,
     net: _core.Network,
@@ -114,7 +118,7 @@ def switch_trial(
     second: str,
     timing: list[tuple[int, int]],
     *,
-    switch_after: int = 8,
+    switch_after: int = SWITCH_AFTER,
 ) -> tuple[TrialRecord, TrialRecord, int | None]:
     """The paper's Fig. 5 test: ``first`` for ``switch_after`` triggers, then ``second`` without
     a reset. Returns both records and how many triggers after the switch the network needed before
@@ -163,7 +167,7 @@ def switch_table(
     trials: int,
     seed: int,
     *,
-    switch_after: int = 8,
+    switch_after: int = SWITCH_AFTER,
 ) -> list[Switch]:
     """:func:`switch_trial` for every ordered pair of the config's targets, on ``trials`` fresh
     trials each: trial ``j`` of every pair has the timings of :func:`fresh_timings` ``2j`` and

@@ -37,8 +37,8 @@ def threads() -> int:
 
 
 def describe_machine() -> None:
-    """Print the versions, CPU model and vector extensions, usable threads and the thread-related
-    environment variables that are set."""
+    """Print the versions, CPU model and vector extensions, dnnevo's kernel, usable threads and the
+    thread-related environment variables that are set."""
     print(f"python {platform.python_version()}, numpy {np.__version__}, "
           f"dnnevo {getattr(dnnevo, '__version__', '?')}, {platform.machine()}")
     try:
@@ -52,6 +52,9 @@ def describe_machine() -> None:
         print(f"cpu: {model} ({vector})")
     except (OSError, StopIteration):
         pass
+    info = dnnevo.build_info()
+    print(f"dnnevo kernel: {info['kernel']} (this CPU can run {', '.join(info['kernels'])}; "
+          f"DNNEVO_SIMD forces one)")
     print(f"threads: {threads()} usable by this process ({os.cpu_count()} logical CPUs)")
     for var in ("RAYON_NUM_THREADS", "OPENBLAS_CORETYPE", "OMP_NUM_THREADS"):
         if var in os.environ:

@@ -9,9 +9,11 @@ import time
 
 import dnnevo
 from dnnevo import analysis
+from _common import describe_machine
 
 
 def main() -> None:
+    describe_machine()
     print("N   equilibria (s)  limit cycles (s)  sweep (s)   equilibria / cycles / sweep events per seed")
     for n in (10, 15):
         times: dict[str, list[float]] = {"eq": [], "cyc": [], "sweep": []}

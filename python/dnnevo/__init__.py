@@ -29,6 +29,8 @@ def _interrupted_import(kind: type[BaseException], value: BaseException,
         seen = seen.__cause__ or seen.__context__
     if issubclass(kind, KeyboardInterrupt) or seen is not None:
         _sys.stderr.write("dnnevo: interrupted\n")
+    elif isinstance(value, DnnevoError) and _startup.is_the_command():
+        _sys.stderr.write(f"dnnevo: error: {value}\n")  # e.g. a bad DNNEVO_SIMD
     else:
         _sys.__excepthook__(kind, value, tb)
 
@@ -36,12 +38,22 @@ def _interrupted_import(kind: type[BaseException], value: BaseException,
 if _sys.excepthook is _sys.__excepthook__:
     _sys.excepthook = _interrupted_import
 
-from dnnevo import plot, presets  # noqa: E402
-from dnnevo._core import LANES, Network, Trace, __version__, compose, run_population
+from dnnevo.errors import DnnevoError  # noqa: E402
+
+from dnnevo import _core, plot, presets  # noqa: E402
+from dnnevo._core import (
+    LANES,
+    Network,
+    Trace,
+    __version__,
+    build_info,
+    compose,
+    run_population,
+    use_kernel,
+)
 from dnnevo.config import EvolutionConfig, IntegratorConfig, Ranges
 from dnnevo.errors import (
     ConfigError,
-    DnnevoError,
     FitnessError,
     FormatError,
     InvalidArgumentError,
@@ -49,6 +61,8 @@ from dnnevo.errors import (
 )
 from dnnevo.evolve import EvolutionResult, evaluate, evolve, resume
 from dnnevo.ga import GeneticAlgorithm
+
+_core.apply_simd_env()  # DNNEVO_SIMD, if set, names the kernel; a bad value fails the import
 
 if _sys.excepthook is _interrupted_import:
     _sys.excepthook = _sys.__excepthook__
@@ -74,6 +88,8 @@ __all__ = [
     "Network",
     "Trace",
     "__version__",
+    "build_info",
     "compose",
     "run_population",
+    "use_kernel",
 ]

@@ -17,6 +17,9 @@ __all__ = [
     "Network",
     "Trace",
     "__version__",
+    "apply_simd_env",
+    "build_info",
+    "use_kernel",
     "analysis_bifurcation",
     "analysis_cycles",
     "analysis_equilibria",
@@ -134,6 +137,21 @@ class Network:
     def __reduce__(self) -> tuple[Any, ...]: ...
     def __eq__(self, other: object, /) -> bool: ...
 
+def build_info() -> dict[str, Any]:
+    """This build's version, the CPU's architecture and SIMD features, the kernels it can run
+    ("portable", "avx2", "avx512") and the one in use.
+
+    >>> import dnnevo
+    >>> info = dnnevo.build_info()
+    >>> info["kernel"] in info["kernels"]
+    True
+    """
+
+def use_kernel(name: str) -> None:
+    """Makes later integrations use kernel ``name``; results do not change, only the speed.
+    Raises InvalidArgumentError for an unknown name or a kernel this CPU cannot run."""
+
+def apply_simd_env() -> None: ...
 def compose(a: Network, b: Network, *, cross_scale: float = 0.0, seed: int = 0, member: int = 0) -> Network: ...
 def run_population(
     networks: Sequence[Network] | Mapping[str, npt.ArrayLike],

@@ -26,6 +26,7 @@ pub mod names;
 pub mod network;
 pub mod population;
 mod rows;
+pub mod simd;
 pub mod validation;
 mod vector;
 

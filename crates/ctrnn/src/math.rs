@@ -10,8 +10,8 @@
 //! one-value versions.
 //!
 //! Multiply-adds are written as [`f64::mul_add`], which is always fused (one rounding): a single
-//! FMA instruction on CPUs that have one (every x86-64 since 2013 and every 64-bit ARM), and the
-//! same bits, slowly, in software elsewhere. Every code path in dnnevo (single network, population,
+//! FMA instruction in code compiled for a CPU that has one (every x86-64 kernel but the portable
+//! one, and every 64-bit ARM), and the same bits, slowly, in software elsewhere. Every code path in dnnevo (single network, population,
 //! tasks) uses [`sigmoid`], which is what makes them agree bit for bit.
 
 use crate::vector::{Arith, ROUND_SHIFT};
@@ -48,9 +48,12 @@ const TAYLOR: [f64; 12] = [
 /// let e = ctrnn::math::exp(1.0);
 /// assert!((e - std::f64::consts::E).abs() <= 2.0 * f64::EPSILON * e);
 /// ```
-#[inline(always)]
+#[inline]
 pub fn exp(x: f64) -> f64 {
-    exp_lanes(x)
+    with_fma(
+        #[inline(always)]
+        || exp_lanes(x),
+    )
 }
 
 /// The logistic firing rate `1 / (1 + e^(-x))`.
@@ -59,9 +62,47 @@ pub fn exp(x: f64) -> f64 {
 /// ```
 /// assert_eq!(ctrnn::math::sigmoid(0.0), 0.5);
 /// ```
-#[inline(always)]
+#[inline]
 pub fn sigmoid(x: f64) -> f64 {
-    sigmoid_lanes(x)
+    with_fma(
+        #[inline(always)]
+        || sigmoid_lanes(x),
+    )
+}
+
+/// Firing rates `out[i] = f(v[i] - theta[i])`, each with the same bits as [`sigmoid`], in one
+/// call: cheaper than one [`sigmoid`] call per neuron.
+///
+/// # Example
+/// ```
+/// let mut out = [0.0; 2];
+/// ctrnn::math::firing_rates(&[1.0, 0.5], &[1.0, 2.0], &mut out);
+/// assert_eq!(out, [0.5, ctrnn::math::sigmoid(-1.5)]);
+/// ```
+pub fn firing_rates(v: &[f64], theta: &[f64], out: &mut [f64]) {
+    with_fma(
+        #[inline(always)]
+        || {
+            for ((o, x), t) in out.iter_mut().zip(v).zip(theta) {
+                *o = sigmoid_lanes(x - t);
+            }
+        },
+    )
+}
+
+/// `f()`, compiled with the CPU's fused multiply-add instruction where the kernel in use has one
+/// ([`crate::simd`]); elsewhere `f64::mul_add` is done in software. The same bits either way.
+/// `f` must be `#[inline(always)]`, or it is compiled without the instruction.
+#[inline(always)]
+fn with_fma<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    if crate::simd::kernel() != crate::simd::Kernel::Portable {
+        // SAFETY: every kernel but the portable one needs AVX2 and FMA, and `simd` only hands
+        // out kernels that the CPU supports.
+        #[allow(unsafe_code)]
+        return unsafe { crate::vector::avx2::enabled(f) };
+    }
+    f()
 }
 
 /// [`exp`] in every lane.
@@ -73,14 +114,23 @@ pub(crate) fn exp_lanes<V: Arith>(x: V) -> V {
     let k = shifted - V::splat(ROUND_SHIFT);
     let r = (-k).mul_add(V::splat(LN2_LO), (-k).mul_add(V::splat(LN2_HI), x));
     // Estrin's scheme: the same polynomial as Horner's, with a dependency chain a third as long.
-    let c = TAYLOR.map(V::splat);
+    // (No closures or `map` here: see `Group` on why the kernel is inlined all the way.)
+    #[inline(always)]
+    fn c<V: Arith>(i: usize) -> V {
+        V::splat(TAYLOR[i])
+    }
     let r2 = r * r;
     let r4 = r2 * r2;
     let r8 = r4 * r4;
-    let pair = |hi: V, lo: V| hi.mul_add(r, lo);
-    let s0 = pair(c[8], c[9]).mul_add(r2, pair(c[10], c[11]));
-    let s1 = pair(c[4], c[5]).mul_add(r2, pair(c[6], c[7]));
-    let s2 = pair(c[0], c[1]).mul_add(r2, pair(c[2], c[3]));
+    let s0 = c::<V>(8)
+        .mul_add(r, c::<V>(9))
+        .mul_add(r2, c::<V>(10).mul_add(r, c::<V>(11)));
+    let s1 = c::<V>(4)
+        .mul_add(r, c::<V>(5))
+        .mul_add(r2, c::<V>(6).mul_add(r, c::<V>(7)));
+    let s2 = c::<V>(0)
+        .mul_add(r, c::<V>(1))
+        .mul_add(r2, c::<V>(2).mul_add(r, c::<V>(3)));
     let p = s2.mul_add(r8, s1.mul_add(r4, s0));
     let er = V::splat(1.0) + r2.mul_add(p, r);
     er.mul_pow2(k)

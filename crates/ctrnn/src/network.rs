@@ -12,7 +12,7 @@
 //! and `sensor_weights[i * n_inputs + k]` the weight from sensor k to neuron i.
 
 use crate::error::{check_finite, Error, Result};
-use crate::math::sigmoid;
+use crate::math::firing_rates;
 use crate::rng::Stream;
 
 /// A network of `size` neurons and `n_inputs` sensors, always valid once constructed.
@@ -142,11 +142,9 @@ impl Network {
 
     /// Firing rates `f(v_i - theta_i)` of the current state.
     pub fn outputs(&self) -> Vec<f64> {
-        self.state
-            .iter()
-            .zip(&self.theta)
-            .map(|(v, t)| sigmoid(v - t))
-            .collect()
+        let mut out = vec![0.0; self.size()];
+        firing_rates(&self.state, &self.theta, &mut out);
+        out
     }
 
     /// Mutable access for the integrator, which keeps values finite only if the inputs are.

@@ -5,22 +5,25 @@
 //! exact scaling by a power of two) onto its own instructions, so every backend gives the same
 //! bits:
 //! - `f64`: one lane.
-//! - `Avx512` (x86-64 builds whose target CPU has AVX-512F): 8 lanes in one 512-bit register.
+//! - `Avx2` (x86-64 with AVX2 and FMA): 4 lanes in one 256-bit register.
+//! - `Avx512` (x86-64 with AVX-512F): 8 lanes in one 512-bit register.
 //!   LLVM does not find this layout on its own: it vectorises the sigmoid loop across neurons,
 //!   with gathers and scatters, instead of across networks.
 //! - [`Group<V, G>`]: `G` of those, operation by operation. A population block of 16 networks
-//!   is `Group<Avx512, 2>`; [`Portable<L>`] is `Group<f64, L>`, used for single networks
-//!   (`L = 1`) and wherever no register backend applies.
+//!   is `Group<Avx512, 2>` or `Group<Avx2, 4>`; [`Portable<L>`] is `Group<f64, L>`, used for
+//!   single networks (`L = 1`) and wherever no register backend applies.
 //!
-//! Which backend a build uses is fixed at compile time by its target features (see
-//! `.cargo/config.toml`); results do not depend on it.
+//! Which backend runs is chosen when the program runs ([`crate::simd`]); the register backends'
+//! code is compiled for their CPU features inside their `enabled` functions, the only way in.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-mod avx512;
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-pub(crate) use avx512::Avx512;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx2;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx512;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use {avx2::Avx2, avx512::Avx512};
 
 /// Lane-by-lane arithmetic that rounds as IEEE 754 binary64 does, so that a backend can only
 /// change speed, never a result.
@@ -48,9 +51,10 @@ pub(crate) trait Vector: Arith {
     /// How a row is stored: its lanes' values in order (`f64`, `[f64; 8]`, or arrays of those).
     type Row: Copy;
     /// Whether a [`Group`] of a few of these still fits in registers, so that running long
-    /// dependency chains side by side pays. True for the explicit register backends; plain
-    /// lanes are left to the compiler (grouping 16-lane portable rows four at a time made an AVX2
-    /// build 4x slower, and made single networks no faster).
+    /// dependency chains side by side pays. True for AVX-512 (32 registers); not for AVX2 (16
+    /// registers, and a block is already four of them); plain lanes are left to the compiler
+    /// (grouping 16-lane portable rows four at a time made an AVX2 build 4x slower, and made
+    /// single networks no faster).
     const INTERLEAVE: bool;
 
     /// Reads a stored row.
@@ -69,6 +73,10 @@ pub(crate) trait Vector: Arith {
 /// `G` vectors computed on together, operation by operation. A long dependency chain such as
 /// the sigmoid then runs `G` times in parallel instead of one after another, which keeps more
 /// of the CPU's execution units busy than its out-of-order window would on its own.
+///
+/// Its operations are plain loops, not `array::from_fn` or `map`: every function between a
+/// backend's `enabled` and its intrinsics must be `#[inline(always)]`, or the intrinsics stay out
+/// of line, compiled without the backend's features (then one call per instruction).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Group<V, const G: usize>(pub [V; G]);
 
@@ -78,7 +86,11 @@ macro_rules! group_op {
             type Output = Self;
             #[inline(always)]
             fn $method(self, o: Self) -> Self {
-                Group(std::array::from_fn(|g| self.0[g].$method(o.0[g])))
+                let mut r = self;
+                for g in 0..G {
+                    r.0[g] = self.0[g].$method(o.0[g]);
+                }
+                r
             }
         }
     };
@@ -92,7 +104,11 @@ impl<V: Arith, const G: usize> Neg for Group<V, G> {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
-        Group(self.0.map(|x| -x))
+        let mut r = self;
+        for g in 0..G {
+            r.0[g] = -self.0[g];
+        }
+        r
     }
 }
 
@@ -103,15 +119,27 @@ impl<V: Arith, const G: usize> Arith for Group<V, G> {
     }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
-        Group(std::array::from_fn(|g| self.0[g].mul_add(a.0[g], b.0[g])))
+        let mut r = self;
+        for g in 0..G {
+            r.0[g] = self.0[g].mul_add(a.0[g], b.0[g]);
+        }
+        r
     }
     #[inline(always)]
     fn clamp(self, lo: f64, hi: f64) -> Self {
-        Group(self.0.map(|x| x.clamp(lo, hi)))
+        let mut r = self;
+        for g in 0..G {
+            r.0[g] = self.0[g].clamp(lo, hi);
+        }
+        r
     }
     #[inline(always)]
     fn mul_pow2(self, k: Self) -> Self {
-        Group(std::array::from_fn(|g| self.0[g].mul_pow2(k.0[g])))
+        let mut r = self;
+        for g in 0..G {
+            r.0[g] = self.0[g].mul_pow2(k.0[g]);
+        }
+        r
     }
 }
 
@@ -121,7 +149,11 @@ impl<V: Vector, const G: usize> Vector for Group<V, G> {
 
     #[inline(always)]
     fn load(row: &Self::Row) -> Self {
-        Group(std::array::from_fn(|g| V::load(&row[g])))
+        let mut r = Group([V::splat(0.0); G]);
+        for g in 0..G {
+            r.0[g] = V::load(&row[g]);
+        }
+        r
     }
     #[inline(always)]
     fn store(self, row: &mut Self::Row) {
@@ -139,7 +171,9 @@ impl<V: Vector, const G: usize> Vector for Group<V, G> {
     }
     #[inline(always)]
     fn prefetch(row: &Self::Row) {
-        row.iter().for_each(V::prefetch);
+        for r in row {
+            V::prefetch(r);
+        }
     }
 }
 
@@ -222,5 +256,89 @@ mod tests {
         let row = &mut Portable::<2>::rows_mut(&mut flat)[1];
         (Portable::<2>::load(row) * Portable::<2>::splat(2.0)).store(row);
         assert_eq!(flat, [1.0, 2.0, 6.0, 8.0, 5.0, 6.0]);
+    }
+
+    /// Runs `f` on backend `V` and on plain `f64`s, `W` inputs at a time, and demands the same
+    /// bits.
+    fn same_bits<V: Vector<Row = [f64; W]>, const W: usize>(
+        inputs: &[f64],
+        f_vec: fn(V) -> V,
+        f_ref: fn(f64) -> f64,
+    ) {
+        for chunk in inputs.chunks(W) {
+            let mut x = [0.0; W];
+            x[..chunk.len()].copy_from_slice(chunk);
+            let mut got = [0.0; W];
+            f_vec(V::load(&x)).store(&mut got);
+            for l in 0..W {
+                let want = f_ref(x[l]);
+                assert!(
+                    got[l].to_bits() == want.to_bits() || got[l].is_nan() && want.is_nan(),
+                    "x = {:e}: {:e} (vector) vs {:e} (f64)",
+                    x[l],
+                    got[l],
+                    want
+                );
+            }
+        }
+    }
+
+    /// A dense sweep where networks live, a coarse one far out, and the edge cases.
+    fn inputs() -> Vec<f64> {
+        let mut x: Vec<f64> = (0..=400_000)
+            .map(|i| -40.0 + 80.0 * i as f64 / 4e5)
+            .collect();
+        x.extend((0..=20_000).map(|i| -800.0 + 1600.0 * i as f64 / 2e4));
+        x.extend([
+            0.0,
+            -0.0,
+            -708.0,
+            709.0,
+            -708.0000001,
+            709.0000001,
+            -745.2,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+            5e-324,
+        ]);
+        x
+    }
+
+    /// `exp`, `sigmoid` and negation on backend `V` against plain `f64`s.
+    fn backend_matches_f64<V: Vector<Row = [f64; W]>, const W: usize>() {
+        use crate::math::{exp_lanes, sigmoid_lanes};
+        let x = inputs();
+        same_bits::<V, W>(&x, exp_lanes, exp_lanes);
+        same_bits::<V, W>(&x, sigmoid_lanes, sigmoid_lanes);
+        same_bits::<V, W>(&x, |v| -v, |v| -v);
+    }
+
+    #[test]
+    fn portable_lanes_match_f64_bit_for_bit() {
+        backend_matches_f64::<Portable<4>, 4>();
+    }
+
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    fn register_backends_match_f64_bit_for_bit() {
+        use crate::simd::Kernel;
+        if Kernel::Avx2.is_supported() {
+            // SAFETY: the CPU has AVX2 and FMA (checked above).
+            unsafe { avx2::enabled(backend_matches_f64::<Avx2, 4>) };
+        } else {
+            eprintln!("this CPU has no AVX2 + FMA: the avx2 backend was not checked");
+        }
+        if Kernel::Avx512.is_supported() {
+            // SAFETY: the CPU has AVX-512F (checked above).
+            unsafe { avx512::enabled(backend_matches_f64::<Avx512, 8>) };
+        } else {
+            eprintln!("this CPU has no AVX-512F: the avx512 backend was not checked");
+        }
     }
 }

@@ -15,6 +15,7 @@ mod network;
 mod population;
 mod pyjson;
 mod sequence;
+mod simd;
 
 use pyo3::prelude::*;
 
@@ -52,6 +53,8 @@ mod _core {
         sequence_assess, sequence_fresh_timings, sequence_timings, sequence_trial,
         sequence_trial_order,
     };
+    #[pymodule_export]
+    use super::simd::{apply_simd_env, build_info, use_kernel};
 
     use pyo3::prelude::*;
 

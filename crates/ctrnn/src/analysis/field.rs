@@ -17,7 +17,7 @@
 use nalgebra::DMatrix;
 
 use crate::error::{Error, Result};
-use crate::math::sigmoid;
+use crate::math::firing_rates;
 use crate::Network;
 
 /// A network with its sensors held at one constant input vector.
@@ -58,7 +58,8 @@ impl<'a> Field<'a> {
     /// `G(v)` into `out`: zero exactly at the equilibria.
     pub(crate) fn residual(&self, v: &[f64], out: &mut [f64]) {
         let (n, w, theta) = (self.size(), self.net.weights(), self.net.theta());
-        let f: Vec<f64> = (0..n).map(|j| sigmoid(v[j] - theta[j])).collect();
+        let mut f = vec![0.0; n];
+        firing_rates(v, theta, &mut f);
         for i in 0..n {
             let row = &w[i * n..(i + 1) * n];
             out[i] = -v[i] + row.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>() + self.drive[i];
@@ -76,12 +77,11 @@ impl<'a> Field<'a> {
     /// The Jacobian of `G` (without the time constants).
     pub(crate) fn residual_jacobian(&self, v: &[f64]) -> DMatrix<f64> {
         let (n, w, theta) = (self.size(), self.net.weights(), self.net.theta());
-        let slope: Vec<f64> = (0..n)
-            .map(|j| {
-                let f = sigmoid(v[j] - theta[j]);
-                f * (1.0 - f)
-            })
-            .collect();
+        let mut slope = vec![0.0; n];
+        firing_rates(v, theta, &mut slope);
+        for f in &mut slope {
+            *f *= 1.0 - *f;
+        }
         DMatrix::from_fn(n, n, |i, j| {
             w[i * n + j] * slope[j] - if i == j { 1.0 } else { 0.0 }
         })

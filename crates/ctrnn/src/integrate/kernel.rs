@@ -62,10 +62,16 @@ impl<V: Vector> Work<'_, V> {
         if !fresh {
             rates::<V>(self.theta, v, self.out);
         }
-        drive::<V>(self.weights, self.ext, self.out, |i, acc| {
-            let x = V::load(&v[i]);
-            V::load(&h[i]).mul_add(acc - x, x).store(&mut v[i]);
-        });
+        drive::<V>(
+            self.weights,
+            self.ext,
+            self.out,
+            #[inline(always)]
+            |i, acc| {
+                let x = V::load(&v[i]);
+                V::load(&h[i]).mul_add(acc - x, x).store(&mut v[i]);
+            },
+        );
     }
 
     /// One classical RK4 step; with `fresh`, `out` already holds `f(v - theta)`.
@@ -88,32 +94,50 @@ impl<V: Vector> Work<'_, V> {
         if !fresh {
             rates::<V>(theta, v, out);
         }
-        drive::<V>(weights, ext, out, |i, acc| {
-            let x = V::load(&v[i]);
-            let d = acc - x;
-            d.store(&mut k1[i]);
-            V::load(&h2[i]).mul_add(d, x).store(&mut probe[i]);
-        });
+        drive::<V>(
+            weights,
+            ext,
+            out,
+            #[inline(always)]
+            |i, acc| {
+                let x = V::load(&v[i]);
+                let d = acc - x;
+                d.store(&mut k1[i]);
+                V::load(&h2[i]).mul_add(d, x).store(&mut probe[i]);
+            },
+        );
         // Slopes 2 and 3 at the probe; the probes after them are v + h/2 k2 and v + h k3.
         for (k, h) in [(&mut **k2, *h2), (&mut **k3, *h)] {
             rates::<V>(theta, probe, out);
-            drive::<V>(weights, ext, out, |i, acc| {
-                let d = acc - V::load(&probe[i]);
-                d.store(&mut k[i]);
-                V::load(&h[i])
-                    .mul_add(d, V::load(&v[i]))
-                    .store(&mut probe[i]);
-            });
+            drive::<V>(
+                weights,
+                ext,
+                out,
+                #[inline(always)]
+                |i, acc| {
+                    let d = acc - V::load(&probe[i]);
+                    d.store(&mut k[i]);
+                    V::load(&h[i])
+                        .mul_add(d, V::load(&v[i]))
+                        .store(&mut probe[i]);
+                },
+            );
         }
         // Slope 4 at the last probe, then v += h/6 (k1 + 2 k2 + 2 k3 + k4).
         rates::<V>(theta, probe, out);
-        drive::<V>(weights, ext, out, |i, acc| {
-            let k4 = acc - V::load(&probe[i]);
-            let two = V::splat(2.0);
-            let sum = V::load(&k1[i]) + two * V::load(&k2[i]) + two * V::load(&k3[i]) + k4;
-            let x = V::load(&v[i]);
-            V::load(&h6[i]).mul_add(sum, x).store(&mut v[i]);
-        });
+        drive::<V>(
+            weights,
+            ext,
+            out,
+            #[inline(always)]
+            |i, acc| {
+                let k4 = acc - V::load(&probe[i]);
+                let two = V::splat(2.0);
+                let sum = V::load(&k1[i]) + two * V::load(&k2[i]) + two * V::load(&k3[i]) + k4;
+                let x = V::load(&v[i]);
+                V::load(&h6[i]).mul_add(sum, x).store(&mut v[i]);
+            },
+        );
     }
 }
 
@@ -121,7 +145,9 @@ impl<V: Vector> Work<'_, V> {
 #[inline(always)]
 fn sensor_drive<V: Vector>(sensor_weights: &[V::Row], inputs: &[V::Row], ext: &mut [V::Row]) {
     if inputs.is_empty() {
-        ext.iter_mut().for_each(|e| V::splat(0.0).store(e));
+        for e in ext {
+            V::splat(0.0).store(e);
+        }
         return;
     }
     for (e, weights) in ext
@@ -140,32 +166,22 @@ fn sensor_drive<V: Vector>(sensor_weights: &[V::Row], inputs: &[V::Row], ext: &m
 /// [`Group`]), else one by one.
 #[inline(always)]
 pub(super) fn rates<V: Vector>(theta: &[V::Row], v: &[V::Row], out: &mut [V::Row]) {
-    let one = |o: &mut V::Row, x: &V::Row, t: &V::Row| {
-        sigmoid_lanes(V::load(x) - V::load(t)).store(o);
-    };
-    if !V::INTERLEAVE {
-        for (o, (x, t)) in out.iter_mut().zip(v.iter().zip(theta)) {
-            one(o, x, t);
-        }
-        return;
-    }
-    let mut groups = out.chunks_exact_mut(RATE_GROUP);
     let mut at = 0;
-    for o in &mut groups {
-        let x = Group::<V, RATE_GROUP>(std::array::from_fn(|g| {
-            V::load(&v[at + g]) - V::load(&theta[at + g])
-        }));
-        for (o, y) in o.iter_mut().zip(sigmoid_lanes(x).0) {
-            y.store(o);
+    if V::INTERLEAVE {
+        while at + RATE_GROUP <= out.len() {
+            let mut x = Group([V::splat(0.0); RATE_GROUP]);
+            for g in 0..RATE_GROUP {
+                x.0[g] = V::load(&v[at + g]) - V::load(&theta[at + g]);
+            }
+            let y = sigmoid_lanes(x);
+            for g in 0..RATE_GROUP {
+                y.0[g].store(&mut out[at + g]);
+            }
+            at += RATE_GROUP;
         }
-        at += RATE_GROUP;
     }
-    for (o, (x, t)) in groups
-        .into_remainder()
-        .iter_mut()
-        .zip(v[at..].iter().zip(&theta[at..]))
-    {
-        one(o, x, t);
+    for i in at..out.len() {
+        sigmoid_lanes(V::load(&v[i]) - V::load(&theta[i])).store(&mut out[i]);
     }
 }
 
@@ -201,10 +217,15 @@ fn drive<V: Vector>(
     let mut i = 0;
     while i + ROWS <= n {
         let (columns, _) = weights[i * n..(i + ROWS) * n].as_chunks::<ROWS>();
-        let mut acc: [V; ROWS] = std::array::from_fn(|r| V::load(&ext[i + r]));
+        let mut acc = [V::splat(0.0); ROWS];
+        for r in 0..ROWS {
+            acc[r] = V::load(&ext[i + r]);
+        }
         for (j, (w, o)) in columns.iter().zip(out).enumerate() {
             if let Some(ahead) = columns.get(j + PREFETCH_COLUMNS) {
-                ahead.iter().for_each(V::prefetch);
+                for a in ahead {
+                    V::prefetch(a);
+                }
             }
             let o = V::load(o);
             for (a, w) in acc.iter_mut().zip(w) {

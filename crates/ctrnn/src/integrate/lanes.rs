@@ -7,36 +7,61 @@ use crate::error::{Error, Result};
 use crate::math::sigmoid;
 use crate::network::Network;
 use crate::rows::Rows;
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-use crate::vector::Avx512;
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-use crate::vector::Group;
+use crate::simd::{self, Kernel};
+#[cfg(target_arch = "x86_64")]
+use crate::vector::{avx2, avx512, Avx2, Avx512, Group};
 use crate::vector::{Portable, Vector};
 
 use super::kernel::{rates, weight_order, Work};
 use super::Integrator;
 
-/// How many networks a population block steps together: two AVX-512 registers of f64, so that
-/// every row of the kernel has two independent dependency chains in flight.
+/// How many networks a population block steps together: two AVX-512 registers of f64 or four
+/// AVX2 ones, so that every row of the kernel has independent dependency chains in flight.
 pub const LANES: usize = 16;
 
 /// Integration steps (rows times substeps) between two looks at the cancel flag, so that Ctrl-C
 /// is seen within milliseconds however many substeps a row has.
 const CANCEL_CHECK_STEPS: usize = 1024;
 
-/// Calls `self.method::<V>(args)` with `V` the lane vector type for `L` lanes: AVX-512 registers
-/// where the build's target CPU has them and `L` is 8 or 16, plain lanes otherwise.
+/// Calls `self.method::<V>(args)` with `V` the lane vector type of `kernel` for `L` lanes:
+/// registers of the kernel where `L` fills them, plain lanes otherwise. Either way the code is
+/// compiled for the kernel's CPU features (so plain lanes get hardware fused multiply-adds too).
 macro_rules! with_backend {
-    ($self:ident . $method:ident ( $($arg:expr),* )) => {{
-        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-        if L == 8 {
-            return $self.$method::<Avx512>($($arg),*);
+    ($kernel:expr, $self:ident . $method:ident ( $($arg:expr),* )) => {{
+        match $kernel {
+            // The closures are always inlined into `enabled`, which compiles them, and the kernel
+            // in them, for the kernel's features.
+            // SAFETY (both): `simd` only hands out kernels that the CPU supports.
+            #[cfg(target_arch = "x86_64")]
+            #[allow(unsafe_code)]
+            Kernel::Avx512 => unsafe {
+                avx512::enabled(#[inline(always)] || {
+                    if L == 8 {
+                        $self.$method::<Avx512>($($arg),*)
+                    } else if L == 16 {
+                        $self.$method::<Group<Avx512, 2>>($($arg),*)
+                    } else {
+                        $self.$method::<Portable<L>>($($arg),*)
+                    }
+                })
+            },
+            #[cfg(target_arch = "x86_64")]
+            #[allow(unsafe_code)]
+            Kernel::Avx2 => unsafe {
+                avx2::enabled(#[inline(always)] || {
+                    if L == 4 {
+                        $self.$method::<Avx2>($($arg),*)
+                    } else if L == 8 {
+                        $self.$method::<Group<Avx2, 2>>($($arg),*)
+                    } else if L == 16 {
+                        $self.$method::<Group<Avx2, 4>>($($arg),*)
+                    } else {
+                        $self.$method::<Portable<L>>($($arg),*)
+                    }
+                })
+            },
+            _ => $self.$method::<Portable<L>>($($arg),*),
         }
-        #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-        if L == 16 {
-            return $self.$method::<Group<Avx512, 2>>($($arg),*);
-        }
-        $self.$method::<Portable<L>>($($arg),*)
     }};
 }
 
@@ -179,9 +204,10 @@ impl<const L: usize> Lanes<L> {
     }
 
     fn compute_outputs(&mut self) {
-        with_backend!(self.compute_outputs_with())
+        with_backend!(simd::kernel(), self.compute_outputs_with())
     }
 
+    #[inline(always)]
     fn compute_outputs_with<V: Vector>(&mut self) {
         rates::<V>(
             V::rows(self.theta.as_flattened()),
@@ -234,8 +260,14 @@ impl<const L: usize> Lanes<L> {
     #[inline(always)]
     pub fn step_row(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
         debug_assert_eq!(inputs.len(), self.n_inputs);
+        self.step_row_on(simd::kernel(), inputs, integ);
+    }
+
+    /// [`step_row`](Self::step_row) on a given kernel, which the CPU must support.
+    #[inline(always)]
+    pub(super) fn step_row_on(&mut self, kernel: Kernel, inputs: &[[f64; L]], integ: &Integrator) {
         self.prepare(integ.dt);
-        with_backend!(self.step_row_with(inputs, integ))
+        with_backend!(kernel, self.step_row_with(inputs, integ))
     }
 
     #[inline(always)]
@@ -278,7 +310,7 @@ impl<const L: usize> Lanes<L> {
             "step_held needs a step_row before it, with no run_rows in between"
         );
         self.prepare(integ.dt);
-        with_backend!(self.step_held_with(integ))
+        with_backend!(simd::kernel(), self.step_held_with(integ))
     }
 
     #[inline(always)]
@@ -300,7 +332,10 @@ impl<const L: usize> Lanes<L> {
         record: impl FnMut(usize, &[[f64; L]]),
     ) -> Result<()> {
         self.prepare(integ.dt);
-        with_backend!(self.run_rows_with(steps, integ, cancel, row, record))?;
+        with_backend!(
+            simd::kernel(),
+            self.run_rows_with(steps, integ, cancel, row, record)
+        )?;
         self.check_finite()
     }
 

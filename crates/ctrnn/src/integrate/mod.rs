@@ -93,8 +93,7 @@ pub(crate) fn check_inputs(inputs: &[f64], want: usize, shape: &str) -> Result<(
 mod tests {
     use super::kernel::weight_order;
     use super::*;
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-    use crate::vector::{Avx512, Group, Portable, Vector};
+    use crate::simd::{self, Kernel};
 
     fn sig(x: f64) -> f64 {
         1.0 / (1.0 + (-x).exp())
@@ -245,9 +244,8 @@ mod tests {
             .collect()
     }
 
-    /// Steps one block with vector backend `V` and with the portable backend: same bits.
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-    fn backends_agree<V: Vector<Row = R>, R, const L: usize>() {
+    /// Steps one block of `L` networks on `kernel` and on the portable kernel: same bits.
+    fn kernels_agree<const L: usize>(kernel: Kernel) {
         for (n, m) in [
             (1, 0),
             (3, 1),
@@ -272,16 +270,14 @@ mod tests {
                     let inputs: Vec<[f64; L]> = (0..m)
                         .map(|k| std::array::from_fn(|l| ((t * 7 + k * 3 + l) % 5) as f64 - 2.0))
                         .collect();
-                    fast.prepare(integ.dt);
-                    fast.step_row_with::<V>(&inputs, &integ);
-                    portable.prepare(integ.dt);
-                    portable.step_row_with::<Portable<L>>(&inputs, &integ);
+                    fast.step_row_on(kernel, &inputs, &integ);
+                    portable.step_row_on(Kernel::Portable, &inputs, &integ);
                 }
                 for i in 0..n {
                     let (a, b) = (fast.state(i), portable.state(i));
                     assert!(
                         a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
-                        "N = {n}, M = {m}, {method:?}, neuron {i}: {a:?} vs {b:?}"
+                        "{kernel}, L = {L}, N = {n}, M = {m}, {method:?}, neuron {i}: {a:?} vs {b:?}"
                     );
                 }
             }
@@ -289,10 +285,17 @@ mod tests {
     }
 
     #[test]
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-    fn avx512_blocks_match_the_portable_kernel_bit_for_bit() {
-        backends_agree::<Avx512, [f64; 8], 8>();
-        backends_agree::<Group<Avx512, 2>, [[f64; 8]; 2], 16>();
+    fn every_kernel_matches_the_portable_kernel_bit_for_bit() {
+        for kernel in simd::supported() {
+            kernels_agree::<1>(kernel);
+            kernels_agree::<3>(kernel);
+            kernels_agree::<4>(kernel);
+            kernels_agree::<8>(kernel);
+            kernels_agree::<LANES>(kernel);
+        }
+        for kernel in Kernel::ALL.into_iter().filter(|k| !k.is_supported()) {
+            eprintln!("this CPU cannot run the {kernel} kernel: not checked");
+        }
     }
 
     #[test]

@@ -1,0 +1,127 @@
+"""The integrator's kernel is chosen when the program runs; every kernel the CPU has gives the same
+bits, and a bad choice is a clear error."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import subprocess
+import sys
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import dnnevo
+from dnnevo import presets
+
+KERNELS = dnnevo.build_info()["kernels"]
+
+
+@pytest.fixture(autouse=True)
+def _restore_kernel() -> Iterator[None]:
+    before = dnnevo.build_info()["kernel"]
+    yield
+    dnnevo.use_kernel(before)
+
+
+def bits(x: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(x, dtype=np.float64).view(np.uint64)
+
+
+def test_build_info_names_the_cpu_and_the_kernel_in_use() -> None:
+    info = dnnevo.build_info()
+    assert info["version"] == dnnevo.__version__
+    assert info["kernel"] in info["kernels"] and "portable" in info["kernels"]
+    assert set(info["kernels"]) <= {"portable", "avx2", "avx512"}
+    assert all(isinstance(v, bool) for v in info["cpu_features"].values())
+    if info["arch"] == "x86_64":
+        assert ("avx2" in info["kernels"]) == (info["cpu_features"]["avx2"] and info["cpu_features"]["fma"])
+        assert ("avx512" in info["kernels"]) == info["cpu_features"]["avx512f"]
+    for name in info["kernels"]:
+        dnnevo.use_kernel(name)
+        assert dnnevo.build_info()["kernel"] == name
+
+
+def test_unknown_and_unsupported_kernels_are_errors() -> None:
+    with pytest.raises(dnnevo.InvalidArgumentError, match="avx513.*portable, avx2, avx512"):
+        dnnevo.use_kernel("avx513")
+    for name in {"avx2", "avx512"} - set(KERNELS):
+        with pytest.raises(dnnevo.InvalidArgumentError, match=f"cannot run the {name} kernel"):
+            dnnevo.use_kernel(name)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    p=st.integers(1, 40),
+    n=st.integers(1, 12),
+    m=st.integers(0, 3),
+    steps=st.integers(1, 30),
+    method=st.sampled_from(["euler", "rk4"]),
+    substeps=st.integers(1, 3),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_every_kernel_gives_the_same_states(
+    p: int, n: int, m: int, steps: int, method: str, substeps: int, seed: int
+) -> None:
+    inputs = np.random.default_rng(seed).uniform(-3, 3, size=(steps, m))
+    runs = {}
+    for name in KERNELS:
+        dnnevo.use_kernel(name)
+        nets = [dnnevo.Network.random(n, m, seed=seed + k) for k in range(p)]  # run() moves a network on
+        states = dnnevo.run_population(nets, inputs, dt=0.05, substeps=substeps, method=method)
+        single = nets[0].run(inputs, dt=0.05, substeps=substeps, method=method)
+        runs[name] = (bits(states), bits(single.states), bits(single.outputs))
+    first = runs[KERNELS[0]]
+    for name, run in runs.items():
+        for a, b in zip(run, first, strict=True):
+            assert np.array_equal(a, b), f"{name} differs from {KERNELS[0]}"
+
+
+TIMINGS = {"evals_per_s", "elapsed_s"}  # the log's columns that are wall times
+
+
+def test_an_evolution_run_is_the_same_on_every_kernel() -> None:
+    config = dataclasses.replace(presets.get("sequence-1bit"), population=40, generations=3)
+    results = {}
+    for name in KERNELS:
+        dnnevo.use_kernel(name)
+        result = dnnevo.evolve("sequence-1bit", config, seed=3, progress=False, threads=2)
+        history = {k: bits(np.asarray(v)) for k, v in result.history.items() if k not in TIMINGS}
+        results[name] = (history, result.best.to_json())
+    first_history, first_best = results[KERNELS[0]]
+    for name, (history, best) in results.items():
+        assert best == first_best, f"{name} differs from {KERNELS[0]}"
+        assert history.keys() == first_history.keys()
+        for key, column in history.items():
+            assert np.array_equal(column, first_history[key]), f"{name}: {key} differs from {KERNELS[0]}"
+
+
+def run_with_simd(value: str, code: str) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "DNNEVO_SIMD": value}
+    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+
+
+@pytest.mark.parametrize("name", KERNELS)
+def test_the_environment_variable_forces_a_kernel(name: str) -> None:
+    done = run_with_simd(name, "import dnnevo; print(dnnevo.build_info()['kernel'])")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == name
+
+
+def test_a_bad_environment_variable_fails_the_import_and_the_command_in_one_line() -> None:
+    done = run_with_simd("avx513", "import dnnevo")
+    assert done.returncode != 0
+    assert "InvalidArgumentError" in done.stderr and "DNNEVO_SIMD" in done.stderr
+    done = run_with_simd("avx513", "import sys; from dnnevo.cli import main; sys.exit(main())")
+    assert done.returncode != 0
+    env = {**os.environ, "DNNEVO_SIMD": "avx513"}
+    command = subprocess.run([sys.executable, "-m", "dnnevo", "--help"], env=env, capture_output=True,
+                             text=True, timeout=120)
+    assert command.returncode != 0
+    assert command.stderr.strip().splitlines() == [
+        'dnnevo: error: DNNEVO_SIMD="avx513": unknown SIMD kernel "avx513"; '
+        "choose one of portable, avx2, avx512"
+    ]

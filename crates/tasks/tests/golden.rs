@@ -1,0 +1,100 @@
+//! Stored bits of a population run and of a short evolution run. They must not change with the
+//! CPU, the SIMD kernel, the number of threads or the build: every kernel this CPU has is checked
+//! here, and `scripts/cross-cpu.sh` runs this file on emulated CPUs with and without AVX2.
+//!
+//! A deliberate change of the numbers (a new sigmoid, say) updates the constants below, and the
+//! changelog says so.
+
+use ctrnn::genome::{self, Layout, Ranges};
+use ctrnn::simd::{self, Kernel};
+use ctrnn::{Evolution, Fill, Inputs, Integrator, Method, Network, Population, Purpose, Stream};
+use tasks::RunConfig;
+
+/// FNV-1a over the bits of `values`: any change of any bit changes it.
+fn fingerprint(values: impl IntoIterator<Item = f64>) -> u64 {
+    let mut hash = 0xcbf2_9ce4_8422_2325u64;
+    for v in values {
+        for byte in v.to_bits().to_le_bytes() {
+            hash = (hash ^ byte as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    hash
+}
+
+/// `f` on every kernel this CPU can run: the same fingerprint on each, and the stored one.
+fn same_on_every_kernel(what: &str, stored: u64, f: impl Fn() -> u64) {
+    let before = simd::kernel();
+    let got: Vec<(Kernel, u64)> = simd::supported()
+        .into_iter()
+        .map(|k| {
+            simd::set_kernel(k).unwrap();
+            (k, f())
+        })
+        .collect();
+    simd::set_kernel(before).unwrap();
+    for (kernel, hash) in got {
+        assert_eq!(
+            hash, stored,
+            "{what} on the {kernel} kernel: fingerprint {hash:#018x}, stored {stored:#018x}"
+        );
+    }
+}
+
+fn random_networks(layout: Layout, count: usize) -> Vec<Network> {
+    (0..count)
+        .map(|i| {
+            let mut s = Stream::new(17, 0, Purpose::Init, i as u64, 0);
+            genome::decode(layout, &genome::random(layout, &Ranges::default(), &mut s)).unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn a_population_run_keeps_its_stored_bits() {
+    // 37 networks: two full blocks of 16 and a ragged one, N = 7 (not a multiple of 4).
+    let nets = random_networks(Layout { size: 7, n_inputs: 2 }, 37);
+    let steps = 120;
+    let inputs: Vec<f64> = (0..steps * 2)
+        .map(|k| ((k * 7) % 11) as f64 / 5.0 - 1.0)
+        .collect();
+    same_on_every_kernel("a population run", 0x26b4_c19b_421f_2efe, || {
+        let mut all = Vec::new();
+        for (method, substeps) in [(Method::Euler, 1), (Method::Rk4, 3)] {
+            let integ = Integrator {
+                method,
+                dt: 0.1,
+                substeps,
+            };
+            let mut pop = Population::new(&nets).unwrap();
+            all.extend(
+                pop.run(Inputs::Shared(&inputs), steps, &integ, true, None)
+                    .unwrap(),
+            );
+        }
+        fingerprint(all)
+    });
+}
+
+#[test]
+fn a_short_evolution_run_keeps_its_stored_bits() {
+    let config = RunConfig {
+        population: 48,
+        generations: 3,
+        ..RunConfig::default()
+    };
+    let task = config.build_task().unwrap();
+    same_on_every_kernel("a sequence-task evolution run", 0x1d97_bd04_9c91_adbe, || {
+        let mut evo =
+            Evolution::new(task.layout(), config.ga(), 5, &[], Fill::default()).unwrap();
+        let mut all = Vec::new();
+        for _ in 0..config.generations {
+            let (stats, fitness) = evo.step(task.as_ref(), None).unwrap();
+            all.extend(fitness);
+            all.extend([stats.best, stats.mean]);
+        }
+        for net in evo.networks().unwrap() {
+            all.extend(genome::encode(&net));
+        }
+        fingerprint(all)
+    });
+}

@@ -52,7 +52,13 @@ fn random_networks(layout: Layout, count: usize) -> Vec<Network> {
 #[test]
 fn a_population_run_keeps_its_stored_bits() {
     // 37 networks: two full blocks of 16 and a ragged one, N = 7 (not a multiple of 4).
-    let nets = random_networks(Layout { size: 7, n_inputs: 2 }, 37);
+    let nets = random_networks(
+        Layout {
+            size: 7,
+            n_inputs: 2,
+        },
+        37,
+    );
     let steps = 120;
     let inputs: Vec<f64> = (0..steps * 2)
         .map(|k| ((k * 7) % 11) as f64 / 5.0 - 1.0)
@@ -83,18 +89,22 @@ fn a_short_evolution_run_keeps_its_stored_bits() {
         ..RunConfig::default()
     };
     let task = config.build_task().unwrap();
-    same_on_every_kernel("a sequence-task evolution run", 0x1d97_bd04_9c91_adbe, || {
-        let mut evo =
-            Evolution::new(task.layout(), config.ga(), 5, &[], Fill::default()).unwrap();
-        let mut all = Vec::new();
-        for _ in 0..config.generations {
-            let (stats, fitness) = evo.step(task.as_ref(), None).unwrap();
-            all.extend(fitness);
-            all.extend([stats.best, stats.mean]);
-        }
-        for net in evo.networks().unwrap() {
-            all.extend(genome::encode(&net));
-        }
-        fingerprint(all)
-    });
+    same_on_every_kernel(
+        "a sequence-task evolution run",
+        0x1d97_bd04_9c91_adbe,
+        || {
+            let mut evo =
+                Evolution::new(task.layout(), config.ga(), 5, &[], Fill::default()).unwrap();
+            let mut all = Vec::new();
+            for _ in 0..config.generations {
+                let (stats, fitness) = evo.step(task.as_ref(), None).unwrap();
+                all.extend(fitness);
+                all.extend([stats.best, stats.mean]);
+            }
+            for net in evo.networks().unwrap() {
+                all.extend(genome::encode(&net));
+            }
+            fingerprint(all)
+        },
+    );
 }

@@ -38,6 +38,9 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 /// Checks that every value of `values` is finite; the error names `field[index]`.
 pub(crate) fn check_finite(field: &str, values: &[f64], cols: usize) -> Result<()> {
+    if all_finite(values) {
+        return Ok(());
+    }
     match values.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
         Some(k) => Err(Error::InvalidNetwork(format!(
@@ -48,10 +51,45 @@ pub(crate) fn check_finite(field: &str, values: &[f64], cols: usize) -> Result<(
     }
 }
 
+/// Whether every value is finite, in a loop that vectorises (the search for the culprit does
+/// not): `v * 0` is 0 for a finite `v` and NaN otherwise, and NaN survives every sum.
+fn all_finite(values: &[f64]) -> bool {
+    const WIDTH: usize = 8;
+    let (chunks, rest) = values.as_chunks::<WIDTH>();
+    let mut acc = [0.0; WIDTH];
+    for chunk in chunks {
+        for (a, v) in acc.iter_mut().zip(chunk) {
+            *a += v * 0.0;
+        }
+    }
+    acc.iter().chain(rest).all(|v| (v * 0.0) == 0.0)
+}
+
 /// `[i]` for a vector (`cols == 0`) or `[i][j]` for a row-major matrix with `cols` columns.
 pub(crate) fn index_label(k: usize, cols: usize) -> String {
     match k.checked_div(cols) {
         None => format!("[{k}]"),
         Some(row) => format!("[{row}][{}]", k % cols),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_finite_finds_every_non_finite_value_wherever_it_is() {
+        for len in [1, 7, 8, 9, 17, 30] {
+            assert!(check_finite("w", &vec![1.5; len], 0).is_ok());
+            for k in 0..len {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut values = vec![-2.0; len];
+                    values[k] = bad;
+                    let err = check_finite("w", &values, 0).unwrap_err().to_string();
+                    assert!(err.contains(&format!("w[{k}] is {bad}")), "{err}");
+                }
+            }
+        }
+        assert!(check_finite("w", &[f64::MAX, f64::MIN, 0.0, -0.0], 0).is_ok());
     }
 }

@@ -52,7 +52,7 @@ impl Population {
             )));
         }
         let blocks = refs
-            .chunks(LANES)
+            .par_chunks(LANES)
             .map(Block::new)
             .collect::<Result<Vec<_>>>()?;
         Ok(Population {

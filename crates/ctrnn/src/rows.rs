@@ -32,18 +32,6 @@ impl<const L: usize> Rows<L> {
         let lines = vec![Line([0.0; VALUES_PER_LINE]); (len * L).div_ceil(VALUES_PER_LINE)];
         Rows { lines, len }
     }
-
-    /// The `len` rows that `rows` yields, in order.
-    pub(crate) fn from_rows(len: usize, rows: impl IntoIterator<Item = [f64; L]>) -> Self {
-        let mut out = Rows::zeros(len);
-        let mut count = 0;
-        for (dst, row) in out.iter_mut().zip(rows) {
-            *dst = row;
-            count += 1;
-        }
-        debug_assert_eq!(count, len);
-        out
-    }
 }
 
 impl<const L: usize> Deref for Rows<L> {
@@ -69,7 +57,8 @@ mod tests {
 
     #[test]
     fn rows_are_aligned_packed_and_hold_their_values() {
-        let rows = Rows::<3>::from_rows(3, [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]);
+        let mut rows = Rows::<3>::zeros(3);
+        rows.copy_from_slice(&[[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]);
         assert_eq!(rows.len(), 3);
         assert_eq!(rows[1], [4.0, 5.0, 6.0]);
         assert!((rows.as_ptr() as usize).is_multiple_of(64));

@@ -56,6 +56,11 @@ pub(crate) trait Vector: Arith {
     /// (grouping 16-lane portable rows four at a time made an AVX2 build 4x slower, and made
     /// single networks no faster).
     const INTERLEAVE: bool;
+    /// How many values of this type the integrator's running sums may hold at once: what the
+    /// register file keeps besides their operands. More independent sums keep the multiply-add
+    /// units busy; more than fit spill to memory (measured: four rows of a 16-lane AVX2 block,
+    /// 16 registers, ran at two thirds the speed of two rows).
+    const SUM_REGISTERS: usize;
 
     /// Reads a stored row.
     fn load(row: &Self::Row) -> Self;
@@ -146,6 +151,8 @@ impl<V: Arith, const G: usize> Arith for Group<V, G> {
 impl<V: Vector, const G: usize> Vector for Group<V, G> {
     type Row = [V::Row; G];
     const INTERLEAVE: bool = V::INTERLEAVE;
+    /// One value of a group takes `G` registers.
+    const SUM_REGISTERS: usize = V::SUM_REGISTERS / G;
 
     #[inline(always)]
     fn load(row: &Self::Row) -> Self {
@@ -212,6 +219,8 @@ impl Arith for f64 {
 impl Vector for f64 {
     type Row = f64;
     const INTERLEAVE: bool = false;
+    /// Plain lanes are left to the compiler: it gets rows four at a time at any lane count.
+    const SUM_REGISTERS: usize = 64;
 
     #[inline(always)]
     fn load(row: &f64) -> Self {

@@ -188,54 +188,75 @@ pub(super) fn rates<V: Vector>(theta: &[V::Row], v: &[V::Row], out: &mut [V::Row
 /// Neurons whose firing rates are computed together in [`rates`].
 const RATE_GROUP: usize = 4;
 
-/// Rows of `W f` computed together in [`drive`].
-const ROWS: usize = 4;
+/// Rows of the weights stored together, column by column (see [`weight_order`]).
+const WEIGHT_GROUP: usize = 4;
 const PREFETCH_COLUMNS: usize = 4;
 
 /// The order in which [`drive`] reads the row-major `N x N` weights, as one stream: each group
-/// of [`ROWS`] rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the rows
-/// left over, row by row. Row `i`'s weights start at `i * N` either way.
+/// of [`WEIGHT_GROUP`] rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the
+/// rows left over, row by row. Row `i`'s weights start at `i * N` either way.
 pub(super) fn weight_order(n: usize) -> impl Iterator<Item = usize> {
-    let full = n - n % ROWS;
+    let full = n - n % WEIGHT_GROUP;
     let groups = (0..full)
-        .step_by(ROWS)
-        .flat_map(move |i| (0..n).flat_map(move |j| (i..i + ROWS).map(move |r| r * n + j)));
+        .step_by(WEIGHT_GROUP)
+        .flat_map(move |i| (0..n).flat_map(move |j| (i..i + WEIGHT_GROUP).map(move |r| r * n + j)));
     groups.chain(full * n..n * n)
 }
 
 /// For every neuron `i`, `finish(i, ext_i + sum_j w_ij out_j)`, the sum taken in the order
-/// `j = 0, 1, ...`. Rows go [`ROWS`] at a time: independent sums keep the multiply-add units
-/// busy, and the result does not depend on the blocking.
+/// `j = 0, 1, ...`. Rows go several at a time, as many as `V`'s registers hold
+/// ([`Vector::SUM_REGISTERS`]): independent sums keep the multiply-add units busy, and the
+/// result does not depend on the blocking.
 #[inline(always)]
 fn drive<V: Vector>(
     weights: &[V::Row],
     ext: &[V::Row],
     out: &[V::Row],
+    finish: impl FnMut(usize, V),
+) {
+    match V::SUM_REGISTERS {
+        0..=1 => drive_by::<V, 1>(weights, ext, out, finish),
+        2..=3 => drive_by::<V, 2>(weights, ext, out, finish),
+        _ => drive_by::<V, 4>(weights, ext, out, finish),
+    }
+}
+
+/// [`drive`], `R` rows at a time within each group of [`WEIGHT_GROUP`] rows.
+#[inline(always)]
+fn drive_by<V: Vector, const R: usize>(
+    weights: &[V::Row],
+    ext: &[V::Row],
+    out: &[V::Row],
     mut finish: impl FnMut(usize, V),
 ) {
+    const { assert!(WEIGHT_GROUP.is_multiple_of(R)) };
     let n = out.len();
     let mut i = 0;
-    while i + ROWS <= n {
-        let (columns, _) = weights[i * n..(i + ROWS) * n].as_chunks::<ROWS>();
-        let mut acc = [V::splat(0.0); ROWS];
-        for r in 0..ROWS {
-            acc[r] = V::load(&ext[i + r]);
-        }
-        for (j, (w, o)) in columns.iter().zip(out).enumerate() {
-            if let Some(ahead) = columns.get(j + PREFETCH_COLUMNS) {
-                for a in ahead {
-                    V::prefetch(a);
+    while i + WEIGHT_GROUP <= n {
+        let (columns, _) = weights[i * n..(i + WEIGHT_GROUP) * n].as_chunks::<WEIGHT_GROUP>();
+        let mut first = 0;
+        while first < WEIGHT_GROUP {
+            let mut acc = [V::splat(0.0); R];
+            for r in 0..R {
+                acc[r] = V::load(&ext[i + first + r]);
+            }
+            for (j, (w, o)) in columns.iter().zip(out).enumerate() {
+                if let Some(ahead) = columns.get(j + PREFETCH_COLUMNS) {
+                    for r in 0..R {
+                        V::prefetch(&ahead[first + r]);
+                    }
+                }
+                let o = V::load(o);
+                for r in 0..R {
+                    acc[r] = V::load(&w[first + r]).mul_add(o, acc[r]);
                 }
             }
-            let o = V::load(o);
-            for (a, w) in acc.iter_mut().zip(w) {
-                *a = V::load(w).mul_add(o, *a);
+            for r in 0..R {
+                finish(i + first + r, acc[r]);
             }
+            first += R;
         }
-        for (r, a) in acc.into_iter().enumerate() {
-            finish(i + r, a);
-        }
-        i += ROWS;
+        i += WEIGHT_GROUP;
     }
     for i in i..n {
         let mut acc = V::load(&ext[i]);

@@ -126,21 +126,29 @@ impl<const L: usize> Lanes<L> {
             }
         }
         // Row r of an array holds value order[r] of every network; padding lanes repeat the first.
-        let gather = |get: fn(&Network) -> &[f64], order: &mut dyn Iterator<Item = usize>| {
-            let sources: [&[f64]; L] = std::array::from_fn(|l| get(nets.get(l).unwrap_or(first)));
-            let len = get(first).len();
-            Rows::from_rows(len, order.map(|q| std::array::from_fn(|l| sources[l][q])))
+        let gather = |get: fn(&Network) -> &[f64], order: &[usize]| {
+            let mut rows = Rows::<L>::zeros(order.len());
+            for l in 0..L {
+                let source = get(nets.get(l).unwrap_or(first));
+                for (row, &q) in rows.iter_mut().zip(order) {
+                    row[l] = source[q];
+                }
+            }
+            rows
         };
+        let identity = |len: usize| (0..len).collect::<Vec<_>>();
+        let (neurons, sensors) = (identity(n), identity(n * m));
+        let weights: Vec<usize> = weight_order(n).collect();
         let zeros = Rows::zeros;
         Ok(Lanes {
             size: n,
             n_inputs: m,
             len: nets.len(),
-            tau: gather(Network::tau, &mut (0..n)),
-            theta: gather(Network::theta, &mut (0..n)),
-            weights: gather(Network::weights, &mut weight_order(n)),
-            sensor_weights: gather(Network::sensor_weights, &mut (0..n * m)),
-            state: gather(Network::state, &mut (0..n)),
+            tau: gather(Network::tau, &neurons),
+            theta: gather(Network::theta, &neurons),
+            weights: gather(Network::weights, &weights),
+            sensor_weights: gather(Network::sensor_weights, &sensors),
+            state: gather(Network::state, &neurons),
             scratch: Scratch {
                 dt: f64::NAN,
                 h: zeros(n),

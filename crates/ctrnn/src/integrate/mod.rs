@@ -212,7 +212,7 @@ mod tests {
 
     #[test]
     fn weights_are_stored_by_row_groups() {
-        // 6 x 6 with ROWS = 4: rows 0-3 column by column, then rows 4 and 5 as they are.
+        // 6 x 6 with WEIGHT_GROUP = 4: rows 0-3 column by column, then rows 4 and 5 as they are.
         let order: Vec<usize> = weight_order(6).collect();
         assert_eq!(order[..8], [0, 6, 12, 18, 1, 7, 13, 19]);
         assert_eq!(order[20..24], [5, 11, 17, 23]);

@@ -57,6 +57,8 @@ impl Vector for Avx2 {
     /// A block of 16 networks is already four registers computed together; grouping four neurons
     /// on top would want 16 registers per operand, all AVX2 has (measured: no faster).
     const INTERLEAVE: bool = false;
+    /// Half of the 16 `ymm` registers; the rest hold the firing rates and weights.
+    const SUM_REGISTERS: usize = 8;
 
     #[inline(always)]
     fn load(row: &[f64; 4]) -> Self {

@@ -58,6 +58,8 @@ impl Neg for Avx512 {
 impl Vector for Avx512 {
     type Row = [f64; 8];
     const INTERLEAVE: bool = true;
+    /// Half of the 32 `zmm` registers; the rest hold the firing rates and weights.
+    const SUM_REGISTERS: usize = 16;
 
     #[inline(always)]
     fn load(row: &[f64; 8]) -> Self {

@@ -35,20 +35,21 @@ def test_build_info_names_the_cpu_and_the_kernel_in_use() -> None:
     info = dnnevo.build_info()
     assert info["version"] == dnnevo.__version__
     assert info["kernel"] in info["kernels"] and "portable" in info["kernels"]
-    assert set(info["kernels"]) <= {"portable", "avx2", "avx512"}
+    assert set(info["kernels"]) <= {"portable", "avx2", "avx512", "neon"}
     assert all(isinstance(v, bool) for v in info["cpu_features"].values())
     if info["arch"] == "x86_64":
         assert ("avx2" in info["kernels"]) == (info["cpu_features"]["avx2"] and info["cpu_features"]["fma"])
         assert ("avx512" in info["kernels"]) == info["cpu_features"]["avx512f"]
+    assert ("neon" in info["kernels"]) == (info["arch"] == "aarch64")
     for name in info["kernels"]:
         dnnevo.use_kernel(name)
         assert dnnevo.build_info()["kernel"] == name
 
 
 def test_unknown_and_unsupported_kernels_are_errors() -> None:
-    with pytest.raises(dnnevo.InvalidArgumentError, match="avx513.*portable, avx2, avx512"):
+    with pytest.raises(dnnevo.InvalidArgumentError, match="avx513.*portable, avx2, avx512, neon"):
         dnnevo.use_kernel("avx513")
-    for name in {"avx2", "avx512"} - set(KERNELS):
+    for name in {"avx2", "avx512", "neon"} - set(KERNELS):
         with pytest.raises(dnnevo.InvalidArgumentError, match=f"cannot run the {name} kernel"):
             dnnevo.use_kernel(name)
 
@@ -123,5 +124,5 @@ def test_a_bad_environment_variable_fails_the_import_and_the_command_in_one_line
     assert command.returncode != 0
     assert command.stderr.strip().splitlines() == [
         'dnnevo: error: DNNEVO_SIMD="avx513": unknown SIMD kernel "avx513"; '
-        "choose one of portable, avx2, avx512"
+        "choose one of portable, avx2, avx512, neon"
     ]

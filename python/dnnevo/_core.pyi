@@ -139,7 +139,7 @@ class Network:
 
 def build_info() -> dict[str, Any]:
     """This build's version, the CPU's architecture and SIMD features, the kernels it can run
-    ("portable", "avx2", "avx512") and the one in use.
+    ("portable", "avx2", "avx512", "neon") and the one in use.
 
     >>> import dnnevo
     >>> info = dnnevo.build_info()

@@ -9,6 +9,7 @@
 //! |---|---|---|
 //! | `avx512` | x86-64 with AVX-512F | 8 |
 //! | `avx2` | x86-64 with AVX2 and FMA | 4 |
+//! | `neon` | every 64-bit ARM (AArch64) CPU | 2 |
 //! | `portable` | any | 1 (what the compiler makes of plain `f64` code) |
 //!
 //! # Example
@@ -27,7 +28,7 @@ use std::sync::atomic::{AtomicU8, Ordering};
 
 use crate::error::{Error, Result};
 
-/// The environment variable that forces a kernel: `avx512`, `avx2` or `portable`.
+/// The environment variable that forces a kernel: `avx512`, `avx2`, `neon` or `portable`.
 pub const ENV: &str = "DNNEVO_SIMD";
 
 /// A vector kernel of the integrator.
@@ -40,11 +41,14 @@ pub enum Kernel {
     Avx2,
     /// 512-bit registers, eight networks each (x86-64 AVX-512F).
     Avx512,
+    /// 128-bit registers, two networks each, with fused multiply-add (AArch64; every 64-bit ARM
+    /// CPU has it).
+    Neon,
 }
 
 impl Kernel {
-    /// Every kernel, slowest first.
-    pub const ALL: [Kernel; 3] = [Kernel::Portable, Kernel::Avx2, Kernel::Avx512];
+    /// Every kernel, slowest first within an architecture.
+    pub const ALL: [Kernel; 4] = [Kernel::Portable, Kernel::Avx2, Kernel::Avx512, Kernel::Neon];
 
     /// The name used by [`ENV`] and [`FromStr`].
     pub fn name(self) -> &'static str {
@@ -52,6 +56,7 @@ impl Kernel {
             Kernel::Portable => "portable",
             Kernel::Avx2 => "avx2",
             Kernel::Avx512 => "avx512",
+            Kernel::Neon => "neon",
         }
     }
 
@@ -70,6 +75,7 @@ impl Kernel {
             }
             #[cfg(not(target_arch = "x86_64"))]
             Kernel::Avx2 | Kernel::Avx512 => false,
+            Kernel::Neon => cfg!(target_arch = "aarch64"),
         }
     }
 

@@ -7,10 +7,11 @@
 //! - `f64`: one lane.
 //! - `Avx2` (x86-64 with AVX2 and FMA): 4 lanes in one 256-bit register.
 //! - `Avx512` (x86-64 with AVX-512F): 8 lanes in one 512-bit register.
+//! - `Neon` (every 64-bit ARM CPU): 2 lanes in one 128-bit register.
 //!   LLVM does not find this layout on its own: it vectorises the sigmoid loop across neurons,
 //!   with gathers and scatters, instead of across networks.
 //! - [`Group<V, G>`]: `G` of those, operation by operation. A population block of 16 networks
-//!   is `Group<Avx512, 2>` or `Group<Avx2, 4>`; [`Portable<L>`] is `Group<f64, L>`, used for
+//!   is `Group<Avx512, 2>`, `Group<Avx2, 4>` or `Group<Neon, 8>`; [`Portable<L>`] is `Group<f64, L>`, used for
 //!   single networks (`L = 1`) and wherever no register backend applies.
 //!
 //! Which backend runs is chosen when the program runs ([`crate::simd`]); the register backends'
@@ -22,6 +23,10 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 pub(crate) mod avx2;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx512;
+#[cfg(target_arch = "aarch64")]
+pub(crate) mod neon;
+#[cfg(target_arch = "aarch64")]
+pub(crate) use neon::Neon;
 #[cfg(target_arch = "x86_64")]
 pub(crate) use {avx2::Avx2, avx512::Avx512};
 
@@ -349,5 +354,11 @@ mod tests {
         } else {
             eprintln!("this CPU has no AVX-512F: the avx512 backend was not checked");
         }
+    }
+
+    #[test]
+    #[cfg(target_arch = "aarch64")]
+    fn neon_backend_matches_f64_bit_for_bit() {
+        backend_matches_f64::<Neon, 2>();
     }
 }

@@ -26,9 +26,9 @@ pub fn build_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     Ok(info)
 }
 
-/// Makes every later integration use the kernel `name` ("avx512", "avx2" or "portable"). The
-/// results do not change, only the speed. Raises `InvalidArgumentError` for an unknown name or a
-/// kernel this CPU cannot run.
+/// Makes every later integration use the kernel `name` ("avx512", "avx2", "neon" or
+/// "portable"). The results do not change, only the speed. Raises `InvalidArgumentError` for an
+/// unknown name or a kernel this CPU cannot run.
 #[pyfunction]
 pub fn use_kernel(name: &str) -> PyResult<()> {
     simd::set_kernel(name.parse::<Kernel>().py_err()?).py_err()

@@ -8,15 +8,19 @@ use crate::math::sigmoid;
 use crate::network::Network;
 use crate::rows::Rows;
 use crate::simd::{self, Kernel};
+#[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+use crate::vector::Group;
+#[cfg(target_arch = "aarch64")]
+use crate::vector::Neon;
 #[cfg(target_arch = "x86_64")]
-use crate::vector::{avx2, avx512, Avx2, Avx512, Group};
+use crate::vector::{avx2, avx512, Avx2, Avx512};
 use crate::vector::{Portable, Vector};
 
 use super::kernel::{rates, weight_order, Work};
 use super::Integrator;
 
-/// How many networks a population block steps together: two AVX-512 registers of f64 or four
-/// AVX2 ones, so that every row of the kernel has independent dependency chains in flight.
+/// How many networks a population block steps together: two AVX-512 registers of f64, four
+/// AVX2 ones or eight NEON ones, so that every row of the kernel has independent dependency chains in flight.
 pub const LANES: usize = 16;
 
 /// Integration steps (rows times substeps) between two looks at the cancel flag, so that Ctrl-C
@@ -60,6 +64,21 @@ macro_rules! with_backend {
                     }
                 })
             },
+            // NEON is part of every AArch64 CPU: no features to enable.
+            #[cfg(target_arch = "aarch64")]
+            Kernel::Neon => {
+                if L == 2 {
+                    $self.$method::<Neon>($($arg),*)
+                } else if L == 4 {
+                    $self.$method::<Group<Neon, 2>>($($arg),*)
+                } else if L == 8 {
+                    $self.$method::<Group<Neon, 4>>($($arg),*)
+                } else if L == 16 {
+                    $self.$method::<Group<Neon, 8>>($($arg),*)
+                } else {
+                    $self.$method::<Portable<L>>($($arg),*)
+                }
+            }
             _ => $self.$method::<Portable<L>>($($arg),*),
         }
     }};

@@ -288,6 +288,7 @@ mod tests {
     fn every_kernel_matches_the_portable_kernel_bit_for_bit() {
         for kernel in simd::supported() {
             kernels_agree::<1>(kernel);
+            kernels_agree::<2>(kernel);
             kernels_agree::<3>(kernel);
             kernels_agree::<4>(kernel);
             kernels_agree::<8>(kernel);

@@ -86,3 +86,16 @@ def median_time(fn, repeats: int):
         t, result = timed(lambda: fn(i))
         times.append(t)
     return statistics.median(times), result
+
+
+def interleaved_medians(fns: dict, repeats: int) -> dict:
+    """Median seconds of `repeats` timed calls of each `fns[name]()`, the contenders taking turns
+    call by call (after a warm-up of each), so that a burst of load from other jobs hits every
+    contender alike."""
+    for fn in fns.values():
+        median_time(lambda _: fn(), 1)
+    times = {name: [] for name in fns}
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            times[name].append(timed(fn)[0])
+    return {name: statistics.median(t) for name, t in times.items()}

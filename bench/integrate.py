@@ -1,23 +1,29 @@
-"""Benchmark: dnnevo's population integrator against a batched NumPy einsum implementation.
+"""Benchmark: dnnevo's population integrator against the hand-written C anchor and NumPy.
 
 Workload (per network size N in {5, 10, 30}):
   P = 1000 random networks (dnnevo.Network.random(N, 2, seed=k)), T = 1000 forward-Euler steps
   (substeps=1, dt=0.1), M = 2 inputs shared by every network: input 0 is a square pulse train
   (10 steps on, 10 off), input 1 a slower one (50 on, 50 off).
 
-dnnevo is timed with run_population(..., record=False) on all cores; NumPy with the same
-equations, batched over the population with einsum, on one core (NumPy's einsum does not thread).
-Each figure is the median of timed runs (--repeats for dnnevo, at most 3 for NumPy) after a
-quarter-second warm-up, in network-steps per second (P x steps / seconds). A dnnevo run lasts
-milliseconds, so many repeats keep a burst of load from other jobs out of the median. NumPy may
-be timed over fewer steps (--numpy-steps) to save time: the figure is a per-step throughput. The final states of both codes
-after the full T steps are compared network by network (rtol = atol = 1e-9). A few random networks
-are chaotic and amplify rounding differences over 1000 steps; a mismatch is reported as such
-(not as a disagreement) when NumPy with a different summation order misses by as much.
+Contenders, each in network-steps per second (P x steps / seconds):
+  - dnnevo: run_population(..., record=False) on all cores, with the kernel it picks (printed);
+  - the C anchor (bench/_anchor.py; found in ../shared/anchors, or --anchor DIR): SIMD across
+    networks, libmvec's vector exp, -ffast-math, OpenMP on 2 threads, on the same networks.
+    Its inputs are its own (a pulse and a state-dependent second input, computed each step),
+    slightly more work than dnnevo's. dnnevo and C take turns call by call, and the medians of
+    --repeats calls are compared: the goal is dnnevo >= 1.25x C (issue #14);
+  - NumPy with the same equations, batched over the population with einsum, on one core
+    (NumPy's einsum does not thread), median of at most 3 runs. NumPy may be timed over fewer
+    steps (--numpy-steps): the figure is a per-step throughput.
+Each contender is warmed up for a quarter second first. The final states of dnnevo and NumPy
+after the full T steps are compared network by network (rtol = atol = 1e-9). A few random
+networks are chaotic and amplify rounding differences over 1000 steps; a mismatch is reported as
+such (not as a disagreement) when NumPy with a different summation order misses by as much. The
+C anchor's results are not compared (fast-math, other inputs).
 
-    python bench/integrate.py [--repeats 21] [--quick] [--numpy-steps 200]
+    python bench/integrate.py [--repeats 21] [--quick] [--numpy-steps 200] [--anchor DIR]
 
-Exits with 1 if the two codes disagree; a ratio below its target is reported, not an error.
+Exits with 1 if dnnevo and NumPy disagree; a ratio below its target is reported, not an error.
 """
 
 from __future__ import annotations
@@ -28,11 +34,13 @@ import time
 
 import numpy as np
 
+import _anchor
 import dnnevo
-from _common import describe_machine, median_time
+from _common import describe_machine, interleaved_medians, median_time
 
 SIZES = (5, 10, 30)
 TARGETS = {5: 20.0, 10: 16.0, 30: 10.0}  # minimum dnnevo / numpy speed-up
+ANCHOR_TARGET = 1.25  # minimum dnnevo / C anchor speed-up, every N
 DT = 0.1
 N_INPUTS = 2
 
@@ -109,17 +117,10 @@ def compare(ours, theirs, params, inputs, tol=1e-9):
     return len(ours) - bad.size, bad[explained], bad[~explained]
 
 
-def bench_size(n: int, args) -> dict:
+def bench_size(n: int, args, anchor) -> dict:
     nets = [dnnevo.Network.random(n, N_INPUTS, seed=k) for k in range(args.population)]
     inputs = pulse_inputs(args.steps)
     p = len(nets)
-
-    def run_dnnevo(_):
-        return dnnevo.run_population(nets, inputs, dt=DT, substeps=1, method="euler",
-                                     record=False)
-
-    t_dnnevo, ours = median_time(run_dnnevo, args.repeats)
-
     params = (
         np.stack([net.tau for net in nets]),
         np.stack([net.theta for net in nets]),
@@ -127,6 +128,17 @@ def bench_size(n: int, args) -> dict:
         np.stack([net.sensor_weights for net in nets]),
         np.stack([net.state for net in nets]),
     )
+
+    def run_dnnevo():
+        return dnnevo.run_population(nets, inputs, dt=DT, substeps=1, method="euler",
+                                     record=False)
+
+    contenders = {"dnnevo": run_dnnevo}
+    if anchor is not None:
+        c_params = _anchor.params(*params)
+        contenders["c"] = lambda: anchor.run_simd_omp(c_params, args.steps)
+    times = interleaved_medians(contenders, args.repeats)
+    ours = run_dnnevo()
     np_steps = min(args.numpy_steps, args.steps)
     np_inputs = inputs[:np_steps]
     t_numpy, theirs = median_time(lambda _: numpy_final_states(params, np_inputs),
@@ -140,7 +152,8 @@ def bench_size(n: int, args) -> dict:
     return dict(
         n=n,
         p=p,
-        dnnevo=p * args.steps / t_dnnevo,
+        dnnevo=p * args.steps / times["dnnevo"],
+        c=p * args.steps / times["c"] if "c" in times else None,
         numpy=p * np_steps / t_numpy,
         n_close=n_close,
         sensitive=sensitive,
@@ -157,6 +170,9 @@ def main(argv=None) -> int:
                     help="a smoke run: fewer networks, steps and repeats (figures are rougher)")
     ap.add_argument("--numpy-steps", type=int, default=None,
                     help="steps of the timed NumPy runs (default: all T; fewer save time)")
+    ap.add_argument("--anchor", default=None, metavar="DIR",
+                    help=f"the C anchor's folder (default: ${_anchor.ENV}, else "
+                         "../shared/anchors next to the repository)")
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error("--repeats must be >= 1")
@@ -171,25 +187,34 @@ def main(argv=None) -> int:
         ap.error("--numpy-steps must be >= 1")
 
     describe_machine()
+    folder = _anchor.locate(args.anchor)
+    anchor = _anchor.load(folder) if folder else None
+    print(f"C anchor: {folder} (block {anchor.BLOCK})" if anchor else
+          f"C anchor: not found (--anchor DIR or ${_anchor.ENV}); NumPy only")
     print(f"workload: P = {args.population} networks, T = {args.steps} Euler steps, dt = {DT}, "
           f"M = {N_INPUTS} shared pulse-train inputs; median of {args.repeats} (dnnevo) / "
           f"{args.numpy_repeats} (numpy, {min(args.numpy_steps, args.steps)} steps) runs"
           f"{' [quick]' if args.quick else ''}")
     print()
-    header = (f"{'N':>3}  {'dnnevo net-steps/s':>18}  {'numpy net-steps/s':>17}  "
-              f"{'ratio':>7}  {'target':>7}  {'met':>3}")
+    header = (f"{'N':>3}  {'dnnevo':>9}  {'C anchor':>9}  {'vs C':>6}  {'met':>3}  "
+              f"{'NumPy':>9}  {'vs NumPy':>8}  {'met':>3}   (network-steps/s; targets: "
+              f"{ANCHOR_TARGET:g}x C, {'/'.join(f'{t:g}x' for t in TARGETS.values())} NumPy)")
     print(header)
     print("-" * len(header))
     start = time.perf_counter()
     results = []
     for n in SIZES:
-        r = bench_size(n, args)
+        r = bench_size(n, args, anchor)
         results.append(r)
-        ratio = r["dnnevo"] / r["numpy"]
-        target = TARGETS[n]
-        print(f"{n:>3}  {r['dnnevo']:>18.4g}  {r['numpy']:>17.4g}  {ratio:>6.1f}x  "
-              f"{'>=' + format(target, 'g') + 'x':>7}  {'yes' if ratio >= target else 'NO':>3}",
-              flush=True)
+        vs_numpy = r["dnnevo"] / r["numpy"]
+        if r["c"] is None:
+            c_cols = f"{'-':>9}  {'-':>6}  {'-':>3}"
+        else:
+            vs_c = r["dnnevo"] / r["c"]
+            c_cols = (f"{r['c']:>9.3g}  {vs_c:>5.2f}x  "
+                      f"{'yes' if vs_c >= ANCHOR_TARGET else 'NO':>3}")
+        print(f"{n:>3}  {r['dnnevo']:>9.3g}  {c_cols}  {r['numpy']:>9.3g}  {vs_numpy:>7.1f}x  "
+              f"{'yes' if vs_numpy >= TARGETS[n] else 'NO':>3}", flush=True)
     print()
     ok = True
     for r in results:

@@ -148,33 +148,30 @@ impl Population {
     ) -> Result<Vec<f64>> {
         let n = self.size;
         let fill = &fill;
-        if record {
-            let mut out = vec![0.0; self.len * steps * n];
-            self.blocks
-                .par_iter_mut()
-                .zip(out.par_chunks_mut(LANES * steps * n))
-                .enumerate()
-                .try_for_each(|(b, (block, chunk))| {
-                    let row = |t, row: &mut [[f64; LANES]]| fill(b, t, row);
-                    let real = block.len();
-                    block.run_rows(steps, integ, cancel, row, |t, state| {
+        // One call of `run_rows` for both cases, so that the kernel under it is compiled once.
+        let mut out = vec![0.0; if record { self.len * steps * n } else { 0 }];
+        let mut chunks: Vec<Option<&mut [f64]>> = if record {
+            out.chunks_mut(LANES * steps * n).map(Some).collect()
+        } else {
+            self.blocks.iter().map(|_| None).collect()
+        };
+        self.blocks
+            .par_iter_mut()
+            .zip(chunks.par_iter_mut())
+            .enumerate()
+            .try_for_each(|(b, (block, chunk))| {
+                let row = |t, row: &mut [[f64; LANES]]| fill(b, t, row);
+                let real = block.len();
+                block.run_rows(steps, integ, cancel, row, |t, state| {
+                    if let Some(chunk) = chunk.as_deref_mut() {
                         for l in 0..real {
                             let at = (l * steps + t) * n;
                             copy_lane(state, l, &mut chunk[at..at + n]);
                         }
-                    })
-                })?;
-            Ok(out)
-        } else {
-            self.blocks
-                .par_iter_mut()
-                .enumerate()
-                .try_for_each(|(b, block)| {
-                    let row = |t, row: &mut [[f64; LANES]]| fill(b, t, row);
-                    block.run_rows(steps, integ, cancel, row, |_, _| {})
-                })?;
-            Ok(self.states())
-        }
+                    }
+                })
+            })?;
+        Ok(if record { out } else { self.states() })
     }
 }
 

@@ -27,24 +27,27 @@ pub(super) struct Work<'a, V: Vector> {
 }
 
 impl<V: Vector> Work<'_, V> {
-    /// Holds `inputs` for `integ.substeps` steps of the state `v`. With `fresh`, `out` already
-    /// holds the firing rates of `v` and the first step starts from them.
+    /// Holds `inputs` for `integ.substeps` steps of the state `v`; without inputs, holds the
+    /// sensor drive already in `ext`. With `fresh`, `out` already holds the firing rates of `v`
+    /// and the first step starts from them.
     #[inline(always)]
     pub(super) fn step(
         &mut self,
         v: &mut [V::Row],
-        inputs: &[V::Row],
+        inputs: Option<&[V::Row]>,
         integ: &Integrator,
         fresh: bool,
     ) {
-        sensor_drive::<V>(self.sensor_weights, inputs, self.ext);
+        if let Some(inputs) = inputs {
+            sensor_drive::<V>(self.sensor_weights, inputs, self.ext);
+        }
         self.integrate(v, integ, fresh);
     }
 
     /// `integ.substeps` steps of the state `v` with the sensor drive in `ext`; `fresh` as for
     /// [`step`](Self::step).
     #[inline(always)]
-    pub(super) fn integrate(&mut self, v: &mut [V::Row], integ: &Integrator, fresh: bool) {
+    fn integrate(&mut self, v: &mut [V::Row], integ: &Integrator, fresh: bool) {
         for s in 0..integ.substeps {
             let fresh = fresh && s == 0;
             match integ.method {

@@ -1,6 +1,7 @@
 //! [`Lanes`]: `L` networks of the same shape packed parameter by parameter, side by side, and
 //! stepped together by the kernel.
 
+use std::any::Any;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::error::{Error, Result};
@@ -22,14 +23,20 @@ use super::Integrator;
 /// How many networks a population block steps together: two AVX-512 registers of f64, four
 /// AVX2 ones or eight NEON ones, so that every row of the kernel has independent dependency chains in flight.
 pub const LANES: usize = 16;
+const _: () = assert!(
+    LANES == 16,
+    "with_backend's register groups assume 16 lanes"
+);
 
 /// Integration steps (rows times substeps) between two looks at the cancel flag, so that Ctrl-C
 /// is seen within milliseconds however many substeps a row has.
 const CANCEL_CHECK_STEPS: usize = 1024;
 
 /// Calls `self.method::<V>(args)` with `V` the lane vector type of `kernel` for `L` lanes:
-/// registers of the kernel where `L` fills them, plain lanes otherwise. Either way the code is
-/// compiled for the kernel's CPU features (so plain lanes get hardware fused multiply-adds too).
+/// registers of the kernel for a block of [`LANES`], plain lanes for any other width (a single
+/// network, the tests' odd widths). Either way the code is compiled for the kernel's CPU features
+/// (so plain lanes get hardware fused multiply-adds too). The widths are `const` conditions, so
+/// the arms a width does not take are never compiled.
 macro_rules! with_backend {
     ($kernel:expr, $self:ident . $method:ident ( $($arg:expr),* )) => {{
         match $kernel {
@@ -40,9 +47,7 @@ macro_rules! with_backend {
             #[allow(unsafe_code)]
             Kernel::Avx512 => unsafe {
                 avx512::enabled(#[inline(always)] || {
-                    if L == 8 {
-                        $self.$method::<Avx512>($($arg),*)
-                    } else if L == 16 {
+                    if const { L == LANES } {
                         $self.$method::<Group<Avx512, 2>>($($arg),*)
                     } else {
                         $self.$method::<Portable<L>>($($arg),*)
@@ -53,11 +58,7 @@ macro_rules! with_backend {
             #[allow(unsafe_code)]
             Kernel::Avx2 => unsafe {
                 avx2::enabled(#[inline(always)] || {
-                    if L == 4 {
-                        $self.$method::<Avx2>($($arg),*)
-                    } else if L == 8 {
-                        $self.$method::<Group<Avx2, 2>>($($arg),*)
-                    } else if L == 16 {
+                    if const { L == LANES } {
                         $self.$method::<Group<Avx2, 4>>($($arg),*)
                     } else {
                         $self.$method::<Portable<L>>($($arg),*)
@@ -67,13 +68,7 @@ macro_rules! with_backend {
             // NEON is part of every AArch64 CPU: no features to enable.
             #[cfg(target_arch = "aarch64")]
             Kernel::Neon => {
-                if L == 2 {
-                    $self.$method::<Neon>($($arg),*)
-                } else if L == 4 {
-                    $self.$method::<Group<Neon, 2>>($($arg),*)
-                } else if L == 8 {
-                    $self.$method::<Group<Neon, 4>>($($arg),*)
-                } else if L == 16 {
+                if const { L == LANES } {
                     $self.$method::<Group<Neon, 8>>($($arg),*)
                 } else {
                     $self.$method::<Portable<L>>($($arg),*)
@@ -231,7 +226,18 @@ impl<const L: usize> Lanes<L> {
     }
 
     fn compute_outputs(&mut self) {
-        with_backend!(simd::kernel(), self.compute_outputs_with())
+        if const { L == LANES } {
+            as_width::<L, LANES>(self).compute_outputs_once();
+        } else if const { L == 1 } {
+            as_width::<L, 1>(self).compute_outputs_once();
+        } else {
+            self.compute_outputs_on(simd::kernel());
+        }
+    }
+
+    #[inline(always)]
+    fn compute_outputs_on(&mut self, kernel: Kernel) {
+        with_backend!(kernel, self.compute_outputs_with())
     }
 
     #[inline(always)]
@@ -287,24 +293,43 @@ impl<const L: usize> Lanes<L> {
     #[inline(always)]
     pub fn step_row(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
         debug_assert_eq!(inputs.len(), self.n_inputs);
-        self.step_row_on(simd::kernel(), inputs, integ);
+        self.advance(Some(inputs), integ);
     }
 
     /// [`step_row`](Self::step_row) on a given kernel, which the CPU must support.
-    #[inline(always)]
+    #[cfg(test)]
     pub(super) fn step_row_on(&mut self, kernel: Kernel, inputs: &[[f64; L]], integ: &Integrator) {
+        self.advance_on(kernel, Some(inputs), integ);
+    }
+
+    /// One row of `integ.substeps` steps: with `inputs`, from their sensor drive; without, from
+    /// the sensor drive held since the last row.
+    #[inline(always)]
+    fn advance(&mut self, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
+        if const { L == LANES } {
+            as_width::<L, LANES>(self).advance_once(inputs.map(as_rows), integ);
+        } else if const { L == 1 } {
+            as_width::<L, 1>(self).advance_once(inputs.map(as_rows), integ);
+        } else {
+            self.advance_on(simd::kernel(), inputs, integ);
+        }
+    }
+
+    /// [`advance`](Self::advance) on a given kernel, which the CPU must support.
+    #[inline(always)]
+    fn advance_on(&mut self, kernel: Kernel, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
         self.prepare(integ.dt);
-        with_backend!(kernel, self.step_row_with(inputs, integ))
+        with_backend!(kernel, self.advance_with(inputs, integ))
     }
 
     #[inline(always)]
-    pub(super) fn step_row_with<V: Vector>(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
+    fn advance_with<V: Vector>(&mut self, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
         let fresh = std::mem::take(&mut self.scratch.fresh);
-        self.scratch.held = true;
+        self.scratch.held |= inputs.is_some();
         let (mut work, state) = self.work::<V>();
         work.step(
             V::rows_mut(state.as_flattened_mut()),
-            V::rows(inputs.as_flattened()),
+            inputs.map(|x| V::rows(x.as_flattened())),
             integ,
             fresh,
         );
@@ -336,15 +361,7 @@ impl<const L: usize> Lanes<L> {
             self.scratch.held,
             "step_held needs a step_row before it, with no run_rows in between"
         );
-        self.prepare(integ.dt);
-        with_backend!(simd::kernel(), self.step_held_with(integ))
-    }
-
-    #[inline(always)]
-    fn step_held_with<V: Vector>(&mut self, integ: &Integrator) {
-        let fresh = std::mem::take(&mut self.scratch.fresh);
-        let (mut work, state) = self.work::<V>();
-        work.integrate(V::rows_mut(state.as_flattened_mut()), integ, fresh);
+        self.advance(None, integ);
     }
 
     /// Runs `steps` input rows. `row(t, inputs)` fills the sensors of row `t`; after each row
@@ -393,7 +410,7 @@ impl<const L: usize> Lanes<L> {
             rows_to_check -= 1;
             row(t, inputs);
             let v = V::rows_mut(state.as_flattened_mut());
-            work.step(v, V::rows(inputs.as_flattened()), integ, fresh);
+            work.step(v, Some(V::rows(inputs.as_flattened())), integ, fresh);
             fresh = false;
             record(t, state);
         }
@@ -444,6 +461,41 @@ impl<const L: usize> Lanes<L> {
         }
         Ok(())
     }
+}
+
+/// Compiles the stepping methods of `Lanes<W>` once, in this crate, for each width `W` given.
+///
+/// A generic method is compiled again in every crate that calls it, and the kernel under it is
+/// large: compiled in `tasks` as well, it cost about a third of a clean `cargo test` build. The
+/// generic methods send the widths used outside this crate, one network (1) and a block
+/// ([`LANES`]), to these non-generic copies, which every crate shares. Each does exactly what the
+/// generic path does, so the bits are the same.
+macro_rules! compile_once {
+    ($($width:expr),*) => {$(
+        impl Lanes<{ $width }> {
+            fn advance_once(&mut self, inputs: Option<&[[f64; $width]]>, integ: &Integrator) {
+                self.advance_on(simd::kernel(), inputs, integ);
+            }
+            fn compute_outputs_once(&mut self) {
+                self.compute_outputs_on(simd::kernel());
+            }
+        }
+    )*};
+}
+compile_once!(1, LANES);
+
+/// `lanes` at its own width `W`; only called where `L == W`.
+fn as_width<const L: usize, const W: usize>(lanes: &mut Lanes<L>) -> &mut Lanes<W> {
+    (lanes as &mut dyn Any)
+        .downcast_mut()
+        .expect("as_width is only called with L == W")
+}
+
+/// `rows` at their own width `W`; only called where `L == W`.
+fn as_rows<const L: usize, const W: usize>(rows: &[[f64; L]]) -> &[[f64; W]] {
+    let (rows, rest) = rows.as_flattened().as_chunks::<W>();
+    debug_assert!(rest.is_empty());
+    rows
 }
 
 /// Copies lane `l` of `rows` (one value per row) into `into`.

@@ -287,11 +287,9 @@ mod tests {
     #[test]
     fn every_kernel_matches_the_portable_kernel_bit_for_bit() {
         for kernel in simd::supported() {
+            // A single network, an odd width (plain lanes both) and a block (registers).
             kernels_agree::<1>(kernel);
-            kernels_agree::<2>(kernel);
             kernels_agree::<3>(kernel);
-            kernels_agree::<4>(kernel);
-            kernels_agree::<8>(kernel);
             kernels_agree::<LANES>(kernel);
         }
         for kernel in Kernel::ALL.into_iter().filter(|k| !k.is_supported()) {
@@ -344,12 +342,13 @@ mod tests {
             }
             let mut rows = read.clone();
             let _ = rows.outputs();
-            let record = |_: usize, _: &[[f64; LANES]]| {};
-            rows.run_rows(5, &integ, None, |_, r| r[0][0] = 1.0, record)
-                .unwrap();
-            plain
-                .run_rows(5, &integ, None, |_, r| r[0][0] = 1.0, record)
-                .unwrap();
+            // One pair of closures for both calls, so the kernel is compiled once for them.
+            let (row, record) = (
+                |_: usize, r: &mut [[f64; LANES]]| r[0][0] = 1.0,
+                |_: usize, _: &[[f64; LANES]]| {},
+            );
+            rows.run_rows(5, &integ, None, row, record).unwrap();
+            plain.run_rows(5, &integ, None, row, record).unwrap();
             assert!(same(&plain, &rows), "{method:?}, run_rows");
         }
     }

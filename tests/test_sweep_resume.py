@@ -1,5 +1,5 @@
 """``dnnevo sweep`` run again on its folder continues the sweep, with the same results as a sweep
-that was never stopped, and refuses other settings."""
+that was never stopped, and refuses other settings; on a local Dask cluster too."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
 import dnnevo
@@ -58,3 +59,19 @@ def test_other_settings_are_refused_in_one_line(tmp_path: Path) -> None:
     # --force starts afresh whatever the folder held.
     assert run_cli("sweep", *ARGS, "--set", "elitism=2", "--seeds", "0", "--out", out, "--force").returncode == 0
     assert json.loads((out / "sweep.json").read_text())["config"]["elitism"] == 2
+
+
+def test_a_sweep_on_a_local_dask_cluster_gives_the_same_results(tmp_path: Path) -> None:
+    pytest.importorskip("distributed")
+    here, there = tmp_path / "here", tmp_path / "there"
+    sweep(here, "0-3")
+    # Seeds 0-1 stopped in process, then continued on two workers with two more seeds.
+    sweep(there, "0-1")
+    r = run_cli("sweep", *ARGS, "--seeds", "0-3", "--out", there, "--workers", "2")
+    assert r.returncode == 0, r.stderr
+    assert "a local Dask cluster of 2 workers" in r.stdout
+    assert "seed 0: finished; judging its champion again" in r.stdout
+    assert results(there) == results(here)
+    for seed in range(4):
+        best = f"seed-{seed}/best.json"
+        assert (there / best).read_bytes() == (here / best).read_bytes()

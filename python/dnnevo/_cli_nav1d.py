@@ -152,15 +152,21 @@ def system(args: argparse.Namespace) -> int:
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
         write_atomic(args.out / "report.json", json.dumps(report, indent=1))
-        records = []
-        for c in nav1d.cases(parts[0].config):
-            first, rest, _ = nav1d.system_record(parts[0], parts[1], parts[2], [c] * args.trials,
-                                                 persist_state=persist)
-            records.append(_join(first, rest))
-        _fig2(records, parts[0].config.task_json(), "integrated system, one environment per case "
-              f"({args.trials} trials, goal on the same side)", args.out / "fig2-system.png")
+        draw_system(parts, args.trials, args.out / "fig2-system.png", persist_state=persist)
         print(f"wrote {args.out / 'report.json'}, {args.out / 'fig2-system.png'}")
     return 0
+
+
+def draw_system(parts: Sequence[nav1d.Part], trials: int, path: Path, *, persist_state: bool = True) -> None:
+    """Fig. 2 of the integrated system of ``parts`` (classifier, far, near): one environment per
+    case, ``trials`` trials each, the goal on the same side, written to ``path``."""
+    records = []
+    for c in nav1d.cases(parts[0].config):
+        first, rest, _ = nav1d.system_record(parts[0], parts[1], parts[2], [c] * trials,
+                                             persist_state=persist_state)
+        records.append(_join(first, rest))
+    _fig2(records, parts[0].config.task_json(), "integrated system, one environment per case "
+          f"({trials} trials, goal on the same side)", path)
 
 
 def _join(first: nav1d.Record, rest: nav1d.Record) -> nav1d.Record:

@@ -9,14 +9,14 @@ import json
 import re
 import shutil
 from pathlib import Path
-from typing import Any
 
-from dnnevo import presets, seeding, sweep
+from dnnevo import presets, scheduler, seeding, sweep
 from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError
-from dnnevo.rundir import LOCK_NAME, RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.errors import ConfigError, DnnevoError
+from dnnevo.rundir import LOCK_NAME, RunDir, check_settings, write_atomic
+from dnnevo.runsview import RunsView
 
 SETTINGS_FILE = "sweep.json"
 """The settings a sweep folder was begun with, so that running the command again continues it."""
@@ -24,6 +24,7 @@ SETTINGS_FILE = "sweep.json"
 EXAMPLE = """examples:
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
   dnnevo sweep landmark --seeds 0-9 --out runs/sweep-lm --eval-trials 100
+  dnnevo sweep sequence-1bit --seeds 0-7 --workers 2 --out runs/sweep-dask
   dnnevo sweep sequence-2bit --seeds 0-4 --out runs/inc --seed-from runs/sequence-1bit-seed0 \
       --seed-from runs/sequence-2bit-alternating-seed0 --seed-populations --cross-scale 1
 
@@ -40,7 +41,12 @@ A sweep records its settings in OUT/sweep.json first. Running the same command a
 it: finished seeds are judged again without evolving, stopped ones resume from their checkpoints,
 and seeds not yet begun are run; more seeds may be added. Other settings are refused, naming the
 first that differs. --force starts the sweep afresh: the old summary goes, and so do the old
-sweep's seed-N run folders (files dnnevo did not write are kept)."""
+sweep's seed-N run folders (files dnnevo did not write are kept).
+
+With --workers N the seeds run in parallel on a local Dask cluster of N processes, one run each
+at a time with --threads threads (default 1); --scheduler tcp://HOST:8786 uses a running cluster
+whose workers see OUT and the --seed-from runs at the same paths (pip install "dnnevo[cluster]").
+The results are the same bits as in this process."""
 
 
 def sweep_command(args: argparse.Namespace) -> int:
@@ -59,28 +65,13 @@ def sweep_command(args: argparse.Namespace) -> int:
     with RunDir(args.out).writing(create=True) as folder:
         resuming = not args.force and (manifest.exists() or manifest.is_symlink())
         if resuming:
-            _check_settings(manifest, settings)
+            check_settings(manifest, settings, what="sweep")
         else:
             folder.create(force=args.force, extra=(*sweep.SUMMARY_FILES, SETTINGS_FILE))
             if args.force:
                 _clear_other_seeds(args.out, args.seeds)
             write_atomic(manifest, json.dumps(settings, indent=1) + "\n")
         return _sweep(args, config, how, trials, resuming)
-
-
-def _check_settings(manifest: Path, settings: dict[str, Any]) -> None:
-    """The folder's sweep.json must hold this command's settings (any seeds)."""
-    try:
-        found = json.loads(manifest.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise RunFileError(f"{manifest}: unreadable ({e}); pass --force to start the sweep afresh") from None
-    if not isinstance(found, dict):
-        raise RunFileError(f"{manifest}: expected a JSON object of settings; pass --force to start afresh")
-    diff = first_difference(found, json.loads(json.dumps(settings)))
-    if diff is not None:
-        raise ConfigError(
-            f"{manifest.parent} holds a sweep with {diff[0]} = {short(diff[1])}, not {short(diff[2])}; "
-            "run the same command to continue it, or choose another --out, or pass --force")
 
 
 def _clear_other_seeds(out: Path, seeds: list[int]) -> None:
@@ -100,7 +91,7 @@ def _clear_other_seeds(out: Path, seeds: list[int]) -> None:
 
 def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seeding | None,
            trials: int, resuming: bool) -> int:
-    runs = []
+    tasks = []
     for seed in args.seeds:
         out = args.out / f"seed-{seed}"
         resume = resuming and (out / "checkpoint.json").exists()
@@ -109,13 +100,18 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
             print(f"seed {seed}: " + ("finished; judging its champion again" if done >= config.generations
                                       else f"resuming at generation {done}"))
         # A seed folder without a checkpoint holds no run yet: it starts afresh.
-        result = sweep.run_seed(config, seed, out, threads=args.threads,
-                                force=args.force or (resuming and not resume),
-                                eval_seed_base=args.eval_seed, eval_trials=trials,
-                                dt_check=args.dt_check, seeding=how, resume=resume)
-        runs.append(result)
-        if result.interrupted:
-            break
+        options = {"threads": args.threads, "force": args.force or (resuming and not resume),
+                   "eval_seed_base": args.eval_seed, "eval_trials": trials, "dt_check": args.dt_check,
+                   "seeding": how, "resume": resume}
+        tasks.append(scheduler.Task(f"seed-{seed}", (), sweep.run_seed, (config, seed, out), options))
+    if args.workers is not None or args.scheduler is not None:
+        runs = _on_dask(args, tasks)
+    else:
+        runs = []
+        for task in tasks:
+            runs.append(task.fn(*task.args, **task.kwargs))
+            if runs[-1].interrupted:
+                break
     summary = sweep.summarize(runs)
     info = {"preset": args.preset, "quick": args.quick, "overrides": list(args.set), "task": config.task,
             "eval_seed": f"{args.eval_seed} + seed", "eval_trials": trials,
@@ -127,6 +123,24 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
               "run the same command again to continue the sweep")
     print(f"wrote {', '.join(map(str, paths))}")
     return 0
+
+
+def _on_dask(args: argparse.Namespace, tasks: list[scheduler.Task]) -> list[sweep.SeedResult]:
+    """The seeds' runs on a Dask cluster, one run per worker at a time, each with ``--threads``
+    threads (default 1); a seed that failed is named and left out of the statistics."""
+    for task in tasks:
+        task.kwargs.update(progress=False, threads=args.threads or 1)
+    view = RunsView(len(tasks))
+    with scheduler.dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+        print(f"on {scheduler.describe(client, args.scheduler)}")
+        outcomes = scheduler.run_on_dask(tasks, view, client)
+    view.close()
+    failed = [o for o in outcomes.values() if o.status != "done"]
+    for o in failed:
+        print(f"{o.task.id} failed: {o.message}")
+    if len(failed) == len(tasks):
+        raise DnnevoError(f"every seed failed; the first: {failed[0].message}")
+    return [o.result for o in outcomes.values() if o.status == "done"]
 
 
 def _generation(x: float) -> str:

@@ -109,6 +109,23 @@ class Rate:
             "trials_to_decide": self.trials_to_decide,
         }
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Rate:
+        """The rate of :meth:`to_dict`, checked; a malformed one raises :class:`ValueError`."""
+        k, n = d["k"], d["n"]
+        if not (_count(k) and _count(n) and 0 <= k <= n and n > 0):
+            raise ValueError(f"rate {d.get('name')!r}: k = {k!r}, n = {n!r} are not counts with 0 <= k <= n")
+        if d["verdict"] not in (None, "pass", "fail", "undecided"):
+            raise ValueError(f"rate {d.get('name')!r}: unknown verdict {d['verdict']!r}")
+        lo, hi = (float(x) for x in d["interval"])
+        return cls(str(d["name"]), k, n, (lo, hi), float(d["effective_n"]),
+                   None if d["threshold"] is None else float(d["threshold"]), d["verdict"],
+                   d["trials_to_decide"])
+
+
+def _count(x: Any) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
 
 def _rate(name: str, k: int, n: int, *, threshold: float | None = None, effective_n: float | None = None,
           per_trial: float = 1.0) -> Rate:
@@ -181,6 +198,23 @@ class Assessment:
             "confidence": CONFIDENCE, "method": self.method,
             "rates": [r.to_dict() for r in self.rates], "verdict": self.verdict, **self.details,
         }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Assessment:
+        """The assessment of :meth:`to_dict` (without the task's own :attr:`report`), checked; a
+        malformed one raises :class:`ValueError`, :class:`KeyError` or :class:`TypeError`."""
+        rates = [Rate.from_dict(r) for r in d["rates"]]
+        verdict = d["verdict"]
+        if not rates or verdict != combine([r.verdict for r in rates if r.verdict is not None] or ["fail"]):
+            raise ValueError(f"verdict {verdict!r} does not follow from the rates")
+        if not _count(d["trials"]) or not _count(d["seed"]):
+            raise ValueError("trials and seed must be integers")
+        details = {k: v for k, v in d.items() if k not in _ASSESSMENT_KEYS}
+        return cls(task=str(d["task"]), trials=d["trials"], unit=str(d["unit"]), seed=d["seed"],
+                   rates=rates, verdict=verdict, method=str(d["method"]), details=details)
+
+
+_ASSESSMENT_KEYS = ("task", "seed", "trials", "unit", "confidence", "method", "rates", "verdict")
 
 
 def assess(

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dnnevo import _cli_analyze, _cli_evaluate, _cli_landmark, _cli_nav1d, _cli_sequence, _cli_sweep, _startup, presets, seeding, sweep
+from dnnevo import _cli_analyze, _cli_evaluate, _cli_nav1d, _cli_reproduce, _cli_sweep, _startup, figures, presets, seeding, sweep
 from dnnevo.assess import DEFAULT_TRIALS
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.rundir import RunDir, save_figure
@@ -38,6 +38,7 @@ EXAMPLES = """examples:
   dnnevo run nav1d-classifier --out runs/cls       the paper's navigation classifier (6 s)
   dnnevo nav1d-system --classifier runs/cls --far runs/far --near runs/near
   dnnevo run landmark --out runs/lm && dnnevo evaluate runs/lm --robot-like
+  dnnevo reproduce --quick --seeds 0-1 --out runs/repro   the whole paper in miniature, with a report
 """
 
 
@@ -143,6 +144,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eval-trials", type=_positive, metavar="N", help="fresh " + trials_help)
     p.add_argument("--no-dt-check", dest="dt_check", action="store_false",
                    help="skip judging each final champion again at a 10x finer step and with RK4")
+    p.add_argument("--workers", type=_positive, metavar="N",
+                   help="run the seeds on a local Dask cluster of N worker processes")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run the seeds on the Dask cluster at ADDRESS")
     seeding.add_arguments(p)
     run_options(p)
 
@@ -174,6 +178,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     _cli_analyze.add_parser(sub)
     _cli_nav1d.add_system_parser(sub)
+    _cli_reproduce.add_parser(sub, _parse_seeds, _positive)
     return parser
 
 
@@ -227,28 +232,8 @@ def _cmd_presets(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    import matplotlib.pyplot as plt
-
-    from dnnevo.plot import plot_fitness
-
-    run = RunDir(args.dir)
-    config, table = run.read_config()
-    history = run.read_log(config)
-    if config.task in ("sequence", "nav1d", "landmark"):
-        run.read_best(config, table)  # checked before any figure is written
-    arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
-    written = []
-    ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
-    save_figure(ax.figure, run.path / "fitness.png")
-    plt.close(ax.figure)
-    written.append("fitness.png")
-    if config.task == "sequence":
-        written += _cli_sequence.plot(run, config, args.seed)
-    if config.task == "nav1d":
-        written += _cli_nav1d.plot(run, config, args.seed)
-    if config.task == "landmark":
-        written += _cli_landmark.plot(run, config, args.seed, animate=args.animate)
-    print(f"wrote {', '.join(str(run.path / w) for w in written)}")
+    written = figures.draw_run(args.dir, seed=args.seed, animate=args.animate)
+    print(f"wrote {', '.join(str(args.dir / w) for w in written)}")
     return 0
 
 
@@ -262,6 +247,7 @@ COMMANDS = {
     "plot": _cmd_plot,
     "analyze": _cli_analyze.analyze,
     "nav1d-system": _cli_nav1d.system,
+    "reproduce": _cli_reproduce.reproduce,
 }
 
 

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from dnnevo.nav1d import Record as Nav1dRecord
     from dnnevo.sequence import TrialRecord
 
-__all__ = ["plot_basins", "plot_bifurcation", "plot_fitness", "plot_landmark_world", "plot_lesions", "plot_nav1d_path",
+__all__ = ["plot_basins", "plot_bifurcation", "plot_fitness", "plot_fitness_seeds", "plot_landmark_world", "plot_lesions", "plot_nav1d_path",
            "plot_nav1d_traces", "plot_phase_portrait", "plot_sequence_trial", "plot_traces"]
 
 
@@ -50,6 +50,26 @@ def plot_fitness(
     ax.set_ylabel("fitness")
     ax.set_xlim(gen.min(initial=0), max(gen.max(initial=1), 1))
     ax.legend(loc="lower right")
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+def plot_fitness_seeds(
+    histories: Mapping[int, Mapping[str, npt.ArrayLike]], ax: Axes | None = None, *, title: str | None = None
+) -> Axes:
+    """The best fitness over generations of several runs, one line per seed (solid), with each
+    run's mean fitness (dotted, same colour)."""
+    ax = _axes(ax)
+    for i, (seed, h) in enumerate(sorted(histories.items())):
+        gen = np.asarray(h["generation"])
+        colour = f"C{i % 10}"
+        ax.plot(gen, np.asarray(h["best"]), color=colour, lw=1.2, label=f"seed {seed}")
+        ax.plot(gen, np.asarray(h["mean"]), color=colour, lw=0.8, ls=":")
+    ax.set_xlabel("generation")
+    ax.set_ylabel("fitness (solid: best, dotted: mean)")
+    if len(histories) <= 10:
+        ax.legend(loc="lower right", fontsize="small")
     if title:
         ax.set_title(title)
     return ax

@@ -6,7 +6,7 @@ import sys
 import time
 from typing import TextIO
 
-__all__ = ["Progress"]
+__all__ = ["Progress", "clock"]
 
 
 class Progress:
@@ -30,7 +30,7 @@ class Progress:
         bar = "#" * filled + "-" * (width - filled)
         line = (
             f"[{bar}] gen {done}/{self.total}  best {best:.4f}  mean {mean:.4f}  "
-            f"{evals_per_s:,.0f} evals/s  ETA {_clock(eta)}"
+            f"{evals_per_s:,.0f} evals/s  ETA {clock(eta)}"
         )
         if self.tty:
             self.stream.write("\r" + line + "\x1b[K")
@@ -45,6 +45,7 @@ class Progress:
             self.stream.flush()
 
 
-def _clock(seconds: float) -> str:
+def clock(seconds: float) -> str:
+    """``seconds`` as H:MM:SS."""
     s = int(round(seconds))
     return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"

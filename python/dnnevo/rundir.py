@@ -182,6 +182,24 @@ def first_difference(a: Any, b: Any, prefix: str = "") -> tuple[str, Any, Any] |
 MAX_CONFIG_DEPTH = 16
 
 
+def check_settings(manifest: Path, settings: dict[str, Any], *, what: str, force: bool = True) -> None:
+    """The settings file ``manifest`` of a folder of several runs (a ``what``, e.g. "sweep") must
+    hold ``settings``; else a one-line :class:`ConfigError` naming the first that differs, or a
+    :class:`RunFileError` when the file is unreadable. ``force``: the command has ``--force``."""
+    again = ", or pass --force" if force else ""
+    try:
+        found = json.loads(manifest.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise RunFileError(f"{manifest}: unreadable ({e}); choose another --out{again}") from None
+    if not isinstance(found, dict):
+        raise RunFileError(f"{manifest}: expected a JSON object of settings; choose another --out{again}")
+    diff = first_difference(found, json.loads(json.dumps(settings)))
+    if diff is not None:
+        raise ConfigError(
+            f"{manifest.parent} holds a {what} with {diff[0]} = {short(diff[1])}, not {short(diff[2])}; "
+            f"run the same command to continue it, or choose another --out{again}")
+
+
 def _depth(value: Any) -> int:
     """How deeply ``value`` nests lists and dicts, without recursion."""
     deepest, stack = 0, [(value, 0)]

@@ -104,6 +104,19 @@ class StepCheck:
             "max_change": self.max_change, "artefact": self.artefact, "artefacts": self.artefacts,
         }
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], base: Assessment) -> StepCheck:
+        """The check of :meth:`to_dict`, whose run's-step assessment was ``base``; a malformed
+        one raises :class:`ValueError`, :class:`KeyError` or :class:`TypeError`."""
+        checks = {str(name): Assessment.from_dict(a) for name, a in d["checks"].items()}
+        for name, a in checks.items():
+            if [r.name for r in a.rates] != [r.name for r in base.rates]:
+                raise ValueError(f"the {name} check judges other rates than the run's step")
+        check = cls(base=base, checks=checks, integrators=dict(d["integrators"]))
+        if check.artefact != d["artefact"]:
+            raise ValueError("'artefact' does not follow from the checks")
+        return check
+
 
 def step_check(
     config: EvolutionConfig, net: _core.Network, trials: int | None = None, *, seed: int,

@@ -100,11 +100,27 @@ class SeedResult:
             "step_check": None if self.step is None else self.step.to_dict(),
         }
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> SeedResult:
+        """The result of :meth:`to_dict`, checked; a malformed one raises :class:`ValueError`,
+        :class:`KeyError` or :class:`TypeError`."""
+        final = Assessment.from_dict(d["final"])
+        step = None if d["step_check"] is None else StepCheck.from_dict(d["step_check"], final)
+        first = d["first_success"]
+        ints = [d["seed"], d["best_generation"], d["last_generation"]] + ([] if first is None else [first])
+        if not all(isinstance(x, int) and not isinstance(x, bool) and x >= 0 for x in ints):
+            raise ValueError("seed and generations must be integers >= 0")
+        if d["succeeded"] != (first is not None):
+            raise ValueError("'succeeded' does not follow from 'first_success'")
+        return cls(seed=d["seed"], best_fitness=float(d["best_fitness"]), best_generation=d["best_generation"],
+                   first_success=first, last_generation=d["last_generation"], wall_s=float(d["wall_s"]),
+                   final=final, interrupted=bool(d["interrupted"]), step=step)
+
 
 def run_seed(
     config: EvolutionConfig, seed: int, out: Path, *, threads: int | None = None, force: bool = False,
     eval_seed_base: int = EVAL_SEED_BASE, eval_trials: int | None = None, dt_check: bool = True,
-    seeding: Seeding | None = None, resume: bool = False,
+    seeding: Seeding | None = None, resume: bool = False, progress: bool = True,
 ) -> SeedResult:
     """Runs ``config`` with ``seed`` into ``out``, then judges the final champion (``out /
     best.json``) on fresh conditions from :func:`eval_seed` with ``eval_trials`` (default: the
@@ -112,7 +128,8 @@ def run_seed(
     steps on the same conditions (:func:`~dnnevo.stepcheck.step_check`). With ``seeding`` the
     first population starts from earlier runs' networks (:mod:`dnnevo.seeding`). With ``resume``
     the run in ``out`` (same config and seed, else a :class:`RunFileError`) is continued from its
-    checkpoint, or only judged if it has finished; its wall time then counts every session."""
+    checkpoint, or only judged if it has finished; its wall time then counts every session.
+    ``progress`` shows the run's progress bar."""
     from dnnevo.evolve import evolve
     from dnnevo.evolve import resume as resume_run
 
@@ -125,13 +142,13 @@ def run_seed(
         if diff is not None:
             raise RunFileError(f"{out}: the run's {diff[0]} is {short(diff[2])}; this sweep's is "
                                f"{short(diff[1])}")
-        result = resume_run(out, threads=threads)
+        result = resume_run(out, threads=threads, progress=progress)
         wall = float(result.history["elapsed_s"][-1]) if len(result.history["elapsed_s"]) else 0.0
     else:
         seeds = seeding.networks(config.size, seed) if seeding else None
         info = seeding.info() if seeding else None
         result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force,
-                        seeds=seeds, run_info=info)
+                        seeds=seeds, run_info=info, progress=progress)
         wall = time.perf_counter() - t0
     champion = RunDir(out).read_best(config, {"seed": seed})
     fresh = eval_seed(seed, eval_seed_base)

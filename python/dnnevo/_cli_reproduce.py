@@ -1,0 +1,152 @@
+"""The ``dnnevo reproduce`` command: every experiment of the paper over seeds (:mod:`dnnevo.plan`),
+run in this process or on Dask (:mod:`dnnevo.scheduler`), resumable, with a report
+(:mod:`dnnevo.report`)."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import json
+import shlex
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from dnnevo import jobs, plan, report, scheduler
+from dnnevo.errors import ConfigError, DnnevoError
+from dnnevo.rundir import LOCK_NAME, RunDir, check_settings, write_atomic
+from dnnevo.runsview import RunsView
+
+SETTINGS_FILE = "reproduce.json"
+"""The settings a reproduction's folder was begun with, so that running the command again
+continues it."""
+
+DESCRIPTION = """\
+Run every experiment of the paper over seeds and write a report: landmark recognition (ideal
+training, then the robot-like test of the champions), one-dimensional navigation (the three
+subnetworks, the goal seekers evolved on chains, both integrated systems, the single network) and
+sequence learning (1-bit, alternating, the incremental 2-bit route from those two runs, direct
+2-bit, 3-bit). Each run has its own run folder OUT/EXPERIMENT/seed-N and its result in
+OUT/EXPERIMENT/seed-N.json; the report is OUT/report.md and OUT/report.html."""
+
+EXAMPLE = """examples:
+  dnnevo reproduce --quick --seeds 0-1 --out runs/repro-quick     about a minute on 2 cores
+  dnnevo reproduce --only sequence --seeds 0-4 --out runs/repro-seq
+  dnnevo reproduce --out reproduce --workers 4 --threads-per-worker 2
+  dnnevo reproduce --out /shared/reproduce --scheduler tcp://HOST:8786
+
+By default the runs go to a Dask LocalCluster of one worker process per core, one run at a time
+each (pip install "dnnevo[cluster]"); without Dask, or with --in-process, they run one after
+another here, each on every core. Running the same command again skips finished runs, resumes
+stopped ones from their checkpoints (a killed worker's run too) and refuses other settings,
+naming the first that differs; more seeds or families may be added. Exit status: 0 when every
+run finished, 2 when some did not (each is named), 130 on Ctrl-C."""
+
+
+def add_parser(sub: Any, parse_seeds: Any, positive: Any) -> None:
+    """Adds the ``reproduce`` command."""
+    p = sub.add_parser("reproduce", help="the whole paper: every experiment over seeds, with a report",
+                       description=DESCRIPTION, epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("0-9"), help="e.g. 0-9 or 1,4,7 (default 0-9)")
+    p.add_argument("--quick", action="store_true", help="each preset's quick variant: small populations, few generations")
+    p.add_argument("--only", type=_families, default=plan.FAMILIES,
+                   metavar="FAMILIES", help=f"comma-separated, from {','.join(plan.FAMILIES)} (default all)")
+    p.add_argument("--out", type=Path, default=Path("reproduce"), help="the reproduction's folder (default reproduce)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a setting for every evolution, after its preset's, e.g. population=200")
+    p.add_argument("--eval-trials", type=positive, metavar="N",
+                   help="fresh trials judging each final champion (default: the task's, as 'dnnevo evaluate')")
+    p.add_argument("--no-dt-check", dest="dt_check", action="store_false",
+                   help="skip judging each final champion again at a 10x finer step and with RK4")
+    p.add_argument("--workers", type=positive, metavar="N", help="worker processes of the local Dask cluster "
+                                                                  "(default: one per core)")
+    p.add_argument("--threads-per-worker", type=positive, default=None, metavar="T",
+                   help="threads of each run (default: 1 on Dask, all cores in process)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://HOST:8786")
+    p.add_argument("--in-process", action="store_true", help="run here, one run after another, without Dask")
+
+
+def _families(text: str) -> tuple[str, ...]:
+    try:
+        return plan.families(text.split(","))
+    except ConfigError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def reproduce(args: argparse.Namespace) -> int:
+    """``dnnevo reproduce``."""
+    settings = jobs.Settings(quick=args.quick, eval_trials=args.eval_trials, dt_check=args.dt_check,
+                             overrides=tuple(args.set))
+    for e in plan.EXPERIMENTS:  # a bad --set is one line now, not a failure of every run
+        if e.kind == plan.EVOLVE:
+            settings.config(e)
+    order = plan.jobs(args.seeds, args.only)
+    dask = not args.in_process and (args.scheduler is not None or args.workers is not None
+                                    or importlib.util.find_spec("distributed") is not None)
+    if args.in_process and (args.scheduler or args.workers):
+        raise ConfigError("--in-process runs here; it takes no --workers or --scheduler")
+    root = args.out.resolve()
+    t0 = time.perf_counter()
+    with RunDir(root).writing(create=True):
+        _begin(root, settings)
+        before = sum(jobs.read_result(root, j, settings) is not None for j in order)
+        print(f"{len(order)} runs in {args.out} ({before} already done)"
+              + ("" if dask else "; in this process" + (" (Dask is not installed: "
+                                                         f"{scheduler.CLUSTER_EXTRA})" if not args.in_process else "")))
+        view = RunsView(len(order), before, bar=dask)
+        threads = (args.threads_per_worker or 1) if dask else args.threads_per_worker
+        progress = not dask and sys.stderr.isatty()
+        tasks = [scheduler.Task(j.id, j.needs, jobs.run_job, (j, str(root), settings, threads), {"progress": progress})
+                 for j in order]
+        try:
+            if dask:
+                with scheduler.dask_client(workers=args.workers, scheduler=args.scheduler) as client:
+                    workers = scheduler.describe(client, args.scheduler)
+                    print(f"on {workers}")
+                    outcomes = scheduler.run_on_dask(tasks, view, client)
+            else:
+                workers = "none (in process)"
+                outcomes = scheduler.run_in_process(tasks, view)
+        except jobs.Stopped as e:
+            view.close()
+            sys.stderr.write(f"dnnevo: stopped: {e}; run the same command again to continue\n")
+            return 130
+        except KeyboardInterrupt:
+            view.close()
+            sys.stderr.write("dnnevo: interrupted; run the same command again to continue from the checkpoints\n")
+            return 130
+        view.close()
+        env = report.environment(workers=workers, threads=threads, wall_s=time.perf_counter() - t0)
+        command = _command(args)
+        blocks = report.build(root, order, outcomes, settings=settings, environment=env, command=command)
+        paths = report.write(root, blocks)
+    print(report.markdown([b for b in blocks if b.kind == "table"][:1]), end="")
+    print(f"wrote {', '.join(str(args.out / p.name) for p in paths)}")
+    missing = [o for o in outcomes.values() if o.status != "done"]
+    for o in missing:
+        sys.stderr.write(f"dnnevo: {o.task.id} {o.status}: {o.message}\n")
+    return 2 if missing else 0
+
+
+def _command(args: argparse.Namespace) -> str:
+    """The command that makes this reproduction, for its report."""
+    words = ["dnnevo", "reproduce", "--seeds", ",".join(map(str, args.seeds)), "--out", str(args.out)]
+    words += ["--quick"] if args.quick else []
+    words += ["--only", ",".join(args.only)] if tuple(args.only) != plan.FAMILIES else []
+    words += ["--eval-trials", str(args.eval_trials)] if args.eval_trials is not None else []
+    words += [] if args.dt_check else ["--no-dt-check"]
+    words += [w for kv in args.set for w in ("--set", kv)]
+    return " ".join(shlex.quote(w) for w in words)
+
+
+def _begin(root: Path, settings: jobs.Settings) -> None:
+    """Records the settings in a new reproduction's folder, or checks them in an old one."""
+    manifest = root / SETTINGS_FILE
+    wanted = settings.to_dict()
+    if manifest.exists() or manifest.is_symlink():
+        check_settings(manifest, wanted, what="reproduction", force=False)
+        return
+    if any(p.name != LOCK_NAME for p in root.iterdir()):
+        raise DnnevoError(f"{root} holds files but no {SETTINGS_FILE}; choose another --out")
+    write_atomic(manifest, json.dumps(wanted, indent=1) + "\n")

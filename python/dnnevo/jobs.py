@@ -1,0 +1,202 @@
+"""Doing one job of ``dnnevo reproduce`` (:mod:`dnnevo.plan`), so that doing it again is safe.
+
+A job's folder ``EXPERIMENT/seed-N`` is an ordinary run folder (for an evolution) and its result
+is ``EXPERIMENT/seed-N.json``, written atomically when the job is done. :func:`run_job`:
+
+- returns the stored result of a finished job, without work;
+- resumes an evolution from its checkpoint when it was stopped (or its worker was killed), so the
+  run's bits are those of an uninterrupted run;
+- starts afresh a folder that holds no checkpoint yet.
+
+Every result file is checked when read: a malformed one is a :class:`~dnnevo.rundir.RunFileError`
+naming it, and one written under other settings is refused.
+
+The function is what a Dask worker runs, so it takes and returns plain data.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from dnnevo import nav1d, plan, presets, stats, sweep
+from dnnevo.assess import DEFAULT_TRIALS, Assessment, assess
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import ConfigError
+from dnnevo.rundir import RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.seeding import Seeding
+
+__all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "Settings", "Stopped", "result_path", "read_result", "run_job"]
+
+ROBOT_SEED_BASE = 3_000_003
+"""The robot-like test of seed s's landmark champion draws its trials from seed
+``ROBOT_SEED_BASE + s``, which no run uses."""
+
+SYSTEM_TRIALS = 5
+"""Trials per environment of the integrated navigation system, as in the paper's Fig. 2."""
+
+
+class Stopped(Exception):
+    """A job's run stopped on Ctrl-C or SIGTERM; its checkpoint lets the next call resume it."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What every job of one reproduction shares; recorded in its folder so that running the
+    command again continues the same reproduction."""
+
+    quick: bool = False
+    """Each preset's quick variant (small population, few generations)."""
+    eval_trials: int | None = None
+    """Fresh trials judging each final champion, in the task's unit (default: the task's
+    :data:`~dnnevo.assess.DEFAULT_TRIALS`); also the robot-like test's trials per landmark."""
+    eval_seed: int = sweep.EVAL_SEED_BASE
+    """Seed s's final champion is judged on fresh conditions from ``eval_seed + s``."""
+    dt_check: bool = True
+    """Judge each final champion again at a 10x finer step and with RK4."""
+    environments: int = 100
+    """Fresh environments for the integrated navigation system."""
+    overrides: tuple[str, ...] = ()
+    """``key=value`` settings applied to every evolution after its own (e.g. ``population=200``
+    for a cheaper reproduction)."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "overrides", tuple(self.overrides))
+        for name in ("eval_trials", "eval_seed", "environments"):
+            value = getattr(self, name)
+            if value is not None and (not isinstance(value, int) or isinstance(value, bool) or value < 0
+                                      or (value == 0 and name != "eval_seed")):
+                raise ConfigError(f"{name} is {value!r}; it must be an integer >= {0 if name == 'eval_seed' else 1}")
+
+    def config(self, experiment: plan.Experiment) -> EvolutionConfig:
+        """The config of an evolution experiment under these settings."""
+        if experiment.preset is None:
+            raise ConfigError(f"{experiment.name} is not an evolution")
+        overrides = list(experiment.overrides)
+        if experiment.generations is not None and not self.quick:
+            overrides.append(f"generations={experiment.generations}")
+        return presets.get(experiment.preset, quick=self.quick, overrides=[*overrides, *self.overrides])
+
+    def trials(self, task: str) -> int:
+        """The fresh trials judging a champion of ``task``."""
+        return self.eval_trials if self.eval_trials is not None else DEFAULT_TRIALS[task]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The settings and every evolution's config, as plain JSON types."""
+        configs = {e.name: self.config(e).to_dict() for e in plan.EXPERIMENTS if e.kind == plan.EVOLVE}
+        return {"settings": asdict(self), "configs": configs}
+
+
+def result_path(root: Path, job: plan.Job) -> Path:
+    """Where ``job``'s result is stored: ``EXPERIMENT/seed-N.json`` under ``root``."""
+    return root / job.experiment / f"seed-{job.seed}.json"
+
+
+def read_result(root: Path, job: plan.Job, settings: Settings) -> dict[str, Any] | None:
+    """``job``'s stored result, checked, or None when the job has not finished."""
+    path = result_path(root, job)
+    if not path.exists() and not path.is_symlink():
+        return None
+    try:
+        found = json.loads(path.read_text(encoding="utf-8"))
+        if not isinstance(found, dict):
+            raise ValueError("not a JSON object")
+        expected = _header(job, settings)
+        diff = first_difference({k: found.get(k) for k in expected}, expected)
+        if diff is not None:
+            raise RunFileError(f"{path}: its {diff[0]} is {short(diff[1])}, this reproduction's is {short(diff[2])}")
+        _check_body(job, found)
+    except RunFileError:
+        raise
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError) as e:
+        raise RunFileError(f"{path}: not a valid job result ({type(e).__name__}: {e}); delete it to "
+                           "redo the job") from None
+    return found
+
+
+def _header(job: plan.Job, settings: Settings) -> dict[str, Any]:
+    e = job.spec
+    header = {"job": job.id, "kind": e.kind, "settings": asdict(settings),
+              "config": settings.config(e).to_dict() if e.kind == plan.EVOLVE else None}
+    return dict(json.loads(json.dumps(header)))
+
+
+def _check_body(job: plan.Job, found: dict[str, Any]) -> None:
+    kind = job.spec.kind
+    if kind == plan.EVOLVE:
+        run = sweep.SeedResult.from_dict(found["run"])
+        if run.seed != job.seed:
+            raise ValueError(f"it holds seed {run.seed}")
+    elif kind == plan.ROBOT_LIKE:
+        Assessment.from_dict(found["assessment"])
+    else:
+        for key in ("goal_rate", "classification_rate"):
+            if not 0.0 <= float(found[key]) <= 1.0:
+                raise ValueError(f"{key} is not a fraction")
+
+
+def run_job(job: plan.Job, root: str | Path, settings: Settings, threads: int | None = None,
+            *needed: Any, progress: bool = False) -> dict[str, Any]:
+    """Does ``job`` under ``root`` (or returns its stored result) and returns its result.
+    ``needed`` are the results of the jobs it needs (unused: passing them makes a scheduler wait
+    for them). ``threads`` is the run's worker threads (default: all cores); ``progress`` shows
+    an evolution's progress bar. Raises :class:`Stopped` when Ctrl-C or SIGTERM stopped the run."""
+    root = Path(root)
+    done = read_result(root, job, settings)
+    if done is not None:
+        return done
+    t0 = time.perf_counter()
+    body = {plan.EVOLVE: _evolve, plan.ROBOT_LIKE: _robot_like, plan.SYSTEM: _system}[job.spec.kind](
+        job, root, settings, threads, progress)
+    result = {**_header(job, settings), **body, "wall_s": round(time.perf_counter() - t0, 2)}
+    path = result_path(root, job)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(path, json.dumps(result, indent=1) + "\n")
+    return result
+
+
+def _folder(root: Path, name: str, seed: int) -> Path:
+    return root / plan.job_id(name, seed)
+
+
+def _evolve(job: plan.Job, root: Path, settings: Settings, threads: int | None, progress: bool) -> dict[str, Any]:
+    e = job.spec
+    config = settings.config(e)
+    out = _folder(root, e.name, job.seed)
+    seeding = Seeding(tuple(_folder(root, n, job.seed) for n in e.needs)) if e.needs else None
+    resume = (out / "checkpoint.json").exists()
+    run = sweep.run_seed(config, job.seed, out, threads=threads, force=not resume and out.exists(),
+                         eval_seed_base=settings.eval_seed, eval_trials=settings.trials(config.task),
+                         dt_check=settings.dt_check, seeding=seeding, resume=resume, progress=progress)
+    if run.interrupted:
+        raise Stopped(f"{job.id} stopped at generation {run.last_generation}; its checkpoint is in {out}")
+    return {"run": run.to_dict()}
+
+
+def _robot_like(job: plan.Job, root: Path, settings: Settings, threads: int | None,
+                progress: bool) -> dict[str, Any]:
+    run = RunDir(_folder(root, job.spec.needs[0], job.seed))
+    config, table = run.read_config()
+    a = assess(config, run.read_best(config, table), settings.trials(config.task),
+               seed=ROBOT_SEED_BASE + job.seed, robot_like=True)
+    return {"assessment": a.to_dict()}
+
+
+def _system(job: plan.Job, root: Path, settings: Settings, threads: int | None, progress: bool) -> dict[str, Any]:
+    classifier, far, near = (nav1d.load_part(_folder(root, n, job.seed)) for n in job.spec.needs)
+    envs = settings.environments
+    report = nav1d.system_assess(classifier, far, near, environments=envs, trials=SYSTEM_TRIALS,
+                                 seed=sweep.eval_seed(job.seed, settings.eval_seed), persist_state=True)
+    rates = nav1d.goal_rates(report["episodes"])
+    # The trials of one environment share the system's state: intervals count environments.
+    return {
+        "environments": envs, "trials": SYSTEM_TRIALS, "seed": sweep.eval_seed(job.seed, settings.eval_seed),
+        "goal_rate": report["goal_rate"],
+        "goal_interval": list(stats.wilson(report["goal_rate"] * envs, envs)),
+        "classification_rate": report["classification_rate"],
+        "classification_interval": list(stats.wilson(report["classification_rate"] * envs, envs)),
+        "goal_rate_by_trial": {env: [float(r) for r in v] for env, v in rates.items()},
+    }

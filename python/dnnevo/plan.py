@@ -1,0 +1,152 @@
+"""What ``dnnevo reproduce`` runs: every experiment of the paper, over seeds, as a graph of jobs.
+
+An :class:`Experiment` is one row of the paper-vs-dnnevo table: an evolution of a preset (with
+its overrides, and seeded from other experiments' runs of the same seed where the paper does
+that), or a test of other experiments' champions (the landmark robot-like test, the integrated
+navigation system). A :class:`Job` is one experiment at one seed; it needs the jobs of the same
+seed that its experiment needs, and nothing else, so seeds never wait for each other.
+
+>>> [job.id for job in jobs([0], only=["sequence"])][:3]
+['sequence-1bit/seed-0', 'sequence-2bit-alternating/seed-0', 'sequence-2bit/seed-0']
+>>> job = next(j for j in jobs([3]) if j.experiment == "nav1d-system")
+>>> job.needs
+('nav1d-classifier/seed-3', 'nav1d-far/seed-3', 'nav1d-near/seed-3')
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+from dnnevo.errors import ConfigError
+
+__all__ = ["FAMILIES", "EXPERIMENTS", "Experiment", "Job", "jobs", "experiment"]
+
+FAMILIES = ("landmark", "nav1d", "sequence")
+"""The paper's three experiment families, in the paper's order; ``--only`` picks among them."""
+
+EVOLVE, ROBOT_LIKE, SYSTEM = "evolve", "robot-like", "nav1d-system"
+"""The kinds of job: an evolution run, the landmark robot-like test, the integrated system."""
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One experiment of the paper."""
+
+    name: str
+    family: str
+    kind: str
+    paper: str
+    """What the paper reports for it."""
+    preset: str | None = None
+    """For an evolution: the preset it runs."""
+    overrides: tuple[str, ...] = ()
+    """For an evolution: ``key=value`` overrides of the preset."""
+    generations: int | None = None
+    """For an evolution: generations other than the preset's (not in a quick reproduction)."""
+    needs: tuple[str, ...] = ()
+    """The experiments whose run of the same seed this one uses: for an evolution, the runs whose
+    champions seed its first population (composed, the first one's output neuron staying the
+    output); for a test, the runs it tests."""
+    note: str = ""
+    """How dnnevo reads the paper here, for the report."""
+
+
+_CHAINED = ("task_params.chained=true", "task_params.reinforcement_input=true", "n_inputs=2")
+
+EXPERIMENTS: tuple[Experiment, ...] = (
+    Experiment("landmark", "landmark", EVOLVE, "§3: solved by generation 15 in simulation",
+               preset="landmark"),
+    Experiment("landmark-robot", "landmark", ROBOT_LIKE,
+               "§3: the real robot right in 17 of 20 trials (10/10 and 7/10)", needs=("landmark",),
+               note="a simulated stand-in for the real robot: sonar noise, specular misses and a "
+                    "jittered room, none of which training saw"),
+    Experiment("nav1d-classifier", "nav1d", EVOLVE, "§4.2: solved at generation 5",
+               preset="nav1d-classifier"),
+    Experiment("nav1d-far", "nav1d", EVOLVE, "§4.2: solved at generation 0", preset="nav1d-far"),
+    Experiment("nav1d-near", "nav1d", EVOLVE, "§4.2: solved at generation 2", preset="nav1d-near"),
+    Experiment("nav1d-system", "nav1d", SYSTEM, "§4.2: works in all four environments",
+               needs=("nav1d-classifier", "nav1d-far", "nav1d-near"),
+               note="the classifier drives trial 1, its answer picks the far or near network for "
+                    "trials 2-5, states persist"),
+    Experiment("nav1d-far-chained", "nav1d", EVOLVE, "not in the paper", preset="nav1d-far",
+               overrides=_CHAINED, generations=100,
+               note="the far goal seeker evolved on chains of trials without a reset, with the "
+                    "reinforcement sensor, so that it keeps working with persisting states"),
+    Experiment("nav1d-near-chained", "nav1d", EVOLVE, "not in the paper", preset="nav1d-near",
+               overrides=_CHAINED, generations=100,
+               note="the near goal seeker, as nav1d-far-chained"),
+    Experiment("nav1d-system-chained", "nav1d", SYSTEM, "not in the paper",
+               needs=("nav1d-classifier", "nav1d-far-chained", "nav1d-near-chained"),
+               note="the integrated system with the chained goal seekers"),
+    Experiment("nav1d-single", "nav1d", EVOLVE, "§4.2: failed (not quantified)",
+               preset="nav1d-single"),
+    Experiment("sequence-1bit", "sequence", EVOLVE, "§5.2: success in 2 of 2 runs",
+               preset="sequence-1bit"),
+    Experiment("sequence-2bit-alternating", "sequence", EVOLVE, "§5.3: success (not quantified)",
+               preset="sequence-2bit-alternating"),
+    Experiment("sequence-2bit", "sequence", EVOLVE, "§5.3: success in 2 of 2 runs",
+               preset="sequence-2bit", needs=("sequence-1bit", "sequence-2bit-alternating"),
+               note="the paper's incremental route read literally: the first population is the "
+                    "composite of the two champions (no cross weights) and its mutants"),
+    Experiment("sequence-2bit-direct", "sequence", EVOLVE, "§5.3: failed (not quantified)",
+               preset="sequence-2bit-direct"),
+    Experiment("sequence-3bit", "sequence", EVOLVE, "§5.4: 1 success, at generation 700",
+               preset="sequence-3bit"),
+)
+"""Every experiment, in the report's order; each one's needs come before it."""
+
+
+def experiment(name: str) -> Experiment:
+    """The experiment called ``name``."""
+    for e in EXPERIMENTS:
+        if e.name == name:
+            return e
+    raise ConfigError(f"unknown experiment {name!r}; experiments: {', '.join(e.name for e in EXPERIMENTS)}")
+
+
+@dataclass(frozen=True)
+class Job:
+    """One experiment at one seed. Its folder is ``EXPERIMENT/seed-N`` under the reproduction's
+    folder."""
+
+    experiment: str
+    seed: int
+    needs: tuple[str, ...]
+    """The ids of the jobs it needs."""
+
+    @property
+    def id(self) -> str:
+        """``EXPERIMENT/seed-N``, also its folder."""
+        return job_id(self.experiment, self.seed)
+
+    @property
+    def spec(self) -> Experiment:
+        """Its experiment."""
+        return experiment(self.experiment)
+
+
+def job_id(name: str, seed: int) -> str:
+    """The id (and folder) of experiment ``name`` at ``seed``."""
+    return f"{name}/seed-{seed}"
+
+
+def families(only: Iterable[str] | None) -> tuple[str, ...]:
+    """The families ``--only`` names (all when None), checked."""
+    if only is None:
+        return FAMILIES
+    picked = tuple(dict.fromkeys(only))
+    unknown = [f for f in picked if f not in FAMILIES]
+    if unknown or not picked:
+        raise ConfigError(f"--only {','.join(picked) or '(empty)'}: families are {', '.join(FAMILIES)}")
+    return picked
+
+
+def jobs(seeds: Sequence[int], only: Iterable[str] | None = None) -> list[Job]:
+    """The jobs of the families ``only`` (default all) over ``seeds``, each after the jobs it
+    needs."""
+    chosen = families(only)
+    if not seeds or any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
+        raise ConfigError(f"seeds must be distinct and >= 0, at least one; got {list(seeds)}")
+    return [Job(e.name, s, tuple(job_id(n, s) for n in e.needs))
+            for e in EXPERIMENTS if e.family in chosen for s in seeds]

@@ -1,0 +1,77 @@
+"""A live view of many runs (``dnnevo reproduce``): how many are done, running and queued, and an
+ETA. On a terminal it is a tqdm bar; otherwise (a log file, CI) one plain line per finished run.
+
+>>> import io
+>>> from dnnevo.scheduler import Outcome, Task
+>>> out = io.StringIO()
+>>> view = RunsView(2, stream=out)
+>>> view.finished(Outcome(Task("sequence-1bit/seed-0", (), abs), "done"), running=1)
+>>> out.getvalue().split(";")[0]
+'[1/2] done sequence-1bit/seed-0'
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import TYPE_CHECKING, Any, TextIO
+
+from tqdm import tqdm
+
+from dnnevo.progress import clock
+
+if TYPE_CHECKING:
+    from dnnevo.scheduler import Outcome
+
+__all__ = ["RunsView"]
+
+
+class RunsView:
+    """Counts ``total`` jobs, ``done`` of which were finished before this view began. With
+    ``bar`` on a terminal it draws a tqdm bar; otherwise it writes a line per job."""
+
+    def __init__(self, total: int, done: int = 0, *, stream: TextIO | None = None, bar: bool = True):
+        self.stream = stream or sys.stderr
+        self.tty = self.stream.isatty()
+        self.total, self.done, self.failed = total, done, 0
+        self.before = done
+        self.t0 = time.perf_counter()
+        self.bar: Any = (tqdm(total=total, initial=done, unit="run", file=self.stream, dynamic_ncols=True,
+                              smoothing=0.0) if bar and self.tty else None)
+
+    def started(self, name: str) -> None:
+        """Shows that the run ``name`` has begun (when runs go one at a time)."""
+        if self.bar is None:
+            self.stream.write(f"[{self.done + 1}/{self.total}] {name} ...\n")
+            self.stream.flush()
+
+    def finished(self, outcome: Outcome, *, running: int | None = None) -> None:
+        """Shows that ``outcome``'s job has ended, with ``running`` jobs still going if known."""
+        self.done += 1
+        self.failed += outcome.status != "done"
+        queued = self.total - self.done - (running or 0)
+        state = f"{running} running, {queued} queued" if running is not None else f"{queued} to go"
+        counts = f"{state}, {self.failed} not done" if self.failed else state
+        if self.bar is not None:
+            self.bar.set_postfix_str(counts, refresh=False)
+            self.bar.update(1)
+            return
+        line = f"[{self.done}/{self.total}] {outcome.status} {outcome.task.id}"
+        wall = outcome.result.get("wall_s") if isinstance(outcome.result, dict) else getattr(outcome.result, "wall_s", None)
+        if wall is not None:
+            line += f" ({wall:.0f} s)"
+        if outcome.message:
+            line += f": {outcome.message}"
+        self.stream.write(f"{line}; {counts}; ETA {self._eta()}\n")
+        self.stream.flush()
+
+    def _eta(self) -> str:
+        new = self.done - self.before
+        if new == 0 or self.done >= self.total:
+            return "0:00:00" if self.done >= self.total else "unknown"
+        return clock((time.perf_counter() - self.t0) / new * (self.total - self.done))
+
+    def close(self) -> None:
+        """Ends the bar."""
+        if self.bar is not None:
+            self.bar.close()

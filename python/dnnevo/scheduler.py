@@ -1,0 +1,174 @@
+"""Running many runs (the jobs of ``dnnevo reproduce``, the seeds of ``dnnevo sweep``): in this
+process, one after another, or on a Dask cluster, where the unit of work is one :class:`Task`,
+usually one evolution run.
+
+A task starts when the tasks it needs are done. A task that fails is reported and the tasks that
+need it are skipped; the others go on. On Dask:
+
+- the default cluster is a :class:`distributed.LocalCluster` of ``workers`` processes, one task
+  at a time each; ``scheduler`` connects to a running cluster instead (its workers must see the
+  same folders, e.g. on a shared filesystem);
+- a worker that dies is replaced and its task is run again, which resumes the run from its last
+  checkpoint, so the result's bits are those of an uninterrupted run.
+
+Dask is optional (``pip install "dnnevo[cluster]"``); without it only :func:`run_in_process`
+works.
+
+>>> from dnnevo.runsview import RunsView
+>>> import io
+>>> tasks = [Task("a", (), abs, (-2,)), Task("b", ("a",), divmod, (7, 0)), Task("c", ("b",), abs, (1,))]
+>>> outcomes = run_in_process(tasks, RunsView(3, stream=io.StringIO()), errors=(ZeroDivisionError,))
+>>> [(o.task.id, o.status, o.result) for o in outcomes.values()]
+[('a', 'done', 2), ('b', 'failed', None), ('c', 'skipped', None)]
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import logging
+import os
+import uuid
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from dnnevo.errors import ConfigError, DnnevoError
+
+if TYPE_CHECKING:
+    from dnnevo.runsview import RunsView
+
+__all__ = ["CLUSTER_EXTRA", "Outcome", "Task", "dask_client", "run_in_process", "run_on_dask"]
+
+CLUSTER_EXTRA = 'pip install "dnnevo[cluster]"'
+"""How to install Dask for dnnevo."""
+
+
+@dataclass(frozen=True)
+class Task:
+    """``fn(*args, **kwargs)`` once the tasks ``needs`` (ids) are done. On Dask, ``fn`` must be
+    importable by the workers (a module's function, or a :func:`functools.partial` of one)."""
+
+    id: str
+    needs: tuple[str, ...]
+    fn: Callable[..., Any]
+    args: tuple[Any, ...] = ()
+    kwargs: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What became of one task."""
+
+    task: Task
+    status: str
+    """``done``, ``failed`` or ``skipped`` (a task it needs did not finish)."""
+    result: Any = None
+    message: str = ""
+
+
+def _blocked(task: Task, outcomes: dict[str, Outcome]) -> str | None:
+    """The first task ``task`` needs that did not finish, if any."""
+    return next((n for n in task.needs if outcomes.get(n) is None or outcomes[n].status != "done"), None)
+
+
+def run_in_process(tasks: Sequence[Task], view: RunsView, *,
+                   errors: tuple[type[BaseException], ...] = (DnnevoError,)) -> dict[str, Outcome]:
+    """Runs ``tasks`` (each after the ones it needs) one after another in this process. A task
+    that raises one of ``errors`` has failed; any other exception ends the whole."""
+    outcomes: dict[str, Outcome] = {}
+    for task in tasks:
+        missing = _blocked(task, outcomes)
+        if missing is not None:
+            outcome = Outcome(task, "skipped", message=f"{missing} did not finish")
+        else:
+            view.started(task.id)
+            try:
+                outcome = Outcome(task, "done", task.fn(*task.args, **task.kwargs))
+            except errors as e:
+                outcome = Outcome(task, "failed", message=str(e))
+        outcomes[task.id] = outcome
+        view.finished(outcome)
+    return outcomes
+
+
+def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str, Outcome]:
+    """Submits ``tasks`` to the Dask ``client``, each with the futures of the tasks it needs as
+    extra arguments after its own, so the scheduler runs it after them."""
+    from distributed import as_completed
+
+    token = uuid.uuid4().hex[:8]
+    futures: dict[str, Any] = {}
+    for task in tasks:
+        needed = [futures[n] for n in task.needs]
+        futures[task.id] = client.submit(_call, task.fn, task.args, task.kwargs, *needed,
+                                         key=f"{task.id}-{token}", pure=False)
+    by_key = {f.key: task for task, f in zip(tasks, futures.values(), strict=True)}
+    finished: dict[str, Any] = {}
+    for future in as_completed(list(futures.values())):
+        task = by_key[future.key]
+        finished[task.id] = future
+        ok = future.status == "finished"
+        view.finished(Outcome(task, "done" if ok else "failed", future.result() if ok else None),
+                      running=_running(client))
+    # Decided in order: a task whose need did not finish is skipped, whatever its future says.
+    outcomes: dict[str, Outcome] = {}
+    for task in tasks:
+        future = finished[task.id]
+        missing = _blocked(task, outcomes)
+        if missing is not None:
+            outcomes[task.id] = Outcome(task, "skipped", message=f"{missing} did not finish")
+        elif future.status == "finished":
+            outcomes[task.id] = Outcome(task, "done", future.result())
+        else:
+            error = future.exception()
+            text = str(error) if isinstance(error, DnnevoError) else f"{type(error).__name__}: {error}"
+            outcomes[task.id] = Outcome(task, "failed", message=text)
+    return outcomes
+
+
+def _call(fn: Callable[..., Any], args: tuple[Any, ...], kwargs: dict[str, Any], *needed: Any) -> Any:
+    """``fn(*args, **kwargs)``; ``needed`` (results of the tasks it waited for) is dropped."""
+    return fn(*args, **kwargs)
+
+
+def _running(client: Any) -> int | None:
+    """How many tasks the cluster's workers are running now, if it says."""
+    try:
+        assigned = sum(len(keys) for keys in client.processing().values())
+        return min(assigned, sum(client.nthreads().values()))
+    except Exception:  # noqa: BLE001 - only a progress figure; never worth failing the run for
+        return None
+
+
+@contextlib.contextmanager
+def dask_client(*, workers: int | None, scheduler: str | None) -> Iterator[Any]:
+    """A Dask client: of a new local cluster of ``workers`` processes (default: one per core),
+    one task at a time each, or of the running cluster at ``scheduler``. The cluster and its
+    workers end with the block."""
+    if importlib.util.find_spec("distributed") is None:
+        raise ConfigError(f"Dask is not installed; {CLUSTER_EXTRA}")
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        if workers is not None:
+            raise ConfigError("--workers sizes the local cluster; a --scheduler's cluster has its own workers")
+        try:
+            client = Client(scheduler, timeout="20s")
+        except OSError as e:
+            raise ConfigError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
+        with client:
+            yield client
+        return
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    dashboard = ":0" if importlib.util.find_spec("bokeh") is not None else None
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard,
+                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        yield client
+
+
+def describe(client: Any, scheduler: str | None) -> str:
+    """Where ``client``'s tasks run, in words, with the dashboard's address when there is one."""
+    where = scheduler or f"a local Dask cluster of {len(client.scheduler_info()['workers'])} workers"
+    link = getattr(client, "dashboard_link", None) if importlib.util.find_spec("bokeh") else None
+    return where + (f"; dashboard {link}" if link else "")

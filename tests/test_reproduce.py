@@ -1,0 +1,220 @@
+"""``dnnevo reproduce``: the graph of runs, one job done safely twice, resuming a stopped run to
+the bits of an uninterrupted one, the report, and the command end to end, in process and on a
+local Dask cluster (with a worker killed mid-run)."""
+
+from __future__ import annotations
+
+import doctest
+import json
+import os
+import re
+import signal
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+from cli_helpers import assert_one_line_error, run_cli
+
+import dnnevo
+from dnnevo import jobs, plan, report, runsview, scheduler
+from dnnevo.errors import ConfigError
+from dnnevo.rundir import RunFileError
+
+QUICK = jobs.Settings(quick=True, eval_trials=10, dt_check=False)
+
+
+def same_run(a: Path, b: Path) -> None:
+    """Two run folders hold the same run: champion, checkpoint state and log (wall times aside)."""
+    assert (a / "best.json").read_bytes() == (b / "best.json").read_bytes()
+    assert _log(a) == _log(b)
+    assert json.loads((a / "checkpoint.json").read_text())["state"] == json.loads((b / "checkpoint.json").read_text())["state"]
+
+
+def _log(run: Path) -> list[list[str]]:
+    """log.csv without its timing columns."""
+    rows = [line.split(",") for line in (run / "log.csv").read_text().splitlines()]
+    keep = [i for i, name in enumerate(rows[0]) if name not in ("evals_per_s", "elapsed_s")]
+    return [[row[i] for i in keep] for row in rows]
+
+
+def without_wall(result: dict[str, Any]) -> dict[str, Any]:
+    out = {k: v for k, v in result.items() if k != "wall_s"}
+    if "run" in out:
+        out["run"] = {k: v for k, v in out["run"].items() if k != "wall_s"}
+    return out
+
+
+@pytest.mark.parametrize("module", [plan, runsview, scheduler])
+def test_doctests(module: Any) -> None:
+    assert doctest.testmod(module).failed == 0
+
+
+def test_the_graph_puts_every_job_after_what_it_needs() -> None:
+    order = plan.jobs([0, 1, 2])
+    seen: set[str] = set()
+    for job in order:
+        assert set(job.needs) <= seen, job.id
+        assert all(n.endswith(f"/seed-{job.seed}") for n in job.needs)
+        seen.add(job.id)
+    assert len(order) == 3 * len(plan.EXPERIMENTS)
+    assert {j.experiment for j in plan.jobs([0], only=["landmark"])} == {"landmark", "landmark-robot"}
+    with pytest.raises(ConfigError, match="families are"):
+        plan.jobs([0], only=["vision"])
+    with pytest.raises(ConfigError, match="distinct"):
+        plan.jobs([1, 1])
+
+
+def test_settings_refuse_bad_values_and_name_them() -> None:
+    with pytest.raises(ConfigError, match="eval_trials"):
+        jobs.Settings(eval_trials=0)
+    with pytest.raises(ConfigError, match="environments"):
+        jobs.Settings(environments=-1)
+    with pytest.raises(ConfigError, match="population"):
+        jobs.Settings(overrides=("population=-3",)).config(plan.experiment("sequence-1bit"))
+
+
+def test_a_job_done_twice_is_done_once(tmp_path: Path) -> None:
+    job = plan.Job("sequence-1bit", 0, ())
+    first = jobs.run_job(job, tmp_path, QUICK, 1)
+    stamp = jobs.result_path(tmp_path, job).stat().st_mtime_ns
+    assert jobs.run_job(job, tmp_path, QUICK, 1) == first
+    assert jobs.result_path(tmp_path, job).stat().st_mtime_ns == stamp
+    # Other settings do not take a finished job's result for theirs.
+    with pytest.raises(RunFileError, match="eval_trials"):
+        jobs.read_result(tmp_path, job, jobs.Settings(quick=True, eval_trials=11, dt_check=False))
+
+
+@pytest.mark.parametrize("damage", ["{", "[]", '{"job": "sequence-1bit/seed-0"}', "truncate"])
+def test_a_damaged_result_is_named_not_trusted(tmp_path: Path, damage: str) -> None:
+    job = plan.Job("sequence-1bit", 0, ())
+    jobs.run_job(job, tmp_path, QUICK, 1)
+    path = jobs.result_path(tmp_path, job)
+    text = path.read_text()
+    path.write_text(text[: len(text) // 2] if damage == "truncate" else damage)
+    with pytest.raises(RunFileError, match=re.escape(str(path))):
+        jobs.read_result(tmp_path, job, QUICK)
+
+
+def test_a_tampered_result_is_refused(tmp_path: Path) -> None:
+    job = plan.Job("sequence-1bit", 0, ())
+    jobs.run_job(job, tmp_path, QUICK, 1)
+    path = jobs.result_path(tmp_path, job)
+    data = json.loads(path.read_text())
+    data["run"]["final"]["rates"][0]["k"] = 10**6
+    path.write_text(json.dumps(data))
+    with pytest.raises(RunFileError, match="not a valid job result"):
+        jobs.read_result(tmp_path, job, QUICK)
+
+
+def test_a_stopped_run_resumes_to_the_bits_of_an_unstopped_one(tmp_path: Path) -> None:
+    settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False, overrides=("generations=12",))
+    job = plan.Job("sequence-2bit-alternating", 4, ())
+    whole = jobs.run_job(job, tmp_path / "whole", settings, 1)
+    # The same job stopped after generation 5: its folder has a checkpoint and no result.
+    config = settings.config(job.spec)
+    out = tmp_path / "parts" / job.id
+    dnnevo.evolve(config.task, config, seed=4, out=out, progress=False, callback=lambda stats, ga: ga.generation >= 5)
+    assert jobs.read_result(tmp_path / "parts", job, settings) is None
+    resumed = jobs.run_job(job, tmp_path / "parts", settings, 2)
+    assert without_wall(resumed) == without_wall(whole)
+    same_run(tmp_path / "whole" / job.id, out)
+
+
+def test_a_composed_run_uses_the_runs_it_needs(tmp_path: Path) -> None:
+    order = plan.jobs([0], only=["sequence"])[:3]
+    for job in order:
+        jobs.run_job(job, tmp_path, QUICK, 1)
+    table = (tmp_path / "sequence-2bit" / "seed-0" / "config.toml").read_text()
+    assert "sequence-1bit/seed-0" in table and "sequence-2bit-alternating/seed-0" in table
+
+
+def test_the_report_says_the_same_in_markdown_and_html(tmp_path: Path) -> None:
+    from dnnevo.scheduler import Outcome, Task
+
+    order = plan.jobs([0, 1], only=["landmark"])
+    tasks = {j.id: Task(j.id, j.needs, jobs.run_job) for j in order}
+    outcomes = {j.id: Outcome(tasks[j.id], "done", jobs.run_job(j, tmp_path, QUICK, 1)) for j in order[:3]}
+    outcomes[order[3].id] = Outcome(tasks[order[3].id], "failed", message="a worker died")
+    env = report.environment(workers="none", threads=1, wall_s=1.0)
+    blocks = report.build(tmp_path, order, outcomes, settings=QUICK, environment=env, command="dnnevo reproduce")
+    md, page = report.markdown(blocks), report.to_html(blocks, tmp_path)
+    assert "| landmark | §3: solved by generation 15 in simulation | 2/2 |" in md
+    assert "| landmark-robot | §3: the real robot right in 17 of 20 trials (10/10 and 7/10) | 1/2 |" in md
+    assert "a worker died" in md and "a worker died" in page
+    images = re.findall(r'<img [^>]*src="([^"]+)"', page)
+    assert images and all(src.startswith("data:image/png;base64,") for src in images)
+    assert len(images) == md.count("![")
+    assert env["SIMD kernel"].split()[0] == dnnevo.build_info()["kernel"]
+
+
+def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path) -> None:
+    out = tmp_path / "repro"
+    args = ["reproduce", "--only", "sequence", "--seeds", "0", "--quick", "--eval-trials", "10",
+            "--no-dt-check", "--in-process", "--out", out]
+    r = run_cli(*args)
+    assert r.returncode == 0, r.stderr
+    assert "5 runs in" in r.stdout and "(0 already done)" in r.stdout
+    for name in report.REPORT_FILES:
+        assert (out / name).stat().st_size > 1000
+    md = (out / "report.md").read_text()
+    assert "| sequence-2bit | §5.3: success in 2 of 2 runs | 1/1 |" in md
+    assert "sequence-3bit" in md and "landmark" not in md.split("## Environment")[0]
+    again = run_cli(*args)
+    assert again.returncode == 0 and "(5 already done)" in again.stdout, again.stderr
+    other = run_cli(*[a if a != "10" else "11" for a in args])
+    assert_one_line_error(other, "eval_trials", "= 10, not 11")
+
+
+def test_reproduce_names_bad_input_in_one_line(tmp_path: Path) -> None:
+    assert_one_line_error(run_cli("reproduce", "--only", "vision", "--out", tmp_path), "families are")
+    assert_one_line_error(run_cli("reproduce", "--set", "population=0", "--in-process", "--out", tmp_path / "a"),
+                          "population")
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "notes.txt").write_text("mine")
+    assert_one_line_error(run_cli("reproduce", "--in-process", "--out", tmp_path / "b"), "reproduce.json")
+
+
+distributed = pytest.importorskip("distributed")
+
+
+def test_reproduce_on_a_local_cluster_matches_in_process(tmp_path: Path) -> None:
+    args = ["reproduce", "--only", "nav1d", "--seeds", "0", "--quick", "--eval-trials", "10", "--no-dt-check"]
+    assert run_cli(*args, "--in-process", "--out", tmp_path / "here").returncode == 0
+    r = run_cli(*args, "--workers", "2", "--out", tmp_path / "dask")
+    assert r.returncode == 0, r.stderr
+    assert "a local Dask cluster of 2 workers" in r.stdout
+    for job in plan.jobs([0], only=["nav1d"]):
+        here = json.loads(jobs.result_path(tmp_path / "here", job).read_text())
+        there = json.loads(jobs.result_path(tmp_path / "dask", job).read_text())
+        assert without_wall(here) == without_wall(there), job.id
+
+
+def test_a_killed_worker_s_run_resumes_to_the_same_bits(tmp_path: Path) -> None:
+    settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False,
+                             overrides=("population=200", "generations=100"))
+    job = plan.Job("sequence-1bit", 0, ())
+    checkpoint = tmp_path / "dask" / job.id / "checkpoint.json"
+    with scheduler.dask_client(workers=1, scheduler=None) as client:
+        pids = list(client.run(os.getpid).values())
+        # A checkpoint every generation on this worker (every 10 s otherwise), so it dies mid-run.
+        client.run(exec, "import sys, dnnevo; sys.modules['dnnevo.evolve'].CHECKPOINT_SECONDS = 0.0")
+        future = client.submit(jobs.run_job, job, str(tmp_path / "dask"), settings, 1, pure=False)
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and not _at_generation(checkpoint, 3):
+            time.sleep(0.01)
+        for pid in pids:
+            os.kill(pid, signal.SIGKILL)
+        killed_at = len(json.loads(checkpoint.read_text())["history"])
+        assert 3 <= killed_at < 100, killed_at
+        result = future.result(timeout=300)
+    whole = jobs.run_job(job, tmp_path / "here", settings, 1)
+    assert without_wall(result) == without_wall(whole)
+    same_run(tmp_path / "here" / job.id, tmp_path / "dask" / job.id)
+
+
+def _at_generation(checkpoint: Path, generation: int) -> bool:
+    try:
+        return len(json.loads(checkpoint.read_text())["history"]) >= generation
+    except (OSError, ValueError, KeyError):
+        return False

@@ -178,16 +178,32 @@ def test_reproduce_names_bad_input_in_one_line(tmp_path: Path) -> None:
 distributed = pytest.importorskip("distributed")
 
 
-def test_reproduce_on_a_local_cluster_matches_in_process(tmp_path: Path) -> None:
-    args = ["reproduce", "--only", "nav1d", "--seeds", "0", "--quick", "--eval-trials", "10", "--no-dt-check"]
+def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_path: Path) -> None:
+    args = ["reproduce", "--seeds", "0", "--quick", "--eval-trials", "10", "--no-dt-check"]
     assert run_cli(*args, "--in-process", "--out", tmp_path / "here").returncode == 0
     r = run_cli(*args, "--workers", "2", "--out", tmp_path / "dask")
     assert r.returncode == 0, r.stderr
     assert "a local Dask cluster of 2 workers" in r.stdout
-    for job in plan.jobs([0], only=["nav1d"]):
+    assert "[15/15] done" in r.stderr  # not a terminal: one line per run
+    for job in plan.jobs([0]):
         here = json.loads(jobs.result_path(tmp_path / "here", job).read_text())
         there = json.loads(jobs.result_path(tmp_path / "dask", job).read_text())
         assert without_wall(here) == without_wall(there), job.id
+    md = (tmp_path / "dask" / "report.md").read_text()
+    for e in plan.EXPERIMENTS:
+        assert f"| {e.name} | {e.paper} | 1/1 |" in md
+    for figure in ("fig1-traces.png", "world.png", "fig2-paths.png", "fig3-classifier.png", "fig4-trials.png",
+                   "fig5-switch.png", "fig2-system.png"):
+        assert figure in md, figure
+
+
+def test_a_running_scheduler_takes_the_runs(tmp_path: Path) -> None:
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+        r = run_cli("reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--eval-trials", "10",
+                    "--no-dt-check", "--scheduler", cluster.scheduler_address, "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert f"on {cluster.scheduler_address}" in r.stdout
+    assert jobs.read_result(tmp_path, plan.Job("landmark-robot", 0, ("landmark/seed-0",)), QUICK) is not None
 
 
 def test_a_killed_worker_s_run_resumes_to_the_same_bits(tmp_path: Path) -> None:

@@ -90,24 +90,31 @@ def reproduce(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with RunDir(root).writing(create=True):
         _begin(root, settings)
-        before = sum(jobs.read_result(root, j, settings) is not None for j in order)
+        # Finished runs are not run again; the others need only the unfinished among their needs.
+        stored = {j.id: jobs.read_result(root, j, settings) for j in order}
+        done = {j.id: scheduler.Outcome(scheduler.Task(j.id, j.needs, jobs.run_job), "done", stored[j.id])
+                for j in order if stored[j.id] is not None}
+        before = len(done)
         print(f"{len(order)} runs in {args.out} ({before} already done)"
               + ("" if dask else "; in this process" + (" (Dask is not installed: "
                                                          f"{scheduler.CLUSTER_EXTRA})" if not args.in_process else "")))
         view = RunsView(len(order), before, bar=dask)
         threads = (args.threads_per_worker or 1) if dask else args.threads_per_worker
         progress = not dask and sys.stderr.isatty()
-        tasks = [scheduler.Task(j.id, j.needs, jobs.run_job, (j, str(root), settings, threads), {"progress": progress})
-                 for j in order]
+        tasks = [scheduler.Task(j.id, tuple(n for n in j.needs if n not in done), jobs.run_job,
+                                (j, str(root), settings, threads), {"progress": progress})
+                 for j in order if j.id not in done]
         try:
-            if dask:
+            if not tasks:
+                workers, ran = "none (every run was done before)", {}
+            elif dask:
                 with scheduler.dask_client(workers=args.workers, scheduler=args.scheduler) as client:
                     workers = scheduler.describe(client, args.scheduler)
                     print(f"on {workers}")
-                    outcomes = scheduler.run_on_dask(tasks, view, client)
+                    ran = scheduler.run_on_dask(tasks, view, client)
             else:
                 workers = "none (in process)"
-                outcomes = scheduler.run_in_process(tasks, view)
+                ran = scheduler.run_in_process(tasks, view)
         except jobs.Stopped as e:
             view.close()
             sys.stderr.write(f"dnnevo: stopped: {e}; run the same command again to continue\n")
@@ -117,6 +124,7 @@ def reproduce(args: argparse.Namespace) -> int:
             sys.stderr.write("dnnevo: interrupted; run the same command again to continue from the checkpoints\n")
             return 130
         view.close()
+        outcomes = {j.id: done[j.id] if j.id in done else ran[j.id] for j in order}
         env = report.environment(workers=workers, threads=threads, wall_s=time.perf_counter() - t0)
         command = _command(args)
         blocks = report.build(root, order, outcomes, settings=settings, environment=env, command=command)

@@ -161,8 +161,9 @@ def dask_client(*, workers: int | None, scheduler: str | None) -> Iterator[Any]:
             yield client
         return
     n = workers if workers is not None else (os.cpu_count() or 1)
-    dashboard = ":0" if importlib.util.find_spec("bokeh") is not None else None
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard,
+    # The scheduler serves HTTP (the dashboard with bokeh) even without a dashboard: on a free
+    # port, never 8787, which another cluster on this machine may hold.
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
         yield client
 

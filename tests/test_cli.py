@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 
@@ -151,6 +152,20 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
         assert r.returncode == 2 and fragment in r.stderr and "Traceback" not in r.stderr, r.stderr
     r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "e"), "--seed-populations")
     assert r.returncode == 2 and "--seed-populations needs" in r.stderr
+    # Spare neurons: a random network composed last, unconnected, so neuron 0 answers as before.
+    spared = Seeding((tmp_path / "a", tmp_path / "b"), populations=True, spare=3).networks(13, seed=7)
+    assert spared[0].size == 13 and spared[0].n_inputs == seeds[0].n_inputs
+    assert (spared[0].weights[:10, :10] == seeds[0].weights).all()
+    assert (spared[0].weights[:10, 10:] == 0).all() and (spared[0].weights[10:, :10] == 0).all()
+    assert not (spared[0].weights[10:, 10:] == spared[1].weights[10:, 10:]).all()
+    inputs = np.random.default_rng(0).uniform(0, 1, (300, 2))
+    assert (seeds[0].run(inputs).outputs[:, 0] == spared[0].run(inputs).outputs[:, 0]).all()
+    with pytest.raises(dn.ConfigError, match="make 13 neurons; the run has 12"):
+        Seeding((tmp_path / "a", tmp_path / "b"), spare=3).networks(12, seed=7)
+    r = dnnevo("run", "sequence-2bit", *small, "--set", "size=12", "--out", str(tmp_path / "h"), "--spare-neurons",
+               "2", "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
+    assert r.returncode == 0, r.stderr
+    assert tomllib.loads((tmp_path / "h" / "config.toml").read_text())["run"]["spare_neurons"] == 2
 
 
 def test_a_sweep_seeds_every_run_from_earlier_runs(tmp_path: Path) -> None:

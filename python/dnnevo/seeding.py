@@ -9,7 +9,11 @@ where the parts come from and how they are joined:
   the i-th members of the runs into the i-th seed, so the seeds pair different networks;
 - ``cross_scale``: the weights between the parts are 0, or drawn per seed uniformly in
   [-cross_scale, cross_scale] from the stream ``(seed, 0, Seeding, j, 1)`` of the new run's seed,
-  where ``j = member`` with two runs (``member (R - 1) + k`` for the k-th of R - 1 joins).
+  where ``j = member`` with two runs (``member (R - 1) + k`` for the k-th of R - 1 joins);
+- ``spare``: that many more neurons, a random network (``Network.random`` with seed
+  ``(seed * SPARE_SEED_STRIDE + member) mod 2**64``) composed last like another part. With no
+  cross weights they cannot change the composite's output until evolution wires them in: room for
+  new circuitry beside the parts. Not in the paper.
 
 When the runs' network sizes do not add up to the new run's size, the networks are used as they
 are, side by side in the population.
@@ -33,7 +37,10 @@ from dnnevo.errors import ConfigError
 from dnnevo.ga import GeneticAlgorithm
 from dnnevo.rundir import RunDir
 
-__all__ = ["Seeding", "add_arguments"]
+__all__ = ["SPARE_SEED_STRIDE", "Seeding", "add_arguments"]
+
+SPARE_SEED_STRIDE = 1_000_003
+"""Seed s's member m gets spare neurons from ``Network.random(..., seed=s * SPARE_SEED_STRIDE + m)``."""
 
 
 @dataclass(frozen=True)
@@ -43,29 +50,40 @@ class Seeding:
     runs: tuple[Path, ...]
     populations: bool = False
     cross_scale: float = 0.0
+    spare: int = 0
 
     def __post_init__(self) -> None:
+        if not (isinstance(self.spare, int) and not isinstance(self.spare, bool) and self.spare >= 0):
+            raise ConfigError(f"--spare-neurons is {self.spare!r}; it must be an integer >= 0")
         if not (isinstance(self.cross_scale, int | float) and math.isfinite(self.cross_scale)
                 and self.cross_scale >= 0):
             raise ConfigError(f"--cross-scale is {self.cross_scale!r}; it must be a finite number >= 0")
-        if not self.runs and (self.populations or self.cross_scale):
-            what = "--seed-populations" if self.populations else "--cross-scale"
+        if not self.runs and (self.populations or self.cross_scale or self.spare):
+            what = ("--seed-populations" if self.populations else "--cross-scale" if self.cross_scale
+                    else "--spare-neurons")
             raise ConfigError(f"{what} needs at least one --seed-from RUN")
 
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> Seeding | None:
         """The seeding the options of :func:`add_arguments` ask for, or None without
         ``--seed-from``."""
-        seeding = cls(tuple(args.seed_from), args.seed_populations, args.cross_scale)
+        seeding = cls(tuple(args.seed_from), args.seed_populations, args.cross_scale, args.spare_neurons)
         return seeding if seeding.runs else None
 
     def networks(self, size: int, seed: int) -> list[_core.Network]:
         """The seed networks for a run of ``size`` neurons with ``seed``."""
         groups = [self._group(RunDir(r)) for r in self.runs]
-        if len(groups) < 2 or sum(g[0].size for g in groups) != size:
+        parts_size = sum(g[0].size for g in groups) + self.spare
+        if self.spare and parts_size != size:
+            raise ConfigError(f"the seed runs' networks and --spare-neurons {self.spare} make {parts_size} "
+                              f"neurons; the run has {size}")
+        if len(groups) + bool(self.spare) < 2 or parts_size != size:
             return [net for group in groups for net in group]
         seeds = []
         for member, parts in enumerate(zip(*groups)):
+            if self.spare:
+                spare_seed = (seed * SPARE_SEED_STRIDE + member) % 2**64
+                parts = (*parts, _core.Network.random(self.spare, parts[0].n_inputs, seed=spare_seed))
             net = parts[0]
             for k, part in enumerate(parts[1:]):
                 join = member * (len(parts) - 1) + k
@@ -75,9 +93,12 @@ class Seeding:
 
     def info(self) -> dict[str, Any]:
         """Entries for the ``[run]`` table of the new run's config.toml."""
-        return {"seeded_from": [str(p) for p in self.runs],
-                "seeded_with": "populations" if self.populations else "champions",
-                "cross_scale": float(self.cross_scale)}
+        info: dict[str, Any] = {"seeded_from": [str(p) for p in self.runs],
+                                "seeded_with": "populations" if self.populations else "champions",
+                                "cross_scale": float(self.cross_scale)}
+        if self.spare:  # only then, so that earlier sweeps' settings still match
+            info["spare_neurons"] = self.spare
+        return info
 
     def _group(self, run: RunDir) -> list[_core.Network]:
         if self.populations:
@@ -98,3 +119,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--cross-scale", type=float, default=0.0, metavar="S",
                    help="with --seed-from: draw each weight between composed parts uniformly in "
                         "[-S, S], per seed network, from the run's seed (default 0: no cross weights)")
+    p.add_argument("--spare-neurons", type=int, default=0, metavar="K",
+                   help="with --seed-from: compose K more neurons (a random network) into each seed, "
+                        "joined like another part; set size to the parts' sum + K (not in the paper)")

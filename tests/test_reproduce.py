@@ -8,6 +8,7 @@ import doctest
 import json
 import os
 import re
+import shutil
 import signal
 import time
 from pathlib import Path
@@ -107,6 +108,45 @@ def test_a_tampered_result_is_refused(tmp_path: Path) -> None:
         jobs.read_result(tmp_path, job, QUICK)
 
 
+@pytest.mark.parametrize(("experiment", "needs", "edit"), [
+    ("landmark-robot", ("landmark",), lambda d: d["assessment"].pop("confusion")),
+    ("landmark-robot", ("landmark",), lambda d: d["assessment"].update(confusion=[[1, 2]])),
+    ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"), lambda d: d.pop("wall_s")),
+    ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"), lambda d: d.update(wall_s="abc")),
+    ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"),
+     lambda d: d.update(goal_rate_by_trial={})),
+    ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"), lambda d: d.update(goal_interval=[0.1])),
+])
+def test_a_result_of_the_wrong_shape_is_named(tmp_path: Path, experiment: str, needs: tuple[str, ...],
+                                              edit: Any) -> None:
+    for name in needs:
+        jobs.run_job(plan.Job(name, 0, ()), tmp_path, QUICK, 1)
+    job = plan.Job(experiment, 0, tuple(f"{n}/seed-0" for n in needs))
+    data = jobs.run_job(job, tmp_path, QUICK, 1)
+    edit(data)
+    jobs.result_path(tmp_path, job).write_text(json.dumps(data))
+    with pytest.raises(RunFileError, match="not a valid job result"):
+        jobs.read_result(tmp_path, job, QUICK)
+
+
+def test_a_result_is_not_trusted_when_its_runs_changed(tmp_path: Path) -> None:
+    landmark, robot = plan.Job("landmark", 0, ()), plan.Job("landmark-robot", 0, ("landmark/seed-0",))
+    first = jobs.run_job(landmark, tmp_path, QUICK, 1)
+    jobs.run_job(robot, tmp_path, QUICK, 1)
+    # A deleted run folder: its result and the test of its champion no longer count, and the run
+    # is made afresh, to the same bits.
+    shutil.rmtree(tmp_path / landmark.id)
+    assert jobs.read_result(tmp_path, landmark, QUICK) is None
+    assert jobs.read_result(tmp_path, robot, QUICK) is None
+    assert without_wall(jobs.run_job(landmark, tmp_path, QUICK, 1)) == without_wall(first)
+    assert jobs.read_result(tmp_path, robot, QUICK) is not None
+    # A run extended by hand is no longer the reproduction's run: named, not silently used.
+    dnnevo.resume(tmp_path / landmark.id, generations=8, progress=False)
+    assert jobs.read_result(tmp_path, landmark, QUICK) is None
+    with pytest.raises(RunFileError, match="generations is 8"):
+        jobs.run_job(landmark, tmp_path, QUICK, 1)
+
+
 def test_a_stopped_run_resumes_to_the_bits_of_an_unstopped_one(tmp_path: Path) -> None:
     settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False, overrides=("generations=12",))
     job = plan.Job("sequence-2bit-alternating", 4, ())
@@ -168,6 +208,11 @@ def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path)
 
 def test_reproduce_names_bad_input_in_one_line(tmp_path: Path) -> None:
     assert_one_line_error(run_cli("reproduce", "--only", "vision", "--out", tmp_path), "families are")
+    assert_one_line_error(run_cli("reproduce", "--seeds", "0-100000000", "--out", tmp_path), "seeds go from 0 to")
+    assert_one_line_error(run_cli("reproduce", "--seeds", "3,3", "--out", tmp_path), "listed twice")
+    assert_one_line_error(run_cli("reproduce", "--workers", "2", "--scheduler", "tcp://h:1", "--out",
+                                  tmp_path / "c"), "--workers sizes the local cluster")
+    assert not (tmp_path / "c").exists()
     assert_one_line_error(run_cli("reproduce", "--set", "population=0", "--in-process", "--out", tmp_path / "a"),
                           "population")
     (tmp_path / "b").mkdir()
@@ -175,10 +220,13 @@ def test_reproduce_names_bad_input_in_one_line(tmp_path: Path) -> None:
     assert_one_line_error(run_cli("reproduce", "--in-process", "--out", tmp_path / "b"), "reproduce.json")
 
 
-distributed = pytest.importorskip("distributed")
+def dask() -> Any:
+    """Dask's distributed, or a skip for the test that needs it."""
+    return pytest.importorskip("distributed")
 
 
 def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_path: Path) -> None:
+    dask()
     args = ["reproduce", "--seeds", "0", "--quick", "--eval-trials", "10", "--no-dt-check"]
     assert run_cli(*args, "--in-process", "--out", tmp_path / "here").returncode == 0
     r = run_cli(*args, "--workers", "2", "--out", tmp_path / "dask")
@@ -198,7 +246,7 @@ def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_
 
 
 def test_a_running_scheduler_takes_the_runs(tmp_path: Path) -> None:
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+    with dask().LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
         r = run_cli("reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--eval-trials", "10",
                     "--no-dt-check", "--scheduler", cluster.scheduler_address, "--out", tmp_path)
     assert r.returncode == 0, r.stderr
@@ -207,6 +255,7 @@ def test_a_running_scheduler_takes_the_runs(tmp_path: Path) -> None:
 
 
 def test_a_killed_worker_s_run_resumes_to_the_same_bits(tmp_path: Path) -> None:
+    dask()
     settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False,
                              overrides=("population=200", "generations=100"))
     job = plan.Job("sequence-1bit", 0, ())

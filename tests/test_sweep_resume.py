@@ -75,3 +75,15 @@ def test_a_sweep_on_a_local_dask_cluster_gives_the_same_results(tmp_path: Path) 
     for seed in range(4):
         best = f"seed-{seed}/best.json"
         assert (there / best).read_bytes() == (here / best).read_bytes()
+
+
+def test_a_seed_that_fails_on_dask_is_named_and_the_exit_status_says_so(tmp_path: Path) -> None:
+    pytest.importorskip("distributed")
+    out = tmp_path / "s"
+    sweep(out, "0-1")
+    (out / "seed-1" / "config.toml").write_text("population = 'many'\n")
+    r = run_cli("sweep", *ARGS, "--seeds", "0-1", "--out", out, "--workers", "1")
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert "dnnevo: seed-1 failed:" in r.stderr and "Traceback" not in r.stderr
+    assert "1 seed(s) failed" in r.stdout
+    assert [run["seed"] for run in results(out)] == [0]

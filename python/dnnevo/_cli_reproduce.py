@@ -27,8 +27,10 @@ Run every experiment of the paper over seeds and write a report: landmark recogn
 training, then the robot-like test of the champions), one-dimensional navigation (the three
 subnetworks, the goal seekers evolved on chains, both integrated systems, the single network) and
 sequence learning (1-bit, alternating, the incremental 2-bit route from those two runs, direct
-2-bit, 3-bit). Each run has its own run folder OUT/EXPERIMENT/seed-N and its result in
-OUT/EXPERIMENT/seed-N.json; the report is OUT/report.md and OUT/report.html."""
+2-bit, 3-bit). Each evolution has its own run folder OUT/EXPERIMENT/seed-N and its result in
+OUT/EXPERIMENT/seed-N.json (the robot-like test and the integrated systems are tests of other
+runs and have only the result). The report, OUT/report.md and OUT/report.html, covers the seeds
+and families of the command that wrote it."""
 
 EXAMPLE = """examples:
   dnnevo reproduce --quick --seeds 0-1 --out runs/repro-quick     about a minute on 2 cores
@@ -40,7 +42,9 @@ By default the runs go to a Dask LocalCluster of one worker process per core, on
 each (pip install "dnnevo[cluster]"); without Dask, or with --in-process, they run one after
 another here, each on every core. Running the same command again skips finished runs, resumes
 stopped ones from their checkpoints (a killed worker's run too) and refuses other settings,
-naming the first that differs; more seeds or families may be added. Exit status: 0 when every
+naming the first that differs; more seeds or families may be added. A result whose run files
+changed since (e.g. a run extended with 'dnnevo resume') is made again. After Ctrl-C with
+--scheduler, the cluster's workers finish the runs they hold. Exit status: 0 when every
 run finished, 2 when some did not (each is named), 130 on Ctrl-C."""
 
 
@@ -86,6 +90,8 @@ def reproduce(args: argparse.Namespace) -> int:
                                     or importlib.util.find_spec("distributed") is not None)
     if args.in_process and (args.scheduler or args.workers):
         raise ConfigError("--in-process runs here; it takes no --workers or --scheduler")
+    if dask:
+        scheduler.check_options(workers=args.workers, scheduler=args.scheduler)
     root = args.out.resolve()
     t0 = time.perf_counter()
     with RunDir(root).writing(create=True):

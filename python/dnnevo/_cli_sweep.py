@@ -8,6 +8,7 @@ import argparse
 import json
 import re
 import shutil
+import sys
 from pathlib import Path
 
 from dnnevo import presets, scheduler, seeding, sweep
@@ -57,6 +58,8 @@ def sweep_command(args: argparse.Namespace) -> int:
     for seed in args.seeds:  # before any run, so a bad --eval-seed costs nothing
         nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
     trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
+    if args.workers is not None or args.scheduler is not None:
+        scheduler.check_options(workers=args.workers, scheduler=args.scheduler)
     how = seeding.Seeding.from_args(args)
     settings = {"preset": args.preset, "eval_seed": args.eval_seed, "eval_trials": trials,
                 "dt_check": args.dt_check, "seeding": how.info() if how else None,
@@ -104,8 +107,9 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
                    "eval_seed_base": args.eval_seed, "eval_trials": trials, "dt_check": args.dt_check,
                    "seeding": how, "resume": resume}
         tasks.append(scheduler.Task(f"seed-{seed}", (), sweep.run_seed, (config, seed, out), options))
+    failed = 0
     if args.workers is not None or args.scheduler is not None:
-        runs = _on_dask(args, tasks)
+        runs, failed = _on_dask(args, tasks)
     else:
         runs = []
         for task in tasks:
@@ -122,12 +126,16 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
         print(f"interrupted during seed {runs[-1].seed}; the statistics cover the {len(runs)} seed(s) run; "
               "run the same command again to continue the sweep")
     print(f"wrote {', '.join(map(str, paths))}")
+    if failed:
+        print(f"{failed} seed(s) failed (named above); the statistics cover the {len(runs)} that did not")
+        return 2
     return 0
 
 
-def _on_dask(args: argparse.Namespace, tasks: list[scheduler.Task]) -> list[sweep.SeedResult]:
+def _on_dask(args: argparse.Namespace, tasks: list[scheduler.Task]) -> tuple[list[sweep.SeedResult], int]:
     """The seeds' runs on a Dask cluster, one run per worker at a time, each with ``--threads``
-    threads (default 1); a seed that failed is named and left out of the statistics."""
+    threads (default 1), and how many failed: each is named on stderr and left out of the
+    statistics."""
     for task in tasks:
         task.kwargs.update(progress=False, threads=args.threads or 1)
     view = RunsView(len(tasks))
@@ -136,11 +144,11 @@ def _on_dask(args: argparse.Namespace, tasks: list[scheduler.Task]) -> list[swee
         outcomes = scheduler.run_on_dask(tasks, view, client)
     view.close()
     failed = [o for o in outcomes.values() if o.status != "done"]
-    for o in failed:
-        print(f"{o.task.id} failed: {o.message}")
     if len(failed) == len(tasks):
         raise DnnevoError(f"every seed failed; the first: {failed[0].message}")
-    return [o.result for o in outcomes.values() if o.status == "done"]
+    for o in failed:
+        sys.stderr.write(f"dnnevo: {o.task.id} failed: {o.message}\n")
+    return [o.result for o in outcomes.values() if o.status == "done"], len(failed)
 
 
 def _generation(x: float) -> str:

@@ -42,18 +42,34 @@ EXAMPLES = """examples:
 """
 
 
+MAX_SEEDS = 10_000
+"""The most seeds a sweep or reproduction takes."""
+
+MAX_SEED = 999_999
+"""The largest seed of a sweep or reproduction: its fresh conditions come from seeds 1000003 +
+seed and up, which no run of it then uses."""
+
+
 def _parse_seeds(text: str) -> list[int]:
     seeds: list[int] = []
     try:
         for part in text.split(","):
             lo, sep, hi = part.partition("-")
-            seeds.extend(range(int(lo), int(hi) + 1) if sep else [int(lo)])
+            first, last = (int(lo), int(hi)) if sep else (int(lo), int(lo))
+            if not 0 <= first <= last <= MAX_SEED:
+                raise argparse.ArgumentTypeError(
+                    f"{part!r}: seeds go from 0 to {MAX_SEED}, a range low to high")
+            seeds.extend(range(first, last + 1))
+            if len(seeds) > MAX_SEEDS:
+                raise argparse.ArgumentTypeError(f"more than {MAX_SEEDS} seeds")
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"{text!r} is not a seed list such as 0-9 or 1,4,7"
+            f"{text[:40]!r} is not a seed list such as 0-9 or 1,4,7"
         ) from None
     if not seeds:
         raise argparse.ArgumentTypeError("the seed list is empty")
+    if len(set(seeds)) != len(seeds):
+        raise argparse.ArgumentTypeError("a seed is listed twice")
     return seeds
 
 

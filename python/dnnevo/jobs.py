@@ -16,6 +16,7 @@ The function is what a Dask worker runs, so it takes and returns plain data.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import time
 from dataclasses import asdict, dataclass
@@ -96,7 +97,8 @@ def result_path(root: Path, job: plan.Job) -> Path:
 
 
 def read_result(root: Path, job: plan.Job, settings: Settings) -> dict[str, Any] | None:
-    """``job``'s stored result, checked, or None when the job has not finished."""
+    """``job``'s stored result, checked, or None when the job has not finished, or when the run
+    files it was computed from have changed or gone since (then it is done again)."""
     path = result_path(root, job)
     if not path.exists() and not path.is_symlink():
         return None
@@ -109,12 +111,35 @@ def read_result(root: Path, job: plan.Job, settings: Settings) -> dict[str, Any]
         if diff is not None:
             raise RunFileError(f"{path}: its {diff[0]} is {short(diff[1])}, this reproduction's is {short(diff[2])}")
         _check_body(job, found)
+        if found["inputs"] != _inputs(root, job):
+            return None
     except RunFileError:
         raise
-    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError) as e:
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError, IndexError) as e:
         raise RunFileError(f"{path}: not a valid job result ({type(e).__name__}: {e}); delete it to "
                            "redo the job") from None
     return found
+
+
+def _inputs(root: Path, job: plan.Job) -> dict[str, Any]:
+    """What ``job``'s result was computed from, by path under ``root``: the SHA-256 of the
+    champion (``best.json``) of its own run (an evolution) or of each run it tests, and an
+    evolution's generation count (the rows of ``log.csv``; the file itself holds wall times).
+    None stands for a missing file. A result whose inputs changed (a run folder deleted, a run
+    extended with ``dnnevo resume``) is done again."""
+    own = job.spec.kind == plan.EVOLVE
+    out: dict[str, Any] = {}
+    for run in [job.id] if own else list(job.needs):
+        try:
+            out[f"{run}/best.json"] = hashlib.sha256((root / run / "best.json").read_bytes()).hexdigest()
+        except FileNotFoundError:
+            out[f"{run}/best.json"] = None
+    if own:
+        try:
+            out[f"{job.id}/log.csv rows"] = len((root / job.id / "log.csv").read_text(encoding="utf-8").splitlines()) - 1
+        except FileNotFoundError:
+            out[f"{job.id}/log.csv rows"] = None
+    return out
 
 
 def _header(job: plan.Job, settings: Settings) -> dict[str, Any]:
@@ -124,18 +149,40 @@ def _header(job: plan.Job, settings: Settings) -> dict[str, Any]:
     return dict(json.loads(json.dumps(header)))
 
 
+def _fraction(value: Any, what: str) -> float:
+    x = float(value)
+    if not 0.0 <= x <= 1.0:
+        raise ValueError(f"{what} is {value!r}, not a fraction")
+    return x
+
+
 def _check_body(job: plan.Job, found: dict[str, Any]) -> None:
+    """Every field a report reads is there and of its type."""
+    if not float(found["wall_s"]) >= 0.0:
+        raise ValueError("wall_s is negative")
     kind = job.spec.kind
     if kind == plan.EVOLVE:
         run = sweep.SeedResult.from_dict(found["run"])
         if run.seed != job.seed:
             raise ValueError(f"it holds seed {run.seed}")
     elif kind == plan.ROBOT_LIKE:
-        Assessment.from_dict(found["assessment"])
+        a = Assessment.from_dict(found["assessment"])
+        matrix = a.details["confusion"]
+        if len(matrix) != 2 or any(len(row) != 2 for row in matrix) or not all(
+                isinstance(x, int) and not isinstance(x, bool) and x >= 0 for row in matrix for x in row):
+            raise ValueError("confusion is not a 2 x 2 matrix of counts")
     else:
         for key in ("goal_rate", "classification_rate"):
-            if not 0.0 <= float(found[key]) <= 1.0:
-                raise ValueError(f"{key} is not a fraction")
+            _fraction(found[key], key)
+        for key in ("goal_interval", "classification_interval"):
+            if len([_fraction(x, key) for x in found[key]]) != 2:
+                raise ValueError(f"{key} is not an interval")
+        by_trial = found["goal_rate_by_trial"]
+        if not by_trial["all"] or not all(_fraction(x, "a goal rate") >= 0 for v in by_trial.values() for x in v):
+            raise ValueError("goal_rate_by_trial has no rates")
+        for key in ("environments", "trials", "seed"):
+            if not (isinstance(found[key], int) and found[key] >= 0):
+                raise ValueError(f"{key} is not a count")
 
 
 def run_job(job: plan.Job, root: str | Path, settings: Settings, threads: int | None = None,
@@ -151,7 +198,8 @@ def run_job(job: plan.Job, root: str | Path, settings: Settings, threads: int | 
     t0 = time.perf_counter()
     body = {plan.EVOLVE: _evolve, plan.ROBOT_LIKE: _robot_like, plan.SYSTEM: _system}[job.spec.kind](
         job, root, settings, threads, progress)
-    result = {**_header(job, settings), **body, "wall_s": round(time.perf_counter() - t0, 2)}
+    result = {**_header(job, settings), **body, "wall_s": round(time.perf_counter() - t0, 2),
+              "inputs": _inputs(root, job)}
     path = result_path(root, job)
     path.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(path, json.dumps(result, indent=1) + "\n")
@@ -172,7 +220,7 @@ def _evolve(job: plan.Job, root: Path, settings: Settings, threads: int | None, 
                          eval_seed_base=settings.eval_seed, eval_trials=settings.trials(config.task),
                          dt_check=settings.dt_check, seeding=seeding, resume=resume, progress=progress)
     if run.interrupted:
-        raise Stopped(f"{job.id} stopped at generation {run.last_generation}; its checkpoint is in {out}")
+        raise Stopped(f"{job.id} stopped; its checkpoint is in {out}")
     return {"run": run.to_dict()}
 
 

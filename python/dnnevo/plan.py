@@ -147,6 +147,7 @@ def jobs(seeds: Sequence[int], only: Iterable[str] | None = None) -> list[Job]:
     needs."""
     chosen = families(only)
     if not seeds or any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
-        raise ConfigError(f"seeds must be distinct and >= 0, at least one; got {list(seeds)}")
+        raise ConfigError(f"seeds must be distinct and >= 0, at least one; got {list(seeds)[:10]}"
+                          + (" ..." if len(seeds) > 10 else ""))
     return [Job(e.name, s, tuple(job_id(n, s) for n in e.needs))
             for e in EXPERIMENTS if e.family in chosen for s in seeds]

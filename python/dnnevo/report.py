@@ -16,6 +16,7 @@ from __future__ import annotations
 import base64
 import html
 import math
+import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -60,7 +61,7 @@ def _generation(x: float) -> str:
 
 
 def _median_wall(values: Sequence[float]) -> str:
-    return f"{sorted(values)[len(values) // 2]:.0f} s" if values else "-"
+    return f"{statistics.median(values):.0f} s" if values else "-"
 
 
 def _runs(name: str, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> list[sweep.SeedResult]:

@@ -38,7 +38,7 @@ from dnnevo.errors import ConfigError, DnnevoError
 if TYPE_CHECKING:
     from dnnevo.runsview import RunsView
 
-__all__ = ["CLUSTER_EXTRA", "Outcome", "Task", "dask_client", "run_in_process", "run_on_dask"]
+__all__ = ["CLUSTER_EXTRA", "Outcome", "Task", "check_options", "dask_client", "describe", "run_in_process", "run_on_dask"]
 
 CLUSTER_EXTRA = 'pip install "dnnevo[cluster]"'
 """How to install Dask for dnnevo."""
@@ -104,25 +104,24 @@ def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str,
         futures[task.id] = client.submit(_call, task.fn, task.args, task.kwargs, *needed,
                                          key=f"{task.id}-{token}", pure=False)
     by_key = {f.key: task for task, f in zip(tasks, futures.values(), strict=True)}
-    finished: dict[str, Any] = {}
+    ended: dict[str, tuple[bool, Any]] = {}  # (finished, its result or its error), as it ended
     for future in as_completed(list(futures.values())):
         task = by_key[future.key]
-        finished[task.id] = future
         ok = future.status == "finished"
-        view.finished(Outcome(task, "done" if ok else "failed", future.result() if ok else None),
+        ended[task.id] = (ok, future.result() if ok else future.exception())
+        view.finished(Outcome(task, "done" if ok else "failed", ended[task.id][1] if ok else None),
                       running=_running(client))
     # Decided in order: a task whose need did not finish is skipped, whatever its future says.
     outcomes: dict[str, Outcome] = {}
     for task in tasks:
-        future = finished[task.id]
+        ok, value = ended[task.id]
         missing = _blocked(task, outcomes)
         if missing is not None:
             outcomes[task.id] = Outcome(task, "skipped", message=f"{missing} did not finish")
-        elif future.status == "finished":
-            outcomes[task.id] = Outcome(task, "done", future.result())
+        elif ok:
+            outcomes[task.id] = Outcome(task, "done", value)
         else:
-            error = future.exception()
-            text = str(error) if isinstance(error, DnnevoError) else f"{type(error).__name__}: {error}"
+            text = str(value) if isinstance(value, DnnevoError) else f"{type(value).__name__}: {value}"
             outcomes[task.id] = Outcome(task, "failed", message=text)
     return outcomes
 
@@ -141,30 +140,37 @@ def _running(client: Any) -> int | None:
         return None
 
 
+def check_options(*, workers: int | None, scheduler: str | None) -> None:
+    """The Dask options make sense and Dask is installed; else a one-line :class:`ConfigError`,
+    before anything is written."""
+    if scheduler is not None and workers is not None:
+        raise ConfigError("--workers sizes the local cluster; a --scheduler's cluster has its own workers")
+    if importlib.util.find_spec("distributed") is None:
+        raise ConfigError(f"Dask is not installed; {CLUSTER_EXTRA}")
+
+
 @contextlib.contextmanager
 def dask_client(*, workers: int | None, scheduler: str | None) -> Iterator[Any]:
     """A Dask client: of a new local cluster of ``workers`` processes (default: one per core),
     one task at a time each, or of the running cluster at ``scheduler``. The cluster and its
-    workers end with the block."""
-    if importlib.util.find_spec("distributed") is None:
-        raise ConfigError(f"Dask is not installed; {CLUSTER_EXTRA}")
+    workers end with the block; a running cluster's workers finish the tasks they hold."""
+    check_options(workers=workers, scheduler=scheduler)
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        if workers is not None:
-            raise ConfigError("--workers sizes the local cluster; a --scheduler's cluster has its own workers")
         try:
             client = Client(scheduler, timeout="20s")
-        except OSError as e:
+        except (OSError, ValueError, TypeError) as e:
             raise ConfigError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
         with client:
             yield client
         return
     n = workers if workers is not None else (os.cpu_count() or 1)
     # The scheduler serves HTTP (the dashboard with bokeh) even without a dashboard: on a free
-    # port, never 8787, which another cluster on this machine may hold.
+    # port, never 8787, which another cluster on this machine may hold. A task's own error is
+    # reported by the caller, not as the workers' log of its traceback.
     with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+                      silence_logs=logging.CRITICAL) as cluster, Client(cluster) as client:
         yield client
 
 

@@ -2,26 +2,22 @@
 ETA. On a terminal it is a tqdm bar; otherwise (a log file, CI) one plain line per finished run.
 
 >>> import io
->>> from dnnevo.scheduler import Outcome, Task
 >>> out = io.StringIO()
 >>> view = RunsView(2, stream=out)
->>> view.finished(Outcome(Task("sequence-1bit/seed-0", (), abs), "done"), running=1)
+>>> view.finished("sequence-1bit/seed-0", "done", wall=64.0, running=1)
 >>> out.getvalue().split(";")[0]
-'[1/2] done sequence-1bit/seed-0'
+'[1/2] done sequence-1bit/seed-0 (64 s)'
 """
 
 from __future__ import annotations
 
 import sys
 import time
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import Any, TextIO
 
 from tqdm import tqdm
 
 from dnnevo.progress import clock
-
-if TYPE_CHECKING:
-    from dnnevo.scheduler import Outcome
 
 __all__ = ["RunsView"]
 
@@ -45,10 +41,12 @@ class RunsView:
             self.stream.write(f"[{self.done + 1}/{self.total}] {name} ...\n")
             self.stream.flush()
 
-    def finished(self, outcome: Outcome, *, running: int | None = None) -> None:
-        """Shows that ``outcome``'s job has ended, with ``running`` jobs still going if known."""
+    def finished(self, name: str, status: str, *, wall: float | None = None, message: str = "",
+                 running: int | None = None) -> None:
+        """Shows that run ``name`` has ended with ``status`` (``done``, ``failed``, ...) after
+        ``wall`` seconds, with ``running`` runs still going if known."""
         self.done += 1
-        self.failed += outcome.status != "done"
+        self.failed += status != "done"
         queued = self.total - self.done - (running or 0)
         state = f"{running} running, {queued} queued" if running is not None else f"{queued} to go"
         counts = f"{state}, {self.failed} not done" if self.failed else state
@@ -56,12 +54,11 @@ class RunsView:
             self.bar.set_postfix_str(counts, refresh=False)
             self.bar.update(1)
             return
-        line = f"[{self.done}/{self.total}] {outcome.status} {outcome.task.id}"
-        wall = outcome.result.get("wall_s") if isinstance(outcome.result, dict) else getattr(outcome.result, "wall_s", None)
+        line = f"[{self.done}/{self.total}] {status} {name}"
         if wall is not None:
             line += f" ({wall:.0f} s)"
-        if outcome.message:
-            line += f": {outcome.message}"
+        if message:
+            line += f": {message}"
         self.stream.write(f"{line}; {counts}; ETA {self._eta()}\n")
         self.stream.flush()
 

@@ -88,7 +88,7 @@ def run_in_process(tasks: Sequence[Task], view: RunsView, *,
             except errors as e:
                 outcome = Outcome(task, "failed", message=str(e))
         outcomes[task.id] = outcome
-        view.finished(outcome)
+        view.finished(task.id, outcome.status, wall=_wall(outcome.result), message=outcome.message)
     return outcomes
 
 
@@ -109,7 +109,7 @@ def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str,
         task = by_key[future.key]
         ok = future.status == "finished"
         ended[task.id] = (ok, future.result() if ok else future.exception())
-        view.finished(Outcome(task, "done" if ok else "failed", ended[task.id][1] if ok else None),
+        view.finished(task.id, "done" if ok else "failed", wall=_wall(ended[task.id][1]) if ok else None,
                       running=_running(client))
     # Decided in order: a task whose need did not finish is skipped, whatever its future says.
     outcomes: dict[str, Outcome] = {}
@@ -124,6 +124,12 @@ def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str,
             text = str(value) if isinstance(value, DnnevoError) else f"{type(value).__name__}: {value}"
             outcomes[task.id] = Outcome(task, "failed", message=text)
     return outcomes
+
+
+def _wall(result: Any) -> float | None:
+    """A run's wall time, from its result (a dict or an object with ``wall_s``), if it has one."""
+    wall = result.get("wall_s") if isinstance(result, dict) else getattr(result, "wall_s", None)
+    return float(wall) if isinstance(wall, int | float) else None
 
 
 def _call(fn: Callable[..., Any], args: tuple[Any, ...], kwargs: dict[str, Any], *needed: Any) -> Any:

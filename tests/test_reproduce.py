@@ -10,6 +10,8 @@ import os
 import re
 import shutil
 import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -204,6 +206,40 @@ def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path)
     assert again.returncode == 0 and "(5 already done)" in again.stdout, again.stderr
     other = run_cli(*[a if a != "10" else "11" for a in args])
     assert_one_line_error(other, "eval_trials", "= 10, not 11")
+
+
+#: The command, checkpointing every generation, with Ctrl-C's default handler (a test's
+#: background process may start with SIGINT ignored).
+FREQUENT = ("import signal, sys, dnnevo; signal.signal(signal.SIGINT, signal.default_int_handler); "
+            "sys.modules['dnnevo.evolve'].CHECKPOINT_SECONDS = 0.0; "
+            "from dnnevo.cli import main; sys.exit(main(sys.argv[1:]))")
+
+
+def test_ctrl_c_stops_a_reproduction_that_then_continues_to_the_same_results(tmp_path: Path) -> None:
+    args = ["reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--set", "generations=60",
+            "--eval-trials", "10", "--no-dt-check", "--in-process", "--threads-per-worker", "1"]
+    stopped = tmp_path / "stopped"
+    proc = subprocess.Popen([sys.executable, "-c", FREQUENT, *args, "--out", str(stopped)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    checkpoint = stopped / "landmark" / "seed-0" / "checkpoint.json"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not _at_generation(checkpoint, 3):
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (out, err)
+    assert "run the same command again to continue" in err and "Traceback" not in err
+    assert jobs.read_result(stopped, plan.Job("landmark", 0, ()), jobs.Settings(
+        quick=True, eval_trials=10, dt_check=False, overrides=("generations=60",))) is None
+    again = run_cli(*args, "--out", stopped)
+    assert again.returncode == 0 and "(0 already done)" in again.stdout, again.stderr
+    whole = tmp_path / "whole"
+    assert run_cli(*args, "--out", whole).returncode == 0
+    for job in plan.jobs([0], only=["landmark"]):
+        a = json.loads(jobs.result_path(stopped, job).read_text())
+        b = json.loads(jobs.result_path(whole, job).read_text())
+        assert without_wall(a) == without_wall(b), job.id
+    same_run(stopped / "landmark" / "seed-0", whole / "landmark" / "seed-0")
 
 
 def test_reproduce_names_bad_input_in_one_line(tmp_path: Path) -> None:

@@ -91,6 +91,9 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                     "composite of the two champions (no cross weights) and its mutants"),
     Experiment("sequence-2bit-direct", "sequence", EVOLVE, "§5.3: failed (not quantified)",
                preset="sequence-2bit-direct"),
+    Experiment("sequence-2bit-direct16", "sequence", EVOLVE, "not in the paper",
+               preset="sequence-2bit-direct16",
+               note="the direct route with 16 neurons, rank selection and 20 elites"),
     Experiment("sequence-3bit", "sequence", EVOLVE, "§5.4: 1 success, at generation 700",
                preset="sequence-3bit"),
 )

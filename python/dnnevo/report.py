@@ -23,7 +23,7 @@ from pathlib import Path
 
 from dnnevo import plan, stats, sweep
 from dnnevo.assess import Assessment
-from dnnevo.jobs import ROBOT_SEED_BASE, Settings
+from dnnevo.jobs import ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings
 from dnnevo.rundir import save_figure, write_atomic
 from dnnevo.scheduler import Outcome
 
@@ -175,7 +175,7 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
         first = done[0]
         parts = [nav1d.load_part(root / plan.job_id(n, first.seed)) for n in e.needs]
         (root / first.id).mkdir(parents=True, exist_ok=True)
-        draw_system(parts, 5, root / first.id / "fig2-system.png")
+        draw_system(parts, SYSTEM_TRIALS, root / first.id / "fig2-system.png")
         blocks.append(Block("img", f"{e.name}, seed {first.seed}: Fig. 2 of the integrated system",
                             path=f"{first.id}/fig2-system.png"))
     return blocks

@@ -14,6 +14,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod aggregate;
 mod common;
 pub mod landmark;
 mod lanes;
@@ -22,10 +23,11 @@ pub mod registry;
 mod run_config;
 pub mod sequence;
 
+pub use aggregate::Aggregate;
 pub use common::{MAX_COUNT, TIME_STEP};
 pub use registry::{build, names};
 pub use run_config::RunConfig;
 pub use sequence::{
-    performance, Aggregate, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask,
-    TargetReport, TrialRecord,
+    performance, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask, TargetReport,
+    TrialRecord,
 };

@@ -4,6 +4,7 @@
 use ctrnn::{Error, Integrator, Result};
 
 use crate::common::TIME_STEP;
+use crate::Aggregate;
 use serde::{Deserialize, Serialize};
 
 use super::environment::Environment;
@@ -110,6 +111,10 @@ pub struct Nav1dConfig {
     pub trials_per_environment: usize,
     /// Chains per environment type in one `"single"` evaluation. Default 2.
     pub chains_per_environment: usize,
+    /// How the environment types' scores make one fitness: `"mean"` over all scored trials
+    /// (default), the worst type's mean (`"min"`), or the mean of the two (`"mean-min"`). With
+    /// `"min"` a network that solves one type and guesses in the other scores as a guesser.
+    pub aggregate: Aggregate,
     /// Fresh chains (of the success check's length) in a run's validation set, on which the best
     /// candidates of each generation are judged to choose the champion. Default 40.
     pub validation_chains: usize,
@@ -146,6 +151,7 @@ impl Default for Nav1dConfig {
             chained: false,
             trials_per_environment: 5,
             chains_per_environment: 2,
+            aggregate: Aggregate::Mean,
             validation_chains: 40,
             start_jitter: 0.0,
             landmark_jitter: 0.0,

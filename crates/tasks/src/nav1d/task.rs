@@ -11,6 +11,7 @@ use super::environment::Environment;
 use super::world::{run_chains, Condition, Side};
 use crate::common::{check_inputs, config_from_params};
 use crate::lanes::{by_block, by_pair, pairs};
+use crate::Aggregate;
 
 /// The fraction of scored trials a network must get right on fresh conditions to have solved its
 /// objective.
@@ -245,8 +246,9 @@ impl Nav1dTask {
     }
 
     /// The fitness of every network in `generation`: the mean score over the scored trials of
-    /// [`chains`](Self::chains). Blocks of [`LANES`] networks run in parallel. Stops with
-    /// [`Error::Interrupted`] between chains once `cancel` is set.
+    /// [`chains`](Self::chains), or, as `aggregate` says, the worst environment type's mean
+    /// score. Blocks of [`LANES`] networks run in parallel. Stops with [`Error::Interrupted`]
+    /// between chains once `cancel` is set.
     pub fn scores(
         &self,
         networks: &[Network],
@@ -259,12 +261,15 @@ impl Nav1dTask {
             return Ok(vec![]);
         }
         let chains = self.chains(seed, generation);
+        let types = &self.config.environments;
+        let type_of = |chain: &[Condition]| types.iter().position(|&e| e == chain[0].environment);
+        let aggregate = self.config.aggregate;
         by_block(
             networks,
             chains.len(),
             cancel,
-            |len| ([0.0; LANES], 0usize, len),
-            |(sum, count, _), _, block, c| {
+            |len| Totals::new(types.len(), len),
+            |totals, _, block, c| {
                 let chain = &chains[c];
                 let outcome = run_chains(
                     &self.config,
@@ -273,20 +278,21 @@ impl Nav1dTask {
                     true,
                     |_, _, _| {},
                 )?;
+                let of_type = type_of(chain).unwrap_or(0);
                 for (t, condition) in chain.iter().enumerate() {
                     let mut scored = false;
                     for l in 0..LANES {
                         let (r, c) = (outcome.reached[t][l], outcome.classification[t][l]);
                         if let Some((score, _)) = self.judge(t, condition, r, c) {
-                            sum[l] += score;
+                            totals.add(of_type, l, score);
                             scored = true;
                         }
                     }
-                    *count += usize::from(scored);
+                    totals.count(of_type, scored);
                 }
                 Ok(())
             },
-            |(sum, count, len)| sum[..len].iter().map(|s| s / count as f64).collect(),
+            |totals| totals.fitness(aggregate),
         )
     }
 
@@ -544,5 +550,54 @@ impl Task for Nav1dTask {
                 })
                 .collect(),
         ))
+    }
+}
+
+/// The running sums of one block's scores: over all scored trials, and per environment type.
+struct Totals {
+    sum: [f64; LANES],
+    count: usize,
+    by_type: Vec<([f64; LANES], usize)>,
+    len: usize,
+}
+
+impl Totals {
+    fn new(types: usize, len: usize) -> Self {
+        Totals {
+            sum: [0.0; LANES],
+            count: 0,
+            by_type: vec![([0.0; LANES], 0); types],
+            len,
+        }
+    }
+
+    fn add(&mut self, of_type: usize, lane: usize, score: f64) {
+        self.sum[lane] += score;
+        self.by_type[of_type].0[lane] += score;
+    }
+
+    fn count(&mut self, of_type: usize, scored: bool) {
+        self.count += usize::from(scored);
+        self.by_type[of_type].1 += usize::from(scored);
+    }
+
+    /// Each lane's fitness: the mean over all scored trials, combined as `aggregate` says with
+    /// the worst type's mean (types without a scored trial are left out).
+    fn fitness(&self, aggregate: Aggregate) -> Vec<f64> {
+        (0..self.len)
+            .map(|l| {
+                let overall = self.sum[l] / self.count as f64;
+                if aggregate == Aggregate::Mean {
+                    return overall;
+                }
+                let worst = self
+                    .by_type
+                    .iter()
+                    .filter(|(_, n)| *n > 0)
+                    .map(|(sum, n)| sum[l] / *n as f64)
+                    .fold(f64::INFINITY, f64::min);
+                aggregate.combine(overall, worst)
+            })
+            .collect()
     }
 }

@@ -2,6 +2,7 @@ use ctrnn::genome::{self, Ranges};
 use ctrnn::{Network, Stream, Task};
 
 use super::*;
+use crate::Aggregate;
 
 /// A network with zero weights whose neuron `i` fires at the constant rate `f(-theta[i])`.
 fn constant(theta: &[f64], m: usize) -> Network {
@@ -197,6 +198,55 @@ fn batched_evaluation_equals_the_record_and_ignores_threads() {
         let single = one.install(|| t.evaluate(&nets, 4, 9, None).unwrap());
         assert_eq!(single, fitness);
     }
+}
+
+#[test]
+fn min_aggregates_score_the_worst_environment_type() {
+    // Per type, the mean over that type's scored trials, recomputed from records in chain order.
+    for objective in [Objective::Goal, Objective::Single] {
+        let mut config = jittered(objective, World::Continuous);
+        let base = task(config.clone());
+        let nets = random_networks(19, 5, 2, 12);
+        let chains = base.chains(9, 4);
+        let means = base.evaluate(&nets, 4, 9, None).unwrap();
+        let mut saw_a_gap = false;
+        for aggregate in [Aggregate::Min, Aggregate::MeanMin] {
+            config.aggregate = aggregate;
+            let fitness = task(config.clone()).evaluate(&nets, 4, 9, None).unwrap();
+            for (p, net) in nets.iter().enumerate() {
+                let mut by_type = [(0.0, 0usize); 2];
+                for chain in &chains {
+                    let i = usize::from(chain[0].environment == Environment::Near);
+                    let rec = base.record(net, chain, true).unwrap();
+                    for (k, c) in chain.iter().enumerate() {
+                        if let Some((s, _)) =
+                            base.judge(k, c, rec.reached[k], rec.classification[k])
+                        {
+                            by_type[i].0 += s;
+                            by_type[i].1 += 1;
+                        }
+                    }
+                }
+                let worst = by_type
+                    .iter()
+                    .map(|&(sum, n)| sum / n as f64)
+                    .fold(f64::INFINITY, f64::min);
+                let want = match aggregate {
+                    Aggregate::Min => worst,
+                    _ => 0.5 * (means[p] + worst),
+                };
+                assert_eq!(fitness[p].to_bits(), want.to_bits(), "{objective:?} {p}");
+                assert!(fitness[p] <= means[p]);
+                saw_a_gap |= fitness[p] < means[p];
+            }
+        }
+        assert!(
+            saw_a_gap,
+            "{objective:?}: no network did better in one type than the other"
+        );
+    }
+    let e = Nav1dTask::from_params(&serde_json::json!({"aggregate": "median"})).unwrap_err();
+    assert!(e.to_string().contains("aggregate"), "{e}");
 }
 
 #[test]

@@ -6,6 +6,7 @@ use ctrnn::{Error, Integrator, Result};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::common::{config_from_params, TIME_STEP};
+use crate::Aggregate;
 
 /// What the two sensors are, for error messages.
 pub(super) const SENSORS: &str = "trigger, reinforcement";
@@ -90,20 +91,6 @@ pub enum Clamp {
     Evaluation,
 }
 
-/// How the scores of the targets make one fitness.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Aggregate {
-    /// The mean over all trials (every target has as many): the paper's.
-    #[default]
-    Mean,
-    /// The worst target's score (each target's score is the mean over its trials, clamped as
-    /// `clamp` says): a network is only as good as the target it learns least.
-    Min,
-    /// The mean of `mean` and `min`: rewards every target, and the weakest twice.
-    MeanMin,
-}
-
 /// The sequence-learning experiment's settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -132,7 +119,8 @@ pub struct SequenceConfig {
     pub perf_base: PerfBase,
     /// Where the performance score is clamped at 0. Default `"trial"`.
     pub clamp: Clamp,
-    /// How the targets' scores make one fitness. Default `"mean"`.
+    /// How the targets' scores make one fitness (each target's score is the mean over its
+    /// trials, clamped as `clamp` says). Default `"mean"`.
     pub aggregate: Aggregate,
     /// How one time step is integrated; `dt * substeps` is the length of a time step in units of
     /// simulated time. Default 10 Euler steps of dt = 0.1.

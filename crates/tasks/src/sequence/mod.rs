@@ -73,7 +73,8 @@ mod scoring;
 mod task;
 mod trial;
 
-pub use config::{Aggregate, Clamp, PerfBase, SequenceConfig};
+pub use crate::Aggregate;
+pub use config::{Clamp, PerfBase, SequenceConfig};
 pub use scoring::{performance, warmup, SUCCESS_FRACTION, SUCCESS_TRIALS};
 pub use task::{Assessment, Scores, SequenceTask, TargetReport, TrialRecord};
 

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::common::check_inputs;
 use crate::lanes::{by_block, by_pair, pairs};
+use crate::Aggregate;
 
 use super::config::*;
 use super::scoring::*;
@@ -320,10 +321,7 @@ impl SequenceTask {
                 Clamp::Evaluation => score(mean(of_target), b),
             })
             .fold(f64::INFINITY, f64::min);
-        match config.aggregate {
-            Aggregate::Min => worst,
-            Aggregate::MeanMin | Aggregate::Mean => 0.5 * (overall + worst),
-        }
+        config.aggregate.combine(overall, worst)
     }
 
     /// One trial of target `targets[target]` for `net`, with `timing[k]` the (delay, gap) of

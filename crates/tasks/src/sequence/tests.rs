@@ -3,6 +3,7 @@
 use super::config::*;
 use super::scoring::*;
 use super::task::*;
+use crate::Aggregate;
 use ctrnn::genome::{self, Ranges};
 use ctrnn::{Error, Layout, Method, Network, Purpose, Stream, Task};
 use std::sync::atomic::AtomicBool;

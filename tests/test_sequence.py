@@ -268,3 +268,11 @@ def test_assess_reports_every_target():
         assert t["success_fraction"] in (0.0, 1 / 3, 2 / 3, 1.0)
         assert t["succeeded"] == (t["success_fraction"] >= 0.9)
     assert report["success"] == all(t["succeeded"] for t in report["targets"])
+
+
+def test_fig5_shows_the_papers_pair_when_the_task_has_it() -> None:
+    from dnnevo._cli_sequence import fig5_pair
+
+    assert fig5_pair(["0", "1", "01", "10"]) == ("01", "0")
+    assert fig5_pair(["0", "1"]) == ("1", "0")
+    assert fig5_pair(["01", "10"]) == ("10", "01")

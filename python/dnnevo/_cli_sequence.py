@@ -63,9 +63,23 @@ def switch_lines(test: dict[str, Any]) -> list[str]:
     return lines
 
 
+def fig5_pair(targets: list[str]) -> tuple[str, str]:
+    """The two targets of Fig. 5: the paper's (01)* then 0* when the task has both, otherwise the
+    last target then the first.
+
+    >>> fig5_pair(["0", "1", "01", "10"])
+    ('01', '0')
+    >>> fig5_pair(["0", "1"])
+    ('1', '0')
+    """
+    if "01" in targets and "0" in targets:
+        return "01", "0"
+    return targets[-1], targets[0]
+
+
 def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
     """``dnnevo plot`` for a ``sequence`` run: Fig. 4 (a trial of each target) and, with two or
-    more targets, Fig. 5 (the switch test)."""
+    more targets, Fig. 5 (the switch test, on :func:`fig5_pair`)."""
     import matplotlib.pyplot as plt
 
     from dnnevo.plot import plot_sequence_trial
@@ -81,11 +95,12 @@ def plot(run: RunDir, config: EvolutionConfig, seed: int) -> list[str]:
     plt.close(fig)
     written = ["fig4-trials.png"]
     if len(targets) >= 2:
+        first, second = fig5_pair(targets)
         timing = sequence.timings(config, seed, 0, 0) + sequence.timings(config, seed, 0, 1)
-        a, b, needed = sequence.switch_trial(config, champion, targets[-1], targets[0], timing)
+        a, b, needed = sequence.switch_trial(config, champion, first, second, timing)
         fig, ax = plt.subplots(figsize=(11, 3), layout="constrained")
         plot_sequence_trial(a, ax=ax, follow=b, title=(
-            f"{targets[-1]}* for {sequence.SWITCH_AFTER} triggers, then {targets[0]}* without reset "
+            f"{first}* for {sequence.SWITCH_AFTER} triggers, then {second}* without reset "
             f"({'settled after ' + str(needed) + ' trigger(s)' if needed is not None else 'never settled'})"))
         save_figure(fig, run.path / "fig5-switch.png")
         plt.close(fig)

@@ -27,6 +27,9 @@ pub mod network;
 pub mod population;
 mod rows;
 pub mod simd;
+// Internals for ctrnn's own integration tests (tests/unit); not public API.
+#[doc(hidden)]
+pub mod testing;
 pub mod validation;
 mod vector;
 

@@ -21,14 +21,14 @@ const VALUES_PER_LINE: usize = 8;
 
 /// `len` rows of `L` values, 64-byte aligned; dereferences to `[[f64; L]]`.
 #[derive(Clone, Debug)]
-pub(crate) struct Rows<const L: usize> {
+pub struct Rows<const L: usize> {
     lines: Vec<Line>,
     len: usize,
 }
 
 impl<const L: usize> Rows<L> {
     /// `len` rows of zeros.
-    pub(crate) fn zeros(len: usize) -> Self {
+    pub fn zeros(len: usize) -> Self {
         let lines = vec![Line([0.0; VALUES_PER_LINE]); (len * L).div_ceil(VALUES_PER_LINE)];
         Rows { lines, len }
     }
@@ -48,30 +48,5 @@ impl<const L: usize> DerefMut for Rows<L> {
     fn deref_mut(&mut self) -> &mut [[f64; L]] {
         let flat: &mut [f64] = bytemuck::cast_slice_mut(&mut self.lines);
         flat[..self.len * L].as_chunks_mut().0
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rows_are_aligned_packed_and_hold_their_values() {
-        let mut rows = Rows::<3>::zeros(3);
-        rows.copy_from_slice(&[[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]);
-        assert_eq!(rows.len(), 3);
-        assert_eq!(rows[1], [4.0, 5.0, 6.0]);
-        assert!((rows.as_ptr() as usize).is_multiple_of(64));
-        assert_eq!(
-            rows.as_flattened(),
-            &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
-        );
-        let mut wide = Rows::<16>::zeros(5);
-        wide[4][15] = 1.0;
-        assert!(wide
-            .iter()
-            .all(|r| (r.as_ptr() as usize).is_multiple_of(64)));
-        assert_eq!(wide.as_flattened().iter().sum::<f64>(), 1.0);
-        assert!(Rows::<1>::zeros(0).is_empty());
     }
 }

@@ -82,7 +82,7 @@ fn distance(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The largest distance (max norm) from a point of either orbit to the other orbit.
-pub(crate) fn orbit_gap(a: &Cycle, b: &Cycle) -> f64 {
+pub fn orbit_gap(a: &Cycle, b: &Cycle) -> f64 {
     let one_way = |p: &[Vec<f64>], q: &[Vec<f64>]| {
         p.iter()
             .map(|x| {
@@ -101,20 +101,21 @@ fn size(c: &Cycle) -> f64 {
 
 /// Whether `new` (at the next input value) continues `old`: their orbits lie within the larger
 /// of their sizes of each other.
-pub(crate) fn continues(old: &Cycle, new: &Cycle) -> bool {
+pub fn continues(old: &Cycle, new: &Cycle) -> bool {
     orbit_gap(old, new) <= size(old).max(size(new))
 }
 
 /// The cycles at one value, each with its branch id (None: new) and its gap to the cycle it
 /// continues.
-pub(crate) struct Here {
-    pub(crate) cycles: Vec<(Cycle, Option<usize>, f64)>,
+pub struct Here {
+    /// Each cycle, with its branch id and its gap to the cycle it continues.
+    pub cycles: Vec<(Cycle, Option<usize>, f64)>,
 }
 
 impl Here {
     /// Adds `cycle`, reached by continuation of branch `id` at gap `gap`: merged with the same
     /// cycle if present, where the smaller gap keeps its branch.
-    pub(crate) fn continued(&mut self, cycle: Cycle, id: usize, gap: f64) {
+    pub fn continued(&mut self, cycle: Cycle, id: usize, gap: f64) {
         match self.cycles.iter_mut().find(|h| same_cycle(&h.0, &cycle)) {
             Some(h) if gap < h.2 => *h = (cycle, Some(id), gap),
             Some(_) => {}
@@ -123,7 +124,7 @@ impl Here {
     }
 
     /// Adds a cycle the search found from its own starts, unless it is already here.
-    pub(crate) fn fresh(&mut self, cycle: Cycle) {
+    pub fn fresh(&mut self, cycle: Cycle) {
         if !self.cycles.iter().any(|h| same_cycle(&h.0, &cycle)) {
             self.cycles.push((cycle, None, f64::INFINITY));
         }
@@ -160,7 +161,7 @@ pub(crate) fn cycles_at(
 
 /// Locates the end of a branch between `with_cycle` (where it has `cycle`) and `without_cycle`.
 /// `step` is the signed step from `with_cycle` to `without_cycle`.
-pub(crate) fn locate(
+pub fn locate(
     at: &At<'_>,
     settings: &CycleSearch,
     with_cycle: f64,

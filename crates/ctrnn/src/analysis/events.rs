@@ -72,7 +72,7 @@ fn det_sign(field: &Field<'_>, v: &[f64]) -> f64 {
 }
 
 /// Everything needed to look at the system at one input value.
-pub(crate) struct At<'a> {
+pub struct At<'a> {
     net: &'a Network,
     base: Vec<f64>,
     input: usize,
@@ -81,12 +81,7 @@ pub(crate) struct At<'a> {
 
 impl<'a> At<'a> {
     /// `net` with input `input` swept, the others held at `base`.
-    pub(crate) fn new(
-        net: &'a Network,
-        base: &[f64],
-        input: usize,
-        search: EquilibriumSearch,
-    ) -> Self {
+    pub fn new(net: &'a Network, base: &[f64], input: usize, search: EquilibriumSearch) -> Self {
         At {
             net,
             base: base.to_vec(),

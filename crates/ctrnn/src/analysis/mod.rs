@@ -26,14 +26,12 @@
 //! ```
 
 mod bifurcation;
-mod branches;
+pub(crate) mod branches;
 mod cycles;
-mod equilibria;
-mod events;
+pub(crate) mod equilibria;
+pub(crate) mod events;
 mod field;
-mod stability;
-#[cfg(test)]
-mod tests;
+pub(crate) mod stability;
 
 pub use bifurcation::{bifurcation, Bifurcation, Sweep};
 pub use branches::{CycleBranch, CycleEnd, CycleEndKind, CYCLE_BISECTIONS};

@@ -67,7 +67,7 @@ impl Stability {
 
 /// The eigenvalues of a square matrix as `[re, im]` pairs, sorted by real part, largest first
 /// (then by imaginary part, positive first).
-pub(crate) fn eigenvalues(m: DMatrix<f64>) -> Result<Vec<[f64; 2]>> {
+pub fn eigenvalues(m: DMatrix<f64>) -> Result<Vec<[f64; 2]>> {
     let n = m.nrows();
     let schur = Schur::try_new(m, f64::EPSILON, 1000 * n.max(1)).ok_or_else(|| {
         Error::InvalidArgument(

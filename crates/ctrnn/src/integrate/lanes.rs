@@ -297,8 +297,7 @@ impl<const L: usize> Lanes<L> {
     }
 
     /// [`step_row`](Self::step_row) on a given kernel, which the CPU must support.
-    #[cfg(test)]
-    pub(super) fn step_row_on(&mut self, kernel: Kernel, inputs: &[[f64; L]], integ: &Integrator) {
+    pub(crate) fn step_row_on(&mut self, kernel: Kernel, inputs: &[[f64; L]], integ: &Integrator) {
         self.advance_on(kernel, Some(inputs), integ);
     }
 

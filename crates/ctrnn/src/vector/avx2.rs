@@ -17,13 +17,13 @@ use super::{Arith, Vector, ROUND_SHIFT};
 /// # Safety
 /// The CPU must have AVX2 and FMA ([`crate::simd::Kernel::Avx2`] is supported).
 #[target_feature(enable = "avx2,fma")]
-pub(crate) unsafe fn enabled<R>(f: impl FnOnce() -> R) -> R {
+pub unsafe fn enabled<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
 /// Four `f64` lanes in a 256-bit register.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Avx2(__m256d);
+pub struct Avx2(__m256d);
 
 macro_rules! avx2_op {
     ($trait:ident, $method:ident, $intrinsic:ident) => {

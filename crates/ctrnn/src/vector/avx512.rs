@@ -17,13 +17,13 @@ use super::{Arith, Vector};
 /// # Safety
 /// The CPU must have AVX-512F, AVX2 and FMA ([`crate::simd::Kernel::Avx512`] is supported).
 #[target_feature(enable = "avx512f,avx2,fma")]
-pub(crate) unsafe fn enabled<R>(f: impl FnOnce() -> R) -> R {
+pub unsafe fn enabled<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
 /// Eight `f64` lanes in a 512-bit register.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Avx512(__m512d);
+pub struct Avx512(__m512d);
 
 macro_rules! avx512_op {
     ($trait:ident, $method:ident, $intrinsic:ident) => {

@@ -14,7 +14,7 @@ use super::{Arith, Vector, ROUND_SHIFT};
 
 /// Two `f64` lanes in a 128-bit register.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Neon(float64x2_t);
+pub struct Neon(float64x2_t);
 
 macro_rules! neon_op {
     ($trait:ident, $method:ident, $intrinsic:ident) => {

@@ -2,9 +2,9 @@
 
 use nalgebra::DMatrix;
 
-use super::stability::eigenvalues;
-use super::*;
-use crate::{Integrator, Method, Network};
+use ctrnn::analysis::*;
+use ctrnn::testing::analysis::{draws, eigenvalues, At};
+use ctrnn::{Integrator, Method, Network};
 
 fn logit(p: f64) -> f64 {
     (p / (1.0 - p)).ln()
@@ -241,8 +241,8 @@ fn hopf_points_have_a_pair_on_the_imaginary_axis() {
 }
 
 fn random_net(n: usize, seed: u64) -> Network {
-    let mut d = super::equilibria::Draws::new(seed);
-    let mut u = |lo: f64, hi: f64| lo + (hi - lo) * d.next();
+    let mut d = draws(seed);
+    let mut u = |lo: f64, hi: f64| lo + (hi - lo) * d();
     let tau = (0..n).map(|_| u(0.5, 5.0)).collect();
     let theta = (0..n).map(|_| u(-8.0, 8.0)).collect();
     let w = (0..n * n).map(|_| u(-16.0, 16.0)).collect();
@@ -313,7 +313,7 @@ fn a_search_is_deterministic_and_more_starts_find_no_fewer() {
 #[test]
 fn bad_arguments_are_typed_errors() {
     let net = one(8.0, 4.0);
-    let msg = |e: crate::Error| e.to_string();
+    let msg = |e: ctrnn::Error| e.to_string();
     let e = msg(equilibria(&net, &[], &EquilibriumSearch::default()).unwrap_err());
     assert!(
         e.contains("input has 0 values") && e.contains("M = 1"),
@@ -358,7 +358,7 @@ fn bad_arguments_are_typed_errors() {
     let osc = centre_pair(5.5, 2.0, 1.0);
     assert!(matches!(
         limit_cycles(&osc, &[0.0], &CycleSearch::default(), Some(&cancel)),
-        Err(crate::Error::Interrupted)
+        Err(ctrnn::Error::Interrupted)
     ));
 }
 
@@ -527,8 +527,8 @@ fn a_cycle_branch_is_followed_and_one_lost_is_located_by_bisection() {
     let branch = &b.branches[0];
     let last = b.values[branch.last];
     let settings = cycle_sweep(0.0, 2.0, 24).cycles.unwrap();
-    let at = super::events::At::new(&net, &[0.0], 0, EquilibriumSearch::default());
-    let end = super::branches::locate(
+    let at = At::new(&net, &[0.0], 0, EquilibriumSearch::default());
+    let end = ctrnn::testing::analysis::locate(
         &at,
         &settings,
         last,
@@ -653,7 +653,7 @@ fn folds_at_one_input_value_are_different_pairs_each_reported_once() {
 /// The seed-0 sequence-3bit champion (`dnnevo run sequence-3bit --seed 0`).
 fn three_bit_champion() -> Network {
     let text = include_str!("../../../../tests/data/sequence-3bit-seed0-champion.json");
-    crate::io::from_json(text).unwrap().network
+    ctrnn::io::from_json(text).unwrap().network
 }
 
 #[test]
@@ -703,7 +703,7 @@ fn the_3bit_champions_two_folds_near_0_4374_are_two_pairs() {
 
 #[test]
 fn two_branches_reaching_one_cycle_leave_it_to_the_closer() {
-    use super::branches::{continues, orbit_gap, Here};
+    use ctrnn::testing::analysis::{continues, orbit_gap, Here};
     let net = centre_pair(5.5, 2.0, 1.0);
     let c = limit_cycles(&net, &[0.0], &CycleSearch::default(), None).unwrap()[0].clone();
     assert!(orbit_gap(&c, &c) == 0.0 && continues(&c, &c));

@@ -1,0 +1,297 @@
+use std::sync::atomic::AtomicBool;
+
+use ctrnn::evolve::*;
+use ctrnn::ga::{self, GaConfig};
+use ctrnn::genome::{self, Layout};
+use ctrnn::{Network, Purpose, Result, Stream, Validation};
+
+#[test]
+fn huge_layouts_and_populations_are_errors_not_aborts() {
+    let config = GaConfig::default();
+    for (size, n_inputs) in [
+        (1_000_000, 1),
+        (usize::MAX / 2, usize::MAX / 2),
+        (3, usize::MAX),
+    ] {
+        let e = Evolution::new(
+            Layout { size, n_inputs },
+            config.clone(),
+            0,
+            &[],
+            Fill::Mutants,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("the limit is"), "{e}");
+    }
+    let big = GaConfig {
+        population: 1_000_000_000_000,
+        ..GaConfig::default()
+    };
+    let e = Evolution::new(
+        Layout {
+            size: 5,
+            n_inputs: 2,
+        },
+        big,
+        0,
+        &[],
+        Fill::Mutants,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("TiB") && e.contains("the limit is"), "{e}");
+}
+
+/// Fitness: how close neuron 0's firing rate is to 1 after a short run from rest.
+struct Excite;
+impl Task for Excite {
+    fn layout(&self) -> Layout {
+        Layout {
+            size: 2,
+            n_inputs: 1,
+        }
+    }
+    fn evaluate(
+        &self,
+        networks: &[Network],
+        _generation: u64,
+        _seed: u64,
+        _cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        networks
+            .iter()
+            .map(|n| {
+                let mut n = n.clone();
+                n.run(&[1.0; 5], 5, &ctrnn::Integrator::default())?;
+                Ok(n.outputs()[0])
+            })
+            .collect()
+    }
+}
+
+fn excite(net: &Network) -> f64 {
+    let mut n = net.clone();
+    n.run(&[1.0; 5], 5, &ctrnn::Integrator::default()).unwrap();
+    n.outputs()[0]
+}
+
+/// Training fitness is half luck: a bonus drawn per (generation, genome), so the fittest
+/// individual of a generation is often a lucky one. Validation sees the true quality,
+/// Excite's score, and counts the networks it validated.
+#[derive(Default)]
+struct Lucky {
+    validated: std::sync::atomic::AtomicUsize,
+}
+impl Task for Lucky {
+    fn layout(&self) -> Layout {
+        Excite.layout()
+    }
+    fn evaluate(
+        &self,
+        networks: &[Network],
+        generation: u64,
+        seed: u64,
+        _cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        Ok(networks
+            .iter()
+            .map(|n| {
+                let bits = genome::encode(n).iter().fold(0u64, |h, g| h ^ g.to_bits());
+                let luck = Stream::new(seed, generation, Purpose::Trial, bits, 0).uniform();
+                0.5 * excite(n) + 0.5 * luck
+            })
+            .collect())
+    }
+    fn validate(
+        &self,
+        networks: &[Network],
+        _seed: u64,
+        _cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        self.validated
+            .fetch_add(networks.len(), std::sync::atomic::Ordering::Relaxed);
+        Ok(Some(
+            networks
+                .iter()
+                .map(|n| Validation {
+                    rate: excite(n),
+                    score: 0.0,
+                })
+                .collect(),
+        ))
+    }
+}
+
+fn config() -> GaConfig {
+    GaConfig {
+        population: 40,
+        ..GaConfig::default()
+    }
+}
+
+#[test]
+fn validation_picks_the_champion_and_leaves_evolution_unchanged() {
+    let task = Lucky::default();
+    let plain = GaConfig {
+        validation_candidates: 0,
+        ..config()
+    };
+    let mut a = Evolution::new(task.layout(), config(), 3, &[], Fill::Mutants).unwrap();
+    let mut b = Evolution::new(task.layout(), plain, 3, &[], Fill::Mutants).unwrap();
+    let mut best_seen = f64::NEG_INFINITY;
+    for _ in 0..15 {
+        a.step(&task, None).unwrap();
+        b.step(&task, None).unwrap();
+        assert_eq!(
+            a.population, b.population,
+            "validation must not change evolution"
+        );
+        let champ = a.champion.as_ref().unwrap();
+        let v = champ.validation.expect("chosen by validation");
+        assert!(
+            v.rate >= best_seen,
+            "the champion's validation never gets worse"
+        );
+        best_seen = v.rate;
+        assert_eq!(v.rate, excite(&a.champion_network().unwrap().unwrap()));
+    }
+    let by_fitness = b.champion.as_ref().unwrap();
+    assert!(by_fitness.validation.is_none());
+    let (va, vb) = (
+        excite(&a.champion_network().unwrap().unwrap()),
+        excite(&b.champion_network().unwrap().unwrap()),
+    );
+    assert!(
+        va > vb,
+        "validated champion {va} should beat the lucky one {vb}"
+    );
+}
+
+#[test]
+fn validated_runs_resume_identically_and_elites_are_validated_once() {
+    let task = Lucky::default();
+    let elitist = GaConfig {
+        elitism: 5,
+        ..config()
+    };
+    let mut a = Evolution::new(task.layout(), elitist, 8, &[], Fill::Mutants).unwrap();
+    for _ in 0..4 {
+        a.step(&task, None).unwrap();
+    }
+    let mut b = Evolution::from_json(&a.to_json()).unwrap();
+    let counted = task.validated.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(
+        counted < 4 * 10,
+        "elites carried over are not validated again: {counted}"
+    );
+    for _ in 0..4 {
+        a.step(&task, None).unwrap();
+        b.step(&task, None).unwrap();
+    }
+    assert_eq!(a.champion, b.champion);
+    assert_eq!(a.population, b.population);
+    assert_eq!(a.to_json(), b.to_json());
+}
+
+#[test]
+fn tasks_without_validation_and_old_checkpoints_choose_by_fitness() {
+    let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
+    evo.step(&Excite, None).unwrap();
+    let champ = evo.champion.clone().unwrap();
+    assert!(champ.validation.is_none());
+    let old: serde_json::Value = serde_json::json!({"population": 10});
+    let read: GaConfig = serde_json::from_value(old).unwrap();
+    assert_eq!(read.validation_candidates, 0);
+    assert_eq!(
+        GaConfig::default().validation_candidates,
+        ga::VALIDATION_CANDIDATES
+    );
+}
+
+#[test]
+fn fitness_improves_and_champion_is_kept() {
+    let mut evo = Evolution::new(Excite.layout(), config(), 5, &[], Fill::Mutants).unwrap();
+    let first = evo.step(&Excite, None).unwrap().0;
+    for _ in 0..10 {
+        evo.step(&Excite, None).unwrap();
+    }
+    let champ = evo.champion.clone().unwrap();
+    assert!(champ.fitness >= first.best);
+    assert_eq!(evo.generation, 11);
+}
+
+#[test]
+fn checkpoint_resume_is_identical() {
+    let mut a = Evolution::new(Excite.layout(), config(), 9, &[], Fill::Mutants).unwrap();
+    for _ in 0..3 {
+        a.step(&Excite, None).unwrap();
+    }
+    let mut b = Evolution::from_json(&a.to_json()).unwrap();
+    for _ in 0..3 {
+        a.step(&Excite, None).unwrap();
+        b.step(&Excite, None).unwrap();
+    }
+    assert_eq!(a, b);
+    for (x, y) in a.population.iter().zip(&b.population) {
+        assert_eq!(x.to_bits(), y.to_bits());
+    }
+}
+
+#[test]
+fn seeding_places_seeds_and_fills() {
+    let layout = Excite.layout();
+    let net = Network::new(
+        vec![1.0, 2.0],
+        vec![0.0; 2],
+        vec![0.0; 4],
+        vec![1.0, 1.0],
+        None,
+    )
+    .unwrap();
+    let g = layout.len();
+    let evo = Evolution::new(
+        layout,
+        config(),
+        1,
+        std::slice::from_ref(&net),
+        Fill::Mutants,
+    )
+    .unwrap();
+    assert_eq!(&evo.population[..g], genome::encode(&net).as_slice());
+    let close = evo.population[g..]
+        .chunks(g)
+        .filter(|c| *c == genome::encode(&net).as_slice())
+        .count();
+    assert!(
+        close > 0,
+        "with mutation 0.025 some mutants are exact copies"
+    );
+    let evo = Evolution::new(
+        layout,
+        config(),
+        1,
+        std::slice::from_ref(&net),
+        Fill::Random,
+    )
+    .unwrap();
+    assert!(evo.population[g..]
+        .chunks(g)
+        .all(|c| c != genome::encode(&net).as_slice()));
+    let wrong = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![0.0], None).unwrap();
+    assert!(Evolution::new(layout, config(), 1, &[wrong], Fill::Mutants).is_err());
+}
+
+#[test]
+fn tell_rejects_nan_and_wrong_length() {
+    let mut evo = Evolution::new(Excite.layout(), config(), 1, &[], Fill::Mutants).unwrap();
+    let mut f = vec![0.5; 40];
+    f[7] = f64::NAN;
+    assert!(evo
+        .tell(&f)
+        .unwrap_err()
+        .to_string()
+        .contains("individual 7"));
+    assert!(evo.tell(&[0.5; 3]).is_err());
+    assert_eq!(evo.generation, 0);
+}

@@ -1,0 +1,324 @@
+use std::sync::atomic::AtomicBool;
+
+use ctrnn::integrate::*;
+use ctrnn::simd::{self, Kernel};
+use ctrnn::testing::integrate::{step_row_on, weight_order};
+use ctrnn::{Error, Network};
+
+fn sig(x: f64) -> f64 {
+    1.0 / (1.0 + (-x).exp())
+}
+
+#[test]
+fn euler_step_matches_hand_calculation() {
+    // N = 2, M = 1, one step from v = (0.5, -1) with input 2.
+    let mut net = Network::new(
+        vec![1.0, 2.0],
+        vec![0.25, -0.5],
+        vec![1.0, -2.0, 0.5, 3.0],
+        vec![0.3, -0.7],
+        Some(vec![0.5, -1.0]),
+    )
+    .unwrap();
+    let integ = Integrator::default();
+    let s = net.run(&[2.0], 1, &integ).unwrap();
+    let f0 = sig(0.5 - 0.25);
+    let f1 = sig(-1.0 + 0.5);
+    let d0 = -0.5 + (1.0 * f0 - 2.0 * f1) + 0.3 * 2.0;
+    let d1 = 1.0 + (0.5 * f0 + 3.0 * f1) - 0.7 * 2.0;
+    let want = [0.5 + 0.1 / 1.0 * d0, -1.0 + 0.1 / 2.0 * d1];
+    for i in 0..2 {
+        assert!((s[i] - want[i]).abs() < 1e-15, "{} vs {}", s[i], want[i]);
+    }
+    assert_eq!(net.state(), &s[..]);
+}
+
+/// With W = 0 and constant input, v(t) = c + (v0 - c) e^{-t / tau} with c = S I.
+fn rk4_error(dt: f64) -> f64 {
+    let tau = [0.7, 1.3, 4.0];
+    let mut net = Network::new(
+        tau.to_vec(),
+        vec![0.0; 3],
+        vec![0.0; 9],
+        vec![1.0, -2.0, 0.5],
+        Some(vec![2.0, 1.0, -3.0]),
+    )
+    .unwrap();
+    let t_end = 2.0;
+    let steps = (t_end / dt).round() as usize;
+    let integ = Integrator {
+        method: Method::Rk4,
+        dt,
+        substeps: steps,
+    };
+    let s = net.run(&[1.5], 1, &integ).unwrap();
+    let c = [1.5, -3.0, 0.75];
+    let v0 = [2.0, 1.0, -3.0];
+    (0..3)
+        .map(|i| (s[i] - (c[i] + (v0[i] - c[i]) * (-t_end / tau[i]).exp())).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn rk4_converges_with_order_four() {
+    let (e1, e2) = (rk4_error(0.2), rk4_error(0.1));
+    let order = (e1 / e2).log2();
+    assert!(
+        (3.8..4.2).contains(&order),
+        "order {order}, errors {e1} {e2}"
+    );
+}
+
+#[test]
+fn euler_converges_with_order_one() {
+    let err = |dt: f64| {
+        let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+        let integ = Integrator {
+            method: Method::Euler,
+            dt,
+            substeps: (1.0 / dt).round() as usize,
+        };
+        let s = net.run(&[1.0], 1, &integ).unwrap();
+        (s[0] - (1.0 - (-1.0f64).exp())).abs()
+    };
+    let order = (err(0.01) / err(0.005)).log2();
+    assert!((0.95..1.05).contains(&order), "order {order}");
+}
+
+#[test]
+fn bad_arguments_are_errors() {
+    let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    let bad_dt = Integrator {
+        dt: -0.1,
+        ..Integrator::default()
+    };
+    assert!(net
+        .run(&[1.0], 1, &bad_dt)
+        .unwrap_err()
+        .to_string()
+        .contains("dt"));
+    let zero = Integrator {
+        substeps: 0,
+        ..Integrator::default()
+    };
+    assert!(net.run(&[1.0], 1, &zero).is_err());
+    assert!(net.run(&[1.0, 2.0], 1, &Integrator::default()).is_err());
+    assert!(net.run(&[f64::NAN], 1, &Integrator::default()).is_err());
+    assert!("rk5".parse::<Method>().is_err());
+}
+
+#[test]
+fn divergence_is_reported_not_returned() {
+    let mut net =
+        Network::new(vec![0.5], vec![0.0], vec![0.0], vec![1.0], Some(vec![1.0])).unwrap();
+    let huge = Integrator {
+        dt: 5.0,
+        substeps: 1000,
+        ..Integrator::default()
+    };
+    let e = net.run(&[0.0], 1, &huge).unwrap_err().to_string();
+    assert!(e.contains("diverged"), "{e}");
+}
+
+#[test]
+fn weights_are_stored_by_row_groups() {
+    // 6 x 6 with WEIGHT_GROUP = 4: rows 0-3 column by column, then rows 4 and 5 as they are.
+    let order: Vec<usize> = weight_order(6).collect();
+    assert_eq!(order[..8], [0, 6, 12, 18, 1, 7, 13, 19]);
+    assert_eq!(order[20..24], [5, 11, 17, 23]);
+    assert_eq!(order[24..], (24..36).collect::<Vec<_>>()[..]);
+    // Fewer rows than a group: row-major.
+    assert_eq!(
+        weight_order(3).collect::<Vec<_>>(),
+        (0..9).collect::<Vec<_>>()
+    );
+}
+
+/// Random networks of one shape, from a fixed seed.
+fn random_networks(count: usize, n: usize, m: usize, seed: u64) -> Vec<Network> {
+    use ctrnn::rng::{Purpose, Stream};
+    let mut rng = Stream::new(seed, 0, Purpose::Init, 0, 0);
+    let mut draw = |count: usize, lo: f64, hi: f64| -> Vec<f64> {
+        (0..count).map(|_| rng.range(lo, hi)).collect()
+    };
+    (0..count)
+        .map(|_| {
+            let (tau, theta) = (draw(n, 0.5, 10.0), draw(n, -16.0, 16.0));
+            let (w, s, v) = (
+                draw(n * n, -16.0, 16.0),
+                draw(n * m, -16.0, 16.0),
+                draw(n, -5.0, 5.0),
+            );
+            Network::new(tau, theta, w, s, Some(v)).unwrap()
+        })
+        .collect()
+}
+
+/// Steps one block of `L` networks on `kernel` and on the portable kernel: same bits.
+fn kernels_agree<const L: usize>(kernel: Kernel) {
+    for (n, m) in [
+        (1, 0),
+        (3, 1),
+        (4, 2),
+        (5, 2),
+        (7, 3),
+        (10, 2),
+        (13, 1),
+        (30, 2),
+    ] {
+        let nets = random_networks(L, n, m, (n * 10 + m) as u64);
+        let refs: Vec<&Network> = nets.iter().collect();
+        for method in [Method::Euler, Method::Rk4] {
+            let integ = Integrator {
+                method,
+                dt: 0.05,
+                substeps: 3,
+            };
+            let mut fast = Lanes::<L>::new(&refs).unwrap();
+            let mut portable = fast.clone();
+            for t in 0..20 {
+                let inputs: Vec<[f64; L]> = (0..m)
+                    .map(|k| std::array::from_fn(|l| ((t * 7 + k * 3 + l) % 5) as f64 - 2.0))
+                    .collect();
+                step_row_on(&mut fast, kernel, &inputs, &integ);
+                step_row_on(&mut portable, Kernel::Portable, &inputs, &integ);
+            }
+            for i in 0..n {
+                let (a, b) = (fast.state(i), portable.state(i));
+                assert!(
+                    a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "{kernel}, L = {L}, N = {n}, M = {m}, {method:?}, neuron {i}: {a:?} vs {b:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn every_kernel_matches_the_portable_kernel_bit_for_bit() {
+    for kernel in simd::supported() {
+        // A single network, an odd width (plain lanes both) and a block (registers).
+        kernels_agree::<1>(kernel);
+        kernels_agree::<3>(kernel);
+        kernels_agree::<LANES>(kernel);
+    }
+    for kernel in Kernel::ALL.into_iter().filter(|k| !k.is_supported()) {
+        eprintln!("this CPU cannot run the {kernel} kernel: not checked");
+    }
+}
+
+#[test]
+fn reading_the_outputs_between_steps_changes_nothing() {
+    let nets = random_networks(LANES, 5, 2, 3);
+    let refs: Vec<&Network> = nets.iter().collect();
+    for method in [Method::Euler, Method::Rk4] {
+        let integ = Integrator {
+            method,
+            dt: 0.1,
+            substeps: 3,
+        };
+        let mut plain = Lanes::<LANES>::new(&refs).unwrap();
+        let mut read = plain.clone();
+        let same = |a: &Lanes<LANES>, b: &Lanes<LANES>| {
+            (0..5).all(|i| {
+                let (x, y) = (a.state(i), b.state(i));
+                x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+            })
+        };
+        for t in 0..30 {
+            // Rates read after row 9 and row 19 must not survive the reset and the new state.
+            if t == 10 {
+                plain.reset();
+                read.reset();
+            }
+            if t == 20 {
+                plain.set_lane_state(3, &[1.0; 5]);
+                read.set_lane_state(3, &[1.0; 5]);
+            }
+            let inputs = [[(t % 3) as f64; LANES], [1.0 - (t % 2) as f64; LANES]];
+            plain.step_row(&inputs, &integ);
+            read.step_row(&inputs, &integ);
+            assert!(same(&plain, &read), "{method:?}, row {t}");
+            if t % 4 != 2 {
+                let out: Vec<[f64; LANES]> = read.outputs().to_vec();
+                for (i, row) in out.iter().enumerate() {
+                    let want = read.output(i);
+                    assert!(row
+                        .iter()
+                        .zip(&want)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()));
+                }
+            }
+        }
+        let mut rows = read.clone();
+        let _ = rows.outputs();
+        // One pair of closures for both calls, so the kernel is compiled once for them.
+        let (row, record) = (
+            |_: usize, r: &mut [[f64; LANES]]| r[0][0] = 1.0,
+            |_: usize, _: &[[f64; LANES]]| {},
+        );
+        rows.run_rows(5, &integ, None, row, record).unwrap();
+        plain.run_rows(5, &integ, None, row, record).unwrap();
+        assert!(same(&plain, &rows), "{method:?}, run_rows");
+    }
+}
+
+#[test]
+fn holding_the_inputs_is_stepping_them_again() {
+    let nets = random_networks(LANES, 5, 2, 4);
+    let refs: Vec<&Network> = nets.iter().collect();
+    for method in [Method::Euler, Method::Rk4] {
+        let integ = Integrator {
+            method,
+            dt: 0.1,
+            substeps: 2,
+        };
+        let mut again = Lanes::<LANES>::new(&refs).unwrap();
+        let (mut held, mut together) = (again.clone(), again.clone());
+        let same = |a: &Lanes<LANES>, b: &Lanes<LANES>| {
+            (0..5).all(|i| {
+                let (x, y) = (a.state(i), b.state(i));
+                x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits())
+            })
+        };
+        for t in 0..12 {
+            let inputs = [[(t / 4) as f64; LANES], [0.5; LANES]];
+            again.step_row(&inputs, &integ);
+            if t % 4 == 0 {
+                held.step_row(&inputs, &integ);
+                // Four rows of the same inputs as one row of four times the steps.
+                let four = Integrator {
+                    substeps: 4 * integ.substeps,
+                    ..integ
+                };
+                together.step_row(&inputs, &four);
+            } else {
+                held.step_held(&integ);
+            }
+            if t % 3 == 0 {
+                let _ = held.outputs();
+            }
+            assert!(same(&again, &held), "{method:?}, row {t}");
+            if t % 4 == 3 {
+                assert!(same(&again, &together), "{method:?}, row {t}");
+            }
+        }
+    }
+}
+
+#[test]
+#[should_panic(expected = "step_held needs a step_row before it")]
+fn holding_needs_a_row() {
+    let net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    Lanes::<1>::new(&[&net])
+        .unwrap()
+        .step_held(&Integrator::default());
+}
+
+#[test]
+fn cancel_flag_interrupts() {
+    let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![], None).unwrap();
+    let flag = AtomicBool::new(true);
+    let r = net.run_cancellable(&[], 10, &Integrator::default(), Some(&flag));
+    assert!(matches!(r, Err(Error::Interrupted)));
+}

@@ -1,0 +1,121 @@
+use std::fs;
+
+use serde_json::Map;
+
+use ctrnn::integrate::Method;
+use ctrnn::io::*;
+use ctrnn::{Error, Integrator, Network};
+
+fn sample() -> NetworkFile {
+    let net = Network::new(
+        vec![0.1 + 0.2, 7.0 / 3.0],
+        vec![-1e-300, 16.0],
+        vec![1.0 / 3.0, -2.5, 5e-324, std::f64::consts::PI],
+        vec![0.1, 0.7],
+        Some(vec![1.0 / 7.0, -0.0]),
+    )
+    .unwrap();
+    let mut meta = Map::new();
+    meta.insert("task".into(), "sequence-1bit".into());
+    meta.insert("seed".into(), 3.into());
+    NetworkFile {
+        network: net,
+        integrator: Some(Integrator {
+            method: Method::Rk4,
+            dt: 0.05,
+            substeps: 10,
+        }),
+        meta,
+    }
+}
+
+#[test]
+fn round_trip_is_exact() {
+    let f = sample();
+    let back = from_json(&to_json(&f)).unwrap();
+    assert_eq!(back, f);
+    for (a, b) in back.network.weights().iter().zip(f.network.weights()) {
+        assert_eq!(a.to_bits(), b.to_bits());
+    }
+    assert_eq!(to_json(&back), to_json(&f));
+}
+
+#[test]
+fn file_round_trip_and_atomic_write() {
+    let dir = std::env::temp_dir().join(format!("ctrnn-io-{}", std::process::id()));
+    fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("net.json");
+    save(&path, &sample()).unwrap();
+    assert_eq!(load(&path).unwrap(), sample());
+    let leftovers = fs::read_dir(&dir).unwrap().count();
+    assert_eq!(leftovers, 1, "no temporary file is left behind");
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[cfg(unix)]
+#[test]
+fn atomic_write_never_follows_a_planted_symlink() {
+    let dir = std::env::temp_dir().join(format!("ctrnn-io-link-{}", std::process::id()));
+    fs::create_dir_all(&dir).unwrap();
+    let target = dir.join("important");
+    fs::write(&target, b"keep").unwrap();
+    let path = dir.join("net.json");
+    // Every name the old scheme used, and the final name itself, point at the target.
+    std::os::unix::fs::symlink(
+        &target,
+        dir.join(format!(".net.json.tmp{}", std::process::id())),
+    )
+    .unwrap();
+    std::os::unix::fs::symlink(&target, &path).unwrap();
+    save(&path, &sample()).unwrap();
+    assert_eq!(fs::read(&target).unwrap(), b"keep");
+    assert!(!fs::symlink_metadata(&path)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(load(&path).unwrap(), sample());
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+fn err(text: &str) -> String {
+    match from_json(text) {
+        Err(Error::Format(m)) => m,
+        other => panic!("expected a format error, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_documents_name_the_problem() {
+    let good = to_json(&sample());
+    let edit = |from: &str, to: &str| good.replacen(from, to, 1);
+    assert!(err(&edit("dnnevo-network", "other")).contains("expected \"dnnevo-network\""));
+    assert!(err(&edit("\"version\": 1", "\"version\": 2")).contains("version is 2"));
+    assert!(err(&good[..good.len() / 2]).contains("not valid JSON"));
+    assert!(err("[1, 2]").contains("not a JSON object"));
+    let no_tau = good.replacen("\"tau\"", "\"tua\"", 1);
+    let e = err(&no_tau);
+    assert!(e.contains("tua") || e.contains("tau"), "{e}");
+    let e = err(&edit("\"theta\": [", "\"theta\": [\"x\", "));
+    assert!(e.contains("theta[0]"), "{e}");
+    let e = err(&edit("\"theta\": [", "\"theta\": [1e999, "));
+    assert!(
+        e.contains("theta") || e.contains("number out of range"),
+        "{e}"
+    );
+    let e = err(&edit("\"tau\": [", "\"tau\": [-1.0, "));
+    assert!(e.contains("weights has 2 rows; expected N = 3"), "{e}");
+    let e = err(&edit("0.30000000000000004", "-0.5"));
+    assert!(e.contains("tau[0]") && e.contains("> 0"), "{e}");
+    let e = err(&edit("\"dt\": 0.05", "\"dt\": -1.0"));
+    assert!(e.contains("integrator") && e.contains("dt"), "{e}");
+    let minimal = r#"{"format": "dnnevo-network", "version": 1, "tau": [1],
+        "theta": [0], "weights": [[0]], "sensor_weights": [[]]}"#;
+    let f = from_json(minimal).unwrap();
+    assert_eq!((f.network.size(), f.network.n_inputs()), (1, 0));
+    assert_eq!(f.network.state(), &[0.0]);
+    let missing = r#"{"format": "dnnevo-network", "version": 1, "tau": [1],
+        "weights": [[0]], "sensor_weights": [[]]}"#;
+    assert!(err(missing).contains("missing field `theta`"));
+    let ragged = minimal.replace("[[0]]", "[[0, 1]]");
+    assert!(err(&ragged).contains("weights[0] has 2 values; expected 1"));
+}

@@ -37,7 +37,7 @@ pub(crate) fn interrupted(cancel: Option<&AtomicBool>) -> bool {
 }
 
 /// A lane whose state stopped being finite.
-pub(crate) struct Diverged {
+pub struct Diverged {
     lane: usize,
     neuron: usize,
     value: f64,
@@ -45,7 +45,7 @@ pub(crate) struct Diverged {
 
 impl Diverged {
     /// The first non-finite state of `lanes`, if any.
-    pub(crate) fn find<const L: usize>(lanes: &Lanes<L>) -> std::result::Result<(), Diverged> {
+    pub fn find<const L: usize>(lanes: &Lanes<L>) -> std::result::Result<(), Diverged> {
         for neuron in 0..lanes.size() {
             let row = lanes.state(neuron);
             if let Some(lane) = (0..lanes.len()).find(|&l| !row[l].is_finite()) {

@@ -22,6 +22,9 @@ pub mod nav1d;
 pub mod registry;
 mod run_config;
 pub mod sequence;
+// Internals for the crate's own integration tests (tests/unit); not public API.
+#[doc(hidden)]
+pub mod testing;
 
 pub use aggregate::Aggregate;
 pub use common::{MAX_COUNT, TIME_STEP};

@@ -40,6 +40,3 @@ pub use task::{
     answer, score, Assessment, LandmarkTask, Record, Sensing, SUCCESS_RATE, SUCCESS_TRIALS,
 };
 pub use training::Training;
-
-#[cfg(test)]
-mod tests;

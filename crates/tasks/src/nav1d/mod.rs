@@ -46,6 +46,3 @@ pub use environment::Environment;
 pub use system::{Part, System, SystemAssessment, SystemEpisode};
 pub use task::{Assessment, Episode, Nav1dTask, Record, SUCCESS_CHAINS, SUCCESS_RATE};
 pub use world::{Condition, Side};
-
-#[cfg(test)]
-mod tests;

@@ -69,7 +69,7 @@
 //! ```
 
 mod config;
-mod scoring;
+pub(crate) mod scoring;
 mod task;
 mod trial;
 
@@ -77,6 +77,3 @@ pub use crate::Aggregate;
 pub use config::{Clamp, PerfBase, SequenceConfig};
 pub use scoring::{performance, warmup, SUCCESS_FRACTION, SUCCESS_TRIALS};
 pub use task::{Assessment, Scores, SequenceTask, TargetReport, TrialRecord};
-
-#[cfg(test)]
-mod tests;

@@ -19,7 +19,7 @@ pub fn performance(rs: &[f64], base: f64) -> f64 {
 }
 
 /// `max(0, (mean_r - base) / (1 - base))`, 0 when `base >= 1`.
-pub(super) fn score(mean_r: f64, base: f64) -> f64 {
+pub fn score(mean_r: f64, base: f64) -> f64 {
     unclamped_score(mean_r, base).max(0.0)
 }
 
@@ -33,7 +33,7 @@ pub(super) fn unclamped_score(mean_r: f64, base: f64) -> f64 {
 }
 
 /// The arithmetic mean, summed in order.
-pub(super) fn mean(xs: &[f64]) -> f64 {
+pub fn mean(xs: &[f64]) -> f64 {
     xs.iter().sum::<f64>() / xs.len() as f64
 }
 
@@ -43,7 +43,7 @@ pub fn warmup(target: &str) -> usize {
 }
 
 /// Whether a trigger whose window had mean output `mean_output` was right about bit `bit`.
-pub(super) fn correct(bit: u8, mean_output: f64) -> bool {
+pub fn correct(bit: u8, mean_output: f64) -> bool {
     if bit == 1 {
         mean_output > 0.5
     } else {

@@ -1,12 +1,10 @@
 //! Tests of the sequence task.
 
-use super::config::*;
-use super::scoring::*;
-use super::task::*;
-use crate::Aggregate;
 use ctrnn::genome::{self, Ranges};
 use ctrnn::{Error, Layout, Method, Network, Purpose, Stream, Task};
 use std::sync::atomic::AtomicBool;
+use tasks::sequence::*;
+use tasks::testing::sequence::{correct, mean, score};
 
 /// A one-neuron network with zero weights and threshold `theta`: its output stays at
 /// `f(-theta)` whatever the inputs.
@@ -153,7 +151,7 @@ fn r_is_measured_over_the_trigger_window() {
     assert_eq!(rec.trigger, trig);
     assert_eq!(rec.reinforcement, reinf);
     let mut replay = net.clone();
-    let states = replay.run(&inputs, steps, &t.config.integrator).unwrap();
+    let states = replay.run(&inputs, steps, &t.config().integrator).unwrap();
     let out: Vec<f64> = states
         .iter()
         .map(|v| ctrnn::math::sigmoid(v - 5.0))

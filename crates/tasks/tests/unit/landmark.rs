@@ -1,7 +1,8 @@
 use ctrnn::genome::{self, Ranges};
 use ctrnn::{Network, Purpose, Stream, Task};
+use tasks::landmark::*;
 
-use super::*;
+mod trials;
 
 fn task(config: LandmarkConfig) -> LandmarkTask {
     LandmarkTask::new(config).unwrap()

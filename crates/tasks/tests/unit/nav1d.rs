@@ -1,8 +1,8 @@
 use ctrnn::genome::{self, Ranges};
 use ctrnn::{Network, Stream, Task};
 
-use super::*;
-use crate::Aggregate;
+use tasks::nav1d::*;
+use tasks::Aggregate;
 
 /// A network with zero weights whose neuron `i` fires at the constant rate `f(-theta[i])`.
 fn constant(theta: &[f64], m: usize) -> Network {

@@ -1,0 +1,89 @@
+use ctrnn::GaConfig;
+use tasks::{RunConfig, TIME_STEP};
+
+fn error(json: &str) -> String {
+    RunConfig::from_json(json).err().unwrap().to_string()
+}
+
+#[test]
+fn defaults_are_valid_and_match_the_ga_and_the_tasks() {
+    let config = RunConfig::from_json("{}").unwrap();
+    assert_eq!(config, RunConfig::default());
+    assert_eq!(config.ga(), GaConfig::default());
+    assert_eq!(config.integrator, TIME_STEP);
+    let round = serde_json::to_string(&config).unwrap();
+    assert_eq!(RunConfig::from_json(&round).unwrap(), config);
+}
+
+#[test]
+fn every_bad_value_names_its_field() {
+    for (json, fragment) in [
+        (r#"{"population": 1}"#, "population is 1"),
+        (
+            r#"{"crossover_rate": 1.5}"#,
+            "crossover_rate is 1.5; it must be in [0, 1]",
+        ),
+        (r#"{"mutation_rate": -0.1}"#, "mutation_rate is -0.1"),
+        (
+            r#"{"mutation_scale": 0}"#,
+            "mutation_scale is 0; it must be in (0, 1]",
+        ),
+        (r#"{"elitism": 100}"#, "elitism is 100"),
+        (r#"{"generations": 0}"#, "generations is 0"),
+        (r#"{"size": 0}"#, "size is 0"),
+        (r#"{"task": ""}"#, "task is empty"),
+        (
+            r#"{"selection": "tournament"}"#,
+            "selection: unknown variant `tournament`",
+        ),
+        (
+            r#"{"mutation": "gauss"}"#,
+            "mutation: unknown variant `gauss`",
+        ),
+        (r#"{"fill": "zeros"}"#, "fill: unknown variant `zeros`"),
+        (r#"{"integrator": {"dt": 0}}"#, "missing field `method`"),
+        (
+            r#"{"integrator": {"method": "euler", "dt": 0, "substeps": 1}}"#,
+            "integrator.dt is 0",
+        ),
+        (
+            r#"{"integrator": {"method": "rk2", "dt": 0.1, "substeps": 1}}"#,
+            "integrator.method: unknown variant `rk2`",
+        ),
+        (r#"{"populaton": 3}"#, "unknown field `populaton`"),
+        (
+            r#"{"population": -1}"#,
+            "population: invalid value: integer `-1`",
+        ),
+        (r#"{"task_params": {"size": 3}}"#, "task_params.size is set"),
+        ("[1]", "the parameters must be a JSON object"),
+        ("{", "not valid JSON"),
+    ] {
+        let e = error(json);
+        assert!(e.contains(fragment), "{json}: {e}");
+    }
+    let tau = r#"{"ranges": {"tau": [0, 1], "theta": [-1, 1], "weights": [-1, 1],
+                  "sensor_weights": [-1, 1]}}"#;
+    assert!(
+        error(tau).contains("ranges.tau is (0, 1)"),
+        "{}",
+        error(tau)
+    );
+}
+
+#[test]
+fn the_task_gets_the_runs_size_and_integrator() {
+    let json = r#"{"size": 7, "task_params": {"targets": ["0", "1"]}}"#;
+    let config = RunConfig::from_json(json).unwrap();
+    assert_eq!(config.build_task().unwrap().layout().size, 7);
+    let params = config.task_params();
+    assert_eq!(params["integrator"]["substeps"], 10);
+    assert_eq!(params["targets"][1], "1");
+    let own = RunConfig {
+        task: "python:m.f".into(),
+        ..RunConfig::default()
+    };
+    assert!(own.validate().is_ok());
+    let e = own.build_task().err().unwrap().to_string();
+    assert!(e.contains("unknown task \"python:m.f\""), "{e}");
+}

@@ -87,25 +87,3 @@ pub(crate) fn check_range(
 pub(crate) fn check_finite(field: &str, value: f64) -> Result<(), Error> {
     check_range(field, value, f64::NEG_INFINITY, false, f64::INFINITY, false)
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn messages_name_field_value_and_range() {
-        let e = check_range("sonar.cone_deg", -3.0, 0.0, false, 180.0, false).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "sonar.cone_deg is -3; it must be in (0, 180)"
-        );
-        let e = check_range("robot.radius", 0.0, 0.0, false, f64::INFINITY, false).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "robot.radius is 0; it must be a finite number > 0"
-        );
-        let e = check_finite("x", f64::NAN).unwrap_err();
-        assert_eq!(e.to_string(), "x is NaN; it must be a finite number");
-        assert!(check_range("p", 1.0, 0.0, true, 1.0, true).is_ok());
-    }
-}

@@ -41,6 +41,9 @@ mod pose;
 pub mod robot;
 pub mod sim;
 pub mod sonar;
+// Internals for the crate's own integration tests (tests/unit); not public API.
+#[doc(hidden)]
+pub mod testing;
 pub mod wall_follow;
 pub mod world;
 pub mod world_spec;

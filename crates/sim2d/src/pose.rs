@@ -66,17 +66,3 @@ pub fn wrap_angle(angle: f64) -> f64 {
     }
     a
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn wrap_keeps_half_open_interval() {
-        assert_eq!(wrap_angle(0.0), 0.0);
-        assert!((wrap_angle(-PI) - PI).abs() < 1e-12);
-        assert!((wrap_angle(1.5 * PI) + 0.5 * PI).abs() < 1e-12);
-        assert!((wrap_angle(-7.0) - (-7.0 + TAU)).abs() < 1e-12);
-        assert!(wrap_angle(f64::NAN).is_nan());
-    }
-}

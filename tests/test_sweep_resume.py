@@ -87,3 +87,33 @@ def test_a_seed_that_fails_on_dask_is_named_and_the_exit_status_says_so(tmp_path
     assert "dnnevo: seed-1 failed:" in r.stderr and "Traceback" not in r.stderr
     assert "1 seed(s) failed" in r.stdout
     assert [run["seed"] for run in results(out)] == [0]
+
+
+def test_a_sweep_stopped_by_ctrl_c_leaves_the_stopped_seed_out_and_exits_130(tmp_path: Path) -> None:
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    # Ctrl-C's default handler (a test's background process may start with SIGINT ignored) and a
+    # checkpoint every generation, so the stop lands inside seed 1.
+    launcher = ("import signal, sys, dnnevo; signal.signal(signal.SIGINT, signal.default_int_handler); "
+                "sys.modules['dnnevo.evolve'].CHECKPOINT_SECONDS = 0.0; "
+                "from dnnevo.cli import main; sys.exit(main(sys.argv[1:]))")
+    out = tmp_path / "s"
+    args = ["sweep", "sequence-1bit", "--quick", "--set", "population=12", "--set", "generations=400",
+            "--eval-trials", "5", "--no-dt-check", "--threads", "1", "--seeds", "0-2", "--out", str(out)]
+    proc = subprocess.Popen([sys.executable, "-c", launcher, *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    checkpoint = out / "seed-1" / "checkpoint.json"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not checkpoint.exists():
+        time.sleep(0.02)
+    time.sleep(0.3)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (stdout, stderr)
+    assert "interrupted during seed 1, which the statistics leave out" in stdout, stdout
+    assert "cover the 1 finished seed(s)" in stdout and "Traceback" not in stderr
+    assert [r["seed"] for r in json.loads((out / "summary.json").read_text())["runs"]] == [0]
+    assert [row.split(",")[0] for row in (out / "summary.csv").read_text().splitlines()] == ["seed", "0", "all"]

@@ -116,16 +116,21 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
             runs.append(task.fn(*task.args, **task.kwargs))
             if runs[-1].interrupted:
                 break
-    summary = sweep.summarize(runs)
-    info = {"preset": args.preset, "quick": args.quick, "overrides": list(args.set), "task": config.task,
-            "eval_seed": f"{args.eval_seed} + seed", "eval_trials": trials,
-            "eval_unit": UNITS[config.task], **(how.info() if how else {})}
-    paths = summary.write(args.out, info)
-    print("\n".join(lines(summary, args.eval_seed, trials, UNITS[config.task])))
-    if runs[-1].interrupted:
-        print(f"interrupted during seed {runs[-1].seed}; the statistics cover the {len(runs)} seed(s) run; "
-              "run the same command again to continue the sweep")
-    print(f"wrote {', '.join(map(str, paths))}")
+    # A seed stopped part-way is not a result: its champion is an early one, not the run's.
+    stopped = [r.seed for r in runs if r.interrupted]
+    finished = [r for r in runs if not r.interrupted]
+    if finished:
+        summary = sweep.summarize(finished)
+        info = {"preset": args.preset, "quick": args.quick, "overrides": list(args.set), "task": config.task,
+                "eval_seed": f"{args.eval_seed} + seed", "eval_trials": trials,
+                "eval_unit": UNITS[config.task], **(how.info() if how else {})}
+        paths = summary.write(args.out, info)
+        print("\n".join(lines(summary, args.eval_seed, trials, UNITS[config.task])))
+        print(f"wrote {', '.join(map(str, paths))}")
+    if stopped:
+        print(f"interrupted during seed {stopped[0]}, which the statistics leave out; they cover the "
+              f"{len(finished)} finished seed(s); run the same command again to continue the sweep")
+        return 130
     if failed:
         print(f"{failed} seed(s) failed (named above); the statistics cover the {len(runs)} that did not")
         return 2

@@ -51,7 +51,7 @@ impl Error {
 
 /// Checks that `value` is finite and inside the interval `(lo, hi)` with the given closedness;
 /// returns an [`Error::Invalid`] for `field` otherwise.
-pub(crate) fn check_range(
+pub fn check_range(
     field: &str,
     value: f64,
     lo: f64,
@@ -84,6 +84,6 @@ pub(crate) fn check_range(
 }
 
 /// Checks that `value` is a finite number.
-pub(crate) fn check_finite(field: &str, value: f64) -> Result<(), Error> {
+pub fn check_finite(field: &str, value: f64) -> Result<(), Error> {
     check_range(field, value, f64::NEG_INFINITY, false, f64::INFINITY, false)
 }

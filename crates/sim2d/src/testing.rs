@@ -5,25 +5,7 @@
 
 /// The range checks behind every message of [`crate::Error::Invalid`].
 pub mod error {
-    use crate::Error;
-
-    /// Checks that `value` is finite and inside the interval `(lo, hi)` with the given
-    /// closedness; an [`Error::Invalid`] for `field` otherwise.
-    pub fn check_range(
-        field: &str,
-        value: f64,
-        lo: f64,
-        lo_closed: bool,
-        hi: f64,
-        hi_closed: bool,
-    ) -> Result<(), Error> {
-        crate::error::check_range(field, value, lo, lo_closed, hi, hi_closed)
-    }
-
-    /// Checks that `value` is a finite number; an [`Error::Invalid`] for `field` otherwise.
-    pub fn check_finite(field: &str, value: f64) -> Result<(), Error> {
-        crate::error::check_finite(field, value)
-    }
+    pub use crate::error::{check_finite, check_range};
 }
 
 /// The wall follower's internals.

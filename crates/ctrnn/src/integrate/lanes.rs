@@ -298,19 +298,26 @@ impl<const L: usize> Lanes<L> {
 
     /// [`step_row`](Self::step_row) on a given kernel, which the CPU must support.
     pub(crate) fn step_row_on(&mut self, kernel: Kernel, inputs: &[[f64; L]], integ: &Integrator) {
-        self.advance_on(kernel, Some(inputs), integ);
+        self.advance_by(kernel, Some(inputs), integ);
     }
 
     /// One row of `integ.substeps` steps: with `inputs`, from their sensor drive; without, from
     /// the sensor drive held since the last row.
     #[inline(always)]
     fn advance(&mut self, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
+        self.advance_by(simd::kernel(), inputs, integ);
+    }
+
+    /// [`advance`](Self::advance) on a given kernel, through the shared copy of its width if
+    /// there is one.
+    #[inline(always)]
+    fn advance_by(&mut self, kernel: Kernel, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
         if const { L == LANES } {
-            as_width::<L, LANES>(self).advance_once(inputs.map(as_rows), integ);
+            as_width::<L, LANES>(self).advance_once(kernel, inputs.map(as_rows), integ);
         } else if const { L == 1 } {
-            as_width::<L, 1>(self).advance_once(inputs.map(as_rows), integ);
+            as_width::<L, 1>(self).advance_once(kernel, inputs.map(as_rows), integ);
         } else {
-            self.advance_on(simd::kernel(), inputs, integ);
+            self.advance_on(kernel, inputs, integ);
         }
     }
 
@@ -472,8 +479,13 @@ impl<const L: usize> Lanes<L> {
 macro_rules! compile_once {
     ($($width:expr),*) => {$(
         impl Lanes<{ $width }> {
-            fn advance_once(&mut self, inputs: Option<&[[f64; $width]]>, integ: &Integrator) {
-                self.advance_on(simd::kernel(), inputs, integ);
+            fn advance_once(
+                &mut self,
+                kernel: Kernel,
+                inputs: Option<&[[f64; $width]]>,
+                integ: &Integrator,
+            ) {
+                self.advance_on(kernel, inputs, integ);
             }
             fn compute_outputs_once(&mut self) {
                 self.compute_outputs_on(simd::kernel());

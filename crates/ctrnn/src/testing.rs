@@ -1,4 +1,4 @@
-//! Internals that ctrnn's own integration tests (`tests/unit`) check directly: the lane vectors
+//! Internals that ctrnn's own integration tests (`tests/unit`, `tests/kernels`) check directly: the lane vectors
 //! and their backends, the sigmoid's kernel, the integrator's weight order, and a few helpers of
 //! the analysis. Not public API: hidden from the documentation, and free to change or go at any
 //! time. It exists so that the unit tests build as an integration test, against the library
@@ -75,8 +75,29 @@ pub mod rows {
 pub mod integrate {
     use crate::integrate::{Integrator, Lanes};
     use crate::simd::Kernel;
+    use crate::{Network, Purpose, Stream};
 
     pub use crate::integrate::kernel::weight_order;
+
+    /// `count` random networks of `n` neurons and `m` sensors from stream `seed`: time
+    /// constants in [0.5, 10], thresholds and weights in [-16, 16], states in [-5, 5].
+    pub fn random_networks(count: usize, n: usize, m: usize, seed: u64) -> Vec<Network> {
+        let mut rng = Stream::new(seed, 0, Purpose::Init, 0, 0);
+        let mut draw = |count: usize, lo: f64, hi: f64| -> Vec<f64> {
+            (0..count).map(|_| rng.range(lo, hi)).collect()
+        };
+        (0..count)
+            .map(|_| {
+                let (tau, theta) = (draw(n, 0.5, 10.0), draw(n, -16.0, 16.0));
+                let (w, s, v) = (
+                    draw(n * n, -16.0, 16.0),
+                    draw(n * m, -16.0, 16.0),
+                    draw(n, -5.0, 5.0),
+                );
+                Network::new(tau, theta, w, s, Some(v)).expect("the ranges are valid")
+            })
+            .collect()
+    }
 
     /// [`Lanes::step_row`] on a given kernel, which the CPU must support.
     pub fn step_row_on<const L: usize>(

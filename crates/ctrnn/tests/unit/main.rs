@@ -18,4 +18,3 @@ mod population;
 mod rows;
 mod simd;
 mod validation;
-mod vector;

@@ -115,6 +115,13 @@ pub struct Nav1dConfig {
     /// (default), the worst type's mean (`"min"`), or the mean of the two (`"mean-min"`). With
     /// `"min"` a network that solves one type and guesses in the other scores as a guesser.
     pub aggregate: Aggregate,
+    /// Implicit fitness sharing (beyond the paper), against a population's collapse onto one
+    /// strategy: each scored trial's score is divided by the mean score of every network scored
+    /// with it on that trial (a trial nobody scored on counts 0 for all), before `aggregate`
+    /// combines them. A network then earns most from the trials few others get right, and a
+    /// population of equals scores 1. Fitness so becomes relative to the networks scored
+    /// together; the champion's validation and the success rule do not change. Default false.
+    pub sharing: bool,
     /// Fresh chains (of the success check's length) in a run's validation set, on which the best
     /// candidates of each generation are judged to choose the champion. Default 40.
     pub validation_chains: usize,
@@ -152,6 +159,7 @@ impl Default for Nav1dConfig {
             trials_per_environment: 5,
             chains_per_environment: 2,
             aggregate: Aggregate::Mean,
+            sharing: false,
             validation_chains: 40,
             start_jitter: 0.0,
             landmark_jitter: 0.0,

@@ -247,8 +247,9 @@ impl Nav1dTask {
 
     /// The fitness of every network in `generation`: the mean score over the scored trials of
     /// [`chains`](Self::chains), or, as `aggregate` says, the worst environment type's mean
-    /// score. Blocks of [`LANES`] networks run in parallel. Stops with [`Error::Interrupted`]
-    /// between chains once `cancel` is set.
+    /// score; with `sharing`, of the shared scores (see [`Nav1dConfig::sharing`]). Blocks of
+    /// [`LANES`] networks run in parallel. Stops with [`Error::Interrupted`] between chains once
+    /// `cancel` is set.
     pub fn scores(
         &self,
         networks: &[Network],
@@ -263,13 +264,22 @@ impl Nav1dTask {
         let chains = self.chains(seed, generation);
         let types = &self.config.environments;
         let type_of = |chain: &[Condition]| types.iter().position(|&e| e == chain[0].environment);
-        let aggregate = self.config.aggregate;
-        by_block(
+        // The environment type of each scored trial, in the order the chains run them.
+        let trial_types: Vec<usize> = chains
+            .iter()
+            .flat_map(|chain| {
+                let of_type = type_of(chain).unwrap_or(0);
+                (0..chain.len())
+                    .filter(|&t| self.judge(t, &chain[t], false, 0.0).is_some())
+                    .map(move |_| of_type)
+            })
+            .collect();
+        let mut scores = by_block(
             networks,
             chains.len(),
             cancel,
-            |len| Totals::new(types.len(), len),
-            |totals, _, block, c| {
+            |len| vec![Vec::with_capacity(trial_types.len()); len],
+            |scores, _, block, c| {
                 let chain = &chains[c];
                 let outcome = run_chains(
                     &self.config,
@@ -278,22 +288,26 @@ impl Nav1dTask {
                     true,
                     |_, _, _| {},
                 )?;
-                let of_type = type_of(chain).unwrap_or(0);
                 for (t, condition) in chain.iter().enumerate() {
-                    let mut scored = false;
-                    for l in 0..LANES {
+                    for (l, lane) in scores.iter_mut().enumerate() {
                         let (r, c) = (outcome.reached[t][l], outcome.classification[t][l]);
                         if let Some((score, _)) = self.judge(t, condition, r, c) {
-                            totals.add(of_type, l, score);
-                            scored = true;
+                            lane.push(score);
                         }
                     }
-                    totals.count(of_type, scored);
                 }
                 Ok(())
             },
-            |totals| totals.fitness(aggregate),
-        )
+            |scores| scores,
+        )?;
+        if self.config.sharing {
+            share(&mut scores);
+        }
+        let aggregate = self.config.aggregate;
+        Ok(scores
+            .iter()
+            .map(|s| fitness(s, &trial_types, types.len(), aggregate))
+            .collect())
     }
 
     /// Runs `net` through each of `chains` (all of the same length), [`LANES`] chains at a time in
@@ -553,51 +567,35 @@ impl Task for Nav1dTask {
     }
 }
 
-/// The running sums of one block's scores: over all scored trials, and per environment type.
-struct Totals {
-    sum: [f64; LANES],
-    count: usize,
-    by_type: Vec<([f64; LANES], usize)>,
-    len: usize,
+/// One network's fitness from its scores on the scored trials (of environment type
+/// `trial_types[k]`, one of `types`): their mean, combined as `aggregate` says with the worst
+/// type's mean (types without a scored trial are left out).
+fn fitness(scores: &[f64], trial_types: &[usize], types: usize, aggregate: Aggregate) -> f64 {
+    let overall = scores.iter().fold(0.0, |sum, s| sum + s) / scores.len() as f64;
+    if aggregate == Aggregate::Mean {
+        return overall;
+    }
+    let mut by_type = vec![(0.0, 0usize); types];
+    for (&s, &of_type) in scores.iter().zip(trial_types) {
+        by_type[of_type].0 += s;
+        by_type[of_type].1 += 1;
+    }
+    let worst = by_type
+        .iter()
+        .filter(|(_, n)| *n > 0)
+        .map(|(sum, n)| sum / *n as f64)
+        .fold(f64::INFINITY, f64::min);
+    aggregate.combine(overall, worst)
 }
 
-impl Totals {
-    fn new(types: usize, len: usize) -> Self {
-        Totals {
-            sum: [0.0; LANES],
-            count: 0,
-            by_type: vec![([0.0; LANES], 0); types],
-            len,
+/// Implicit fitness sharing: each network's score on each trial (`scores[network][trial]`),
+/// divided by every network's mean score on that trial; 0 where that mean is 0.
+fn share(scores: &mut [Vec<f64>]) {
+    let trials = scores.first().map_or(0, Vec::len);
+    for k in 0..trials {
+        let mean = scores.iter().fold(0.0, |sum, s| sum + s[k]) / scores.len() as f64;
+        for s in scores.iter_mut() {
+            s[k] = if mean > 0.0 { s[k] / mean } else { 0.0 };
         }
-    }
-
-    fn add(&mut self, of_type: usize, lane: usize, score: f64) {
-        self.sum[lane] += score;
-        self.by_type[of_type].0[lane] += score;
-    }
-
-    fn count(&mut self, of_type: usize, scored: bool) {
-        self.count += usize::from(scored);
-        self.by_type[of_type].1 += usize::from(scored);
-    }
-
-    /// Each lane's fitness: the mean over all scored trials, combined as `aggregate` says with
-    /// the worst type's mean (types without a scored trial are left out).
-    fn fitness(&self, aggregate: Aggregate) -> Vec<f64> {
-        (0..self.len)
-            .map(|l| {
-                let overall = self.sum[l] / self.count as f64;
-                if aggregate == Aggregate::Mean {
-                    return overall;
-                }
-                let worst = self
-                    .by_type
-                    .iter()
-                    .filter(|(_, n)| *n > 0)
-                    .map(|(sum, n)| sum[l] / *n as f64)
-                    .fold(f64::INFINITY, f64::min);
-                aggregate.combine(overall, worst)
-            })
-            .collect()
     }
 }

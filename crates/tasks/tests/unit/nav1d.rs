@@ -201,6 +201,82 @@ fn batched_evaluation_equals_the_record_and_ignores_threads() {
 }
 
 #[test]
+fn sharing_divides_each_trial_by_the_populations_mean_score() {
+    // Recomputed from records in chain order: each scored trial's score over the mean of all
+    // networks' scores on it, then the mean (or the worst type's mean) of those.
+    for objective in [Objective::Goal, Objective::Single, Objective::Classify] {
+        let plain = jittered(objective, World::Continuous);
+        let base = task(plain.clone());
+        let nets = random_networks(19, 5, 2, 12);
+        let chains = base.chains(9, 4);
+        let mut scores = vec![vec![]; nets.len()];
+        let mut of_type = vec![];
+        for chain in &chains {
+            let near = usize::from(chain[0].environment == Environment::Near);
+            for (p, net) in nets.iter().enumerate() {
+                let rec = base.record(net, chain, true).unwrap();
+                for (k, c) in chain.iter().enumerate() {
+                    if let Some((s, _)) = base.judge(k, c, rec.reached[k], rec.classification[k]) {
+                        scores[p].push(s);
+                        of_type.extend((p == 0).then_some(near));
+                    }
+                }
+            }
+        }
+        for k in 0..of_type.len() {
+            let mean = scores.iter().fold(0.0, |sum, s| sum + s[k]) / nets.len() as f64;
+            for s in scores.iter_mut() {
+                s[k] = if mean > 0.0 { s[k] / mean } else { 0.0 };
+            }
+        }
+        let means = base.evaluate(&nets, 4, 9, None).unwrap();
+        let mut differs = false;
+        for aggregate in [Aggregate::Mean, Aggregate::Min] {
+            let shared = Nav1dConfig {
+                sharing: true,
+                aggregate,
+                ..plain.clone()
+            };
+            let fitness = task(shared).evaluate(&nets, 4, 9, None).unwrap();
+            for (p, s) in scores.iter().enumerate() {
+                let mean = s.iter().fold(0.0, |sum, x| sum + x) / s.len() as f64;
+                let mut by_type = [(0.0, 0usize); 2];
+                for (&x, &i) in s.iter().zip(&of_type) {
+                    by_type[i].0 += x;
+                    by_type[i].1 += 1;
+                }
+                let worst = by_type
+                    .iter()
+                    .map(|&(sum, n)| sum / n as f64)
+                    .fold(f64::INFINITY, f64::min);
+                let want = if aggregate == Aggregate::Mean {
+                    mean
+                } else {
+                    worst
+                };
+                assert_eq!(fitness[p].to_bits(), want.to_bits(), "{objective:?} {p}");
+                differs |= fitness[p] != means[p];
+            }
+        }
+        assert!(differs, "{objective:?}: sharing changed no fitness");
+    }
+}
+
+#[test]
+fn sharing_among_equals_leaves_goal_scores_as_they_are() {
+    // Every network of the population alike: a trial is either scored by all (shared score 1)
+    // or by none (0), as without sharing.
+    let plain = jittered(Objective::Single, World::Continuous);
+    let nets = vec![random_networks(1, 5, 2, 3).remove(0); 5];
+    let want = task(plain.clone()).evaluate(&nets, 2, 7, None).unwrap();
+    let shared = Nav1dConfig {
+        sharing: true,
+        ..plain
+    };
+    assert_eq!(task(shared).evaluate(&nets, 2, 7, None).unwrap(), want);
+}
+
+#[test]
 fn min_aggregates_score_the_worst_environment_type() {
     // Per type, the mean over that type's scored trials, recomputed from records in chain order.
     for objective in [Objective::Goal, Objective::Single] {

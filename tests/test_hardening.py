@@ -309,7 +309,8 @@ def test_generations_extends_a_run_keeping_files_in_agreement(pristine: Path, tm
 
 
 KILLS = 30 if FULL else 8
-KILL_RUN = ["sequence-1bit", "--quick", "--set", "population=40", "--set", "generations=200"]
+KILL_GENERATIONS = 100
+KILL_RUN = ["sequence-1bit", "--quick", "--set", "population=40", "--set", f"generations={KILL_GENERATIONS}"]
 #: The command, checkpointing after every generation so that kills land inside writes too.
 FREQUENT = ("import sys, dnnevo; e = sys.modules['dnnevo.evolve']; e.CHECKPOINT_SECONDS = 0.0; "
             "e.LOG_SECONDS = 0.0; from dnnevo.cli import main; sys.exit(main(sys.argv[1:]))")
@@ -337,12 +338,12 @@ def test_kill_at_random_moments_then_resume_is_bit_identical(tmp_path: Path) -> 
         assert "Traceback" not in err, err
         if (out / "checkpoint.json").exists():
             progress.append(len(RunDir(out).read_checkpoint().history))
-            if progress[-1] == 200 and not any(0 < n < 200 for n in progress):
+            if progress[-1] == KILL_GENERATIONS and not any(0 < n < KILL_GENERATIONS for n in progress):
                 # The machine got quicker than during the reference run, so a whole run fit
                 # before the kill: start again with kill times over a shorter span.
                 shutil.rmtree(out)
                 span = max(0.5, span / 2)
-    assert any(0 < n < 200 for n in progress), progress  # some kills landed mid-run
+    assert any(0 < n < KILL_GENERATIONS for n in progress), progress  # some kills landed mid-run
     r = run_cli("resume", out) if (out / "checkpoint.json").exists() else run_cli(*start)
     assert r.returncode == 0, r.stderr
     assert (out / "best.json").read_bytes() == (ref / "best.json").read_bytes()

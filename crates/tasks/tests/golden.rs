@@ -5,9 +5,9 @@
 //! A deliberate change of the numbers (a new sigmoid, say) updates the constants below, and the
 //! changelog says so.
 
-use ctrnn::genome::{self, Layout, Ranges};
+use ctrnn::genome::{self, Layout};
 use ctrnn::simd::{self, Kernel};
-use ctrnn::{Evolution, Fill, Inputs, Integrator, Method, Network, Population, Purpose, Stream};
+use ctrnn::{Evolution, Fill, Inputs, Integrator, Method, Network, Population};
 use tasks::RunConfig;
 
 /// FNV-1a over the bits of `values`: any change of any bit changes it.
@@ -41,12 +41,7 @@ fn same_on_every_kernel(what: &str, stored: u64, f: impl Fn() -> u64) {
 }
 
 fn random_networks(layout: Layout, count: usize) -> Vec<Network> {
-    (0..count)
-        .map(|i| {
-            let mut s = Stream::new(17, 0, Purpose::Init, i as u64, 0);
-            genome::decode(layout, &genome::random(layout, &Ranges::default(), &mut s)).unwrap()
-        })
-        .collect()
+    tasks::testing::random_networks(layout, count, 17)
 }
 
 #[test]

@@ -2,8 +2,7 @@
 //! training conditions of any generation or with the conditions `dnnevo evaluate` draws, and
 //! judged per network whatever the batch it comes in.
 
-use ctrnn::genome::{self, Layout, Ranges};
-use ctrnn::{Network, Purpose, Stream, Task, Validation};
+use ctrnn::{Layout, Network, Purpose, Task, Validation};
 use tasks::landmark::{LandmarkConfig, LandmarkTask};
 use tasks::nav1d::{Nav1dConfig, Nav1dTask, Objective};
 use tasks::{SequenceConfig, SequenceTask};
@@ -11,12 +10,7 @@ use tasks::{SequenceConfig, SequenceTask};
 const SEED: u64 = 11;
 
 fn random_networks(layout: Layout, count: usize) -> Vec<Network> {
-    (0..count)
-        .map(|i| {
-            let mut s = Stream::new(5, 0, Purpose::Init, i as u64, 0);
-            genome::decode(layout, &genome::random(layout, &Ranges::default(), &mut s)).unwrap()
-        })
-        .collect()
+    tasks::testing::random_networks(layout, count, 5)
 }
 
 /// `validate` of a batch equals `validate` of each network alone, and every value is in [0, 1].

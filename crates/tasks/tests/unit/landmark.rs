@@ -1,5 +1,4 @@
-use ctrnn::genome::{self, Ranges};
-use ctrnn::{Network, Purpose, Stream, Task};
+use ctrnn::{Layout, Network, Purpose, Stream, Task};
 use tasks::landmark::*;
 
 mod trials;
@@ -24,16 +23,11 @@ fn constant(theta0: f64) -> Network {
 }
 
 fn random_networks(count: usize, seed: u64) -> Vec<Network> {
-    let layout = genome::Layout {
+    let layout = Layout {
         size: 8,
         n_inputs: 1,
     };
-    (0..count)
-        .map(|i| {
-            let mut s = Stream::new(seed, 0, Purpose::Init, i as u64, 0);
-            genome::decode(layout, &genome::random(layout, &Ranges::default(), &mut s)).unwrap()
-        })
-        .collect()
+    tasks::testing::random_networks(layout, count, seed)
 }
 
 #[test]

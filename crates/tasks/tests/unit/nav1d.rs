@@ -1,7 +1,7 @@
-use ctrnn::genome::{self, Ranges};
-use ctrnn::{Network, Stream, Task};
+use ctrnn::{Layout, Network, Task};
 
 use tasks::nav1d::*;
+use tasks::testing;
 use tasks::Aggregate;
 
 /// A network with zero weights whose neuron `i` fires at the constant rate `f(-theta[i])`.
@@ -34,14 +34,7 @@ fn goal_task(envs: &[Environment]) -> Nav1dTask {
 }
 
 fn random_networks(count: usize, size: usize, m: usize, seed: u64) -> Vec<Network> {
-    let layout = genome::Layout { size, n_inputs: m };
-    let ranges = Ranges::default();
-    (0..count)
-        .map(|i| {
-            let mut s = Stream::new(seed, 0, ctrnn::Purpose::Init, i as u64, 0);
-            genome::decode(layout, &genome::random(layout, &ranges, &mut s)).unwrap()
-        })
-        .collect()
+    testing::random_networks(Layout { size, n_inputs: m }, count, seed)
 }
 
 #[test]

@@ -1,6 +1,5 @@
 //! Tests of the sequence task.
 
-use ctrnn::genome::{self, Ranges};
 use ctrnn::{Error, Layout, Method, Network, Purpose, Stream, Task};
 use std::sync::atomic::AtomicBool;
 use tasks::sequence::*;
@@ -18,12 +17,7 @@ fn random_networks(count: usize, seed: u64) -> Vec<Network> {
         size: 5,
         n_inputs: 2,
     };
-    (0..count)
-        .map(|i| {
-            let mut s = Stream::new(seed, 0, Purpose::Init, i as u64, 0);
-            genome::decode(layout, &genome::random(layout, &Ranges::default(), &mut s)).unwrap()
-        })
-        .collect()
+    tasks::testing::random_networks(layout, count, seed)
 }
 
 fn task(config: SequenceConfig) -> SequenceTask {

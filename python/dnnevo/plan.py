@@ -94,6 +94,10 @@ EXPERIMENTS: tuple[Experiment, ...] = (
     Experiment("sequence-2bit-direct16", "sequence", EVOLVE, "not in the paper",
                preset="sequence-2bit-direct16",
                note="the direct route with 16 neurons, rank selection and 20 elites"),
+    Experiment("sequence-2bit-direct16-clamp-eval", "sequence", EVOLVE, "not in the paper",
+               preset="sequence-2bit-direct16-clamp-eval",
+               note="sequence-2bit-direct16 with the score clamped once per evaluation, not per "
+                    "trial"),
     Experiment("sequence-3bit", "sequence", EVOLVE, "§5.4: 1 success, at generation 700",
                preset="sequence-3bit"),
 )

@@ -15,8 +15,6 @@ import sys
 import time
 from typing import Any, TextIO
 
-from tqdm import tqdm
-
 from dnnevo.progress import clock
 
 __all__ = ["RunsView"]
@@ -32,8 +30,12 @@ class RunsView:
         self.total, self.done, self.failed = total, done, 0
         self.before = done
         self.t0 = time.perf_counter()
-        self.bar: Any = (tqdm(total=total, initial=done, unit="run", file=self.stream, dynamic_ncols=True,
-                              smoothing=0.0) if bar and self.tty else None)
+        self.bar: Any = None
+        if bar and self.tty:
+            from tqdm import tqdm  # here, not at the top: its import costs every command ~0.1 s
+
+            self.bar = tqdm(total=total, initial=done, unit="run", file=self.stream, dynamic_ncols=True,
+                            smoothing=0.0)
 
     def started(self, name: str) -> None:
         """Shows that the run ``name`` has begun (when runs go one at a time)."""

@@ -122,6 +122,15 @@ pub struct Nav1dConfig {
     /// population of equals scores 1. Fitness so becomes relative to the networks scored
     /// together; the champion's validation and the success rule do not change. Default false.
     pub sharing: bool,
+    /// Shaping toward the classifier (beyond the paper), for `"single"` only: each scored trial
+    /// scores `(1 - w) * reached + w * c` with `w = classify_weight`, where `c` is the
+    /// classifier's output read as `"classify"` reads it (`f(v_C)` in a landmark-near
+    /// environment, `1 - f(v_C)` in a landmark-far one) at the end of that trial's reinforcement
+    /// period. It rewards a network for holding its environment type through the chain, a
+    /// stepping stone the goal alone does not reward. Whether a trial is done right, and so the
+    /// rate, the champion's validation and the success rule, still count goals only. In [0, 1];
+    /// default 0 (the goal alone).
+    pub classify_weight: f64,
     /// Fresh chains (of the success check's length) in a run's validation set, on which the best
     /// candidates of each generation are judged to choose the champion. Default 40.
     pub validation_chains: usize,
@@ -160,6 +169,7 @@ impl Default for Nav1dConfig {
             chains_per_environment: 2,
             aggregate: Aggregate::Mean,
             sharing: false,
+            classify_weight: 0.0,
             validation_chains: 40,
             start_jitter: 0.0,
             landmark_jitter: 0.0,
@@ -218,6 +228,15 @@ impl Nav1dConfig {
         }
         if self.chained && self.objective != Objective::Goal {
             return config("chained is true; it applies to the \"goal\" objective only".into());
+        }
+        let w = self.classify_weight;
+        if !(0.0..=1.0).contains(&w) {
+            return config(format!("classify_weight is {w}; it must lie in [0, 1]"));
+        }
+        if w != 0.0 && self.objective != Objective::Single {
+            return config(format!(
+                "classify_weight is {w}; it applies to the \"single\" objective only"
+            ));
         }
         if self.objective == Objective::Single && self.trials_per_environment < 2 {
             return config(format!(

@@ -234,14 +234,18 @@ impl Nav1dTask {
         reached: bool,
         classification: f64,
     ) -> Option<(f64, bool)> {
-        let goal = (f64::from(u8::from(reached)), reached);
+        let goal = f64::from(u8::from(reached));
+        let classified = match condition.environment {
+            Environment::Near => (classification, classification >= 0.5),
+            Environment::Far => (1.0 - classification, classification < 0.5),
+        };
         match self.config.objective {
-            Objective::Goal => Some(goal),
-            Objective::Single => (t > 0).then_some(goal),
-            Objective::Classify => Some(match condition.environment {
-                Environment::Near => (classification, classification >= 0.5),
-                Environment::Far => (1.0 - classification, classification < 0.5),
-            }),
+            Objective::Goal => Some((goal, reached)),
+            Objective::Single => {
+                let w = self.config.classify_weight;
+                (t > 0).then_some(((1.0 - w) * goal + w * classified.0, reached))
+            }
+            Objective::Classify => Some(classified),
         }
     }
 

@@ -270,6 +270,71 @@ fn sharing_among_equals_leaves_goal_scores_as_they_are() {
 }
 
 #[test]
+fn classify_weight_blends_the_goal_with_the_classifier_on_scored_trials() {
+    // Recomputed from records: the mean over trials 2..k of (1 - w) * goal + w * the classifier's
+    // right-hand output (f(v_C) near, 1 - f(v_C) far) at the end of the trial.
+    let plain = jittered(Objective::Single, World::Continuous);
+    let base = task(plain.clone());
+    let nets = random_networks(11, 5, 2, 21);
+    let chains = base.chains(5, 3);
+    let w = 0.375;
+    let shaped = task(Nav1dConfig {
+        classify_weight: w,
+        ..plain
+    });
+    let fitness = shaped.evaluate(&nets, 3, 5, None).unwrap();
+    let mut differs = false;
+    for (p, net) in nets.iter().enumerate() {
+        let (mut total, mut scored) = (0.0, 0);
+        for chain in &chains {
+            let rec = base.record(net, chain, true).unwrap();
+            for k in 1..chain.len() {
+                let c = rec.classification[k];
+                let right = match chain[k].environment {
+                    Environment::Near => c,
+                    Environment::Far => 1.0 - c,
+                };
+                total += (1.0 - w) * f64::from(u8::from(rec.reached[k])) + w * right;
+                scored += 1;
+            }
+        }
+        let want = total / scored as f64;
+        assert!(
+            (fitness[p] - want).abs() < 1e-12,
+            "{p}: {} vs {want}",
+            fitness[p]
+        );
+        differs |= fitness[p] != base.evaluate(&nets[p..=p], 3, 5, None).unwrap()[0];
+    }
+    assert!(differs, "classify_weight changed no fitness");
+    // Done right still means the goal reached: the rate and the success rule ignore the weight.
+    for net in &nets[..3] {
+        let (a, b) = (
+            base.assess(net, 6, 2).unwrap(),
+            shaped.assess(net, 6, 2).unwrap(),
+        );
+        assert_eq!(a.rate, b.rate);
+    }
+    for (params, needle) in [
+        (
+            serde_json::json!({"objective": "single", "classify_weight": 1.5}),
+            "[0, 1]",
+        ),
+        (
+            serde_json::json!({"objective": "single", "classify_weight": -0.1}),
+            "[0, 1]",
+        ),
+        (
+            serde_json::json!({"objective": "goal", "classify_weight": 0.5}),
+            "\"single\"",
+        ),
+    ] {
+        let e = Nav1dTask::from_params(&params).unwrap_err().to_string();
+        assert!(e.contains("classify_weight") && e.contains(needle), "{e}");
+    }
+}
+
+#[test]
 fn min_aggregates_score_the_worst_environment_type() {
     // Per type, the mean over that type's scored trials, recomputed from records in chain order.
     for objective in [Objective::Goal, Objective::Single] {

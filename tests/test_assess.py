@@ -92,7 +92,7 @@ def test_nav1d_clusters_the_trials_of_a_chain() -> None:
     cfg = presets.get("nav1d-single")
     a = assess.assess(cfg, constant([8.0, -8.0], 8, 2), 20, seed=1)  # always drives right
     overall = a.rates[-1]
-    assert a.details == {"objective": "single", "scored_per_chain": 4}
+    assert a.details == {"objective": "single", "scored_per_chain": 4, "classify_weight": 0.0}
     assert (overall.n, overall.effective_n) == (80, 20.0)  # trials 2-5 of 20 chains
     assert overall.rate == pytest.approx(a.report["rate"])
     assert overall.interval == pytest.approx(stats.wilson(overall.rate * 20, 20))
@@ -100,6 +100,26 @@ def test_nav1d_clusters_the_trials_of_a_chain() -> None:
     # The clustered interval is wider than one that took the 80 trials as independent.
     lo, hi = stats.wilson(overall.k, 80)
     assert overall.interval[1] - overall.interval[0] > hi - lo
+
+
+def test_shaped_single_networks_show_their_classifier_by_trial() -> None:
+    from pathlib import Path
+
+    from dnnevo import _cli_nav1d
+
+    says_near = constant([8.0, -8.0, -50.0], 8, 2)  # drives right; f(v_C) ~ 1 says near
+    plain = presets.get("nav1d-single")
+    shaped = presets.get("nav1d-single", overrides=["task_params.classify_weight=0.5"])
+    a = assess.assess(shaped, says_near, 20, seed=1)
+    assert a.details["classify_weight"] == 0.5
+    lines = _cli_nav1d.preface(Path("run"), a)
+    at = next(i for i, line in enumerate(lines) if line.startswith("The classifier"))
+    rows = {line.split()[0]: line.split()[2:] for line in lines[at + 2:]}
+    assert set(rows["far"]) == {"0.0%"} and set(rows["near"]) == {"100.0%"}
+    # The goals, and so the verdict, do not depend on the shaping.
+    b = assess.assess(plain, says_near, 20, seed=1)
+    assert a.rates == b.rates
+    assert not any(line.startswith("The classifier") for line in _cli_nav1d.preface(Path("run"), b))
 
 
 def test_scored_trials_follow_the_task() -> None:

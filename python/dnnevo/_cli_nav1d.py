@@ -25,7 +25,11 @@ SYSTEM_EXAMPLE = (
 
 def _rate_table(episodes: Sequence[dict[str, Any]], first_scored: int) -> list[str]:
     """Goal rate by environment type and trial index, one line per environment type."""
-    rates = nav1d.goal_rates(episodes)
+    return _by_trial(nav1d.goal_rates(episodes), episodes, first_scored)
+
+
+def _by_trial(rates: dict[str, Any], episodes: Sequence[dict[str, Any]], first_scored: int) -> list[str]:
+    """A table of ``rates`` by environment type and trial index, one line per environment type."""
     k = len(rates["all"])
     lines = [f"{'environment':>12} {'chains':>6}  " + " ".join(f"{'trial ' + str(t + 1):>8}" for t in range(k))]
     for env in ("far", "near", "all"):
@@ -57,6 +61,10 @@ def preface(where: Path, a: Assessment) -> list[str]:
                 lines.append(f"{env:>12} {goal:>6} {len(picked):>6} {right.mean():>7.1%} {f.mean():>12.3f}")
     else:
         lines += _rate_table(episodes, 1 if objective == "single" else 0)
+    if objective == "single" and a.details.get("classify_weight", 0.0) > 0:
+        lines.append("The classifier (shaped by classify_weight): trials after which it names the "
+                     "environment right (f(v_C) >= 0.5 exactly in landmark-near chains).")
+        lines += _by_trial(nav1d.classifier_rates(episodes), episodes, 0)
     return lines
 
 

@@ -177,7 +177,7 @@ class Assessment:
     """How the intervals were computed, in words."""
     details: dict[str, Any] = field(default_factory=dict)
     """Task-specific facts: ``mean_performance`` (sequence), ``confusion`` and ``robot_like``
-    (landmark), ``objective`` and ``scored_per_chain`` (nav1d)."""
+    (landmark), ``objective``, ``scored_per_chain`` and ``classify_weight`` (nav1d)."""
     report: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     """The task's own assessment, as its module returned it (not in :meth:`to_dict`)."""
 
@@ -321,5 +321,6 @@ def _nav1d(config: EvolutionConfig, net: _core.Network, trials: int, seed: int) 
     return Assessment(
         task="nav1d", trials=trials, unit=UNITS["nav1d"], seed=seed, rates=[*rates, overall],
         verdict=combine([r.verdict for r in [overall] if r.verdict is not None]), method=method,
-        details={"objective": objective, "scored_per_chain": per_chain}, report=report,
+        details={"objective": objective, "scored_per_chain": per_chain,
+                 "classify_weight": float(config.task_json().get("classify_weight", 0.0))}, report=report,
     )

@@ -173,6 +173,19 @@ def goal_rates(episodes: Sequence[dict[str, Any]]) -> dict[str, npt.NDArray[np.f
     return out
 
 
+def classifier_rates(episodes: Sequence[dict[str, Any]]) -> dict[str, npt.NDArray[np.float64]]:
+    """The fraction of trials after which the classifier named the environment right
+    (``f(v_C) >= 0.5`` exactly in landmark-near chains, read at the end of the trial's
+    reinforcement period), by environment type (``"far"``, ``"near"``, ``"all"``) and trial
+    index, as :func:`goal_rates` breaks down the goals."""
+    out = {}
+    for env in ("far", "near", "all"):
+        rows = [[(c is not None and c >= 0.5) == (e["environment"] == "near") for c in e["classification"]]
+                for e in episodes if env in ("all", e["environment"])]
+        out[env] = np.array(rows, dtype=float).mean(axis=0) if rows else np.array([])
+    return out
+
+
 def load_part(run_dir: str | Path, role: str | None = None) -> Part:
     """The config and champion of a ``nav1d`` run folder; ``role`` (e.g. ``"--far"``) names the
     folder in errors."""

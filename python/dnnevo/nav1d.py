@@ -23,7 +23,7 @@ reached, or the environment classified right: ``f(v_C) >= 0.5`` means landmark-n
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -166,22 +166,23 @@ def assess(config: EvolutionConfig, net: _core.Network, count: int, seed: int) -
 def goal_rates(episodes: Sequence[dict[str, Any]]) -> dict[str, npt.NDArray[np.float64]]:
     """The fraction of trials that reached the goal, by environment type (``"far"``,
     ``"near"``, ``"all"``) and trial index: an array of length k for each."""
-    out = {}
-    for env in ("far", "near", "all"):
-        rows = [e["reached"] for e in episodes if env in ("all", e["environment"])]
-        out[env] = np.array(rows, dtype=float).mean(axis=0) if rows else np.array([])
-    return out
+    return _by_environment(episodes, lambda e: e["reached"])
 
 
 def classifier_rates(episodes: Sequence[dict[str, Any]]) -> dict[str, npt.NDArray[np.float64]]:
     """The fraction of trials after which the classifier named the environment right
     (``f(v_C) >= 0.5`` exactly in landmark-near chains, read at the end of the trial's
-    reinforcement period), by environment type (``"far"``, ``"near"``, ``"all"``) and trial
-    index, as :func:`goal_rates` breaks down the goals."""
+    reinforcement period), by environment type and trial index, as :func:`goal_rates`."""
+    return _by_environment(episodes, lambda e: [(c is not None and c >= 0.5) == (e["environment"] == "near")
+                                                 for c in e["classification"]])
+
+
+def _by_environment(episodes: Sequence[dict[str, Any]],
+                    row: Callable[[dict[str, Any]], Sequence[bool]]) -> dict[str, npt.NDArray[np.float64]]:
+    """The mean of ``row(episode)`` over the episodes of each environment type and of all."""
     out = {}
     for env in ("far", "near", "all"):
-        rows = [[(c is not None and c >= 0.5) == (e["environment"] == "near") for c in e["classification"]]
-                for e in episodes if env in ("all", e["environment"])]
+        rows = [row(e) for e in episodes if env in ("all", e["environment"])]
         out[env] = np.array(rows, dtype=float).mean(axis=0) if rows else np.array([])
     return out
 

@@ -30,6 +30,13 @@ def results(out: Path) -> list[dict[str, Any]]:
     return [{k: v for k, v in r.items() if k != "wall_s"} for r in runs]
 
 
+def log_without_times(run: Path) -> list[list[str]]:
+    """log.csv without its speed and wall-time columns, which differ from run to run."""
+    rows = [line.split(",") for line in (run / "log.csv").read_text().splitlines()]
+    keep = [i for i, name in enumerate(rows[0]) if name not in ("evals_per_s", "elapsed_s")]
+    return [[row[i] for i in keep] for row in rows]
+
+
 def test_a_stopped_sweep_continues_to_the_same_results(tmp_path: Path) -> None:
     whole = tmp_path / "whole"
     sweep(whole, "0-2")
@@ -47,6 +54,29 @@ def test_a_stopped_sweep_continues_to_the_same_results(tmp_path: Path) -> None:
     for seed in range(3):
         best = f"seed-{seed}/best.json"
         assert (parts / best).read_bytes() == (whole / best).read_bytes()
+
+
+def test_more_generations_extend_a_sweep_to_the_results_of_a_longer_one(tmp_path: Path) -> None:
+    longer = tmp_path / "longer"
+    assert run_cli("sweep", *ARGS, "--set", "generations=12", "--seeds", "0-1", "--out", longer).returncode == 0
+    extended = tmp_path / "extended"
+    sweep(extended, "0-1")
+    r = run_cli("sweep", *ARGS, "--set", "generations=12", "--seeds", "0-2", "--out", extended)
+    assert r.returncode == 0, r.stderr
+    assert "extending the sweep from 8 to 12 generations" in r.stdout
+    assert "seed 1: resuming at generation 8" in r.stdout
+    assert json.loads((extended / "sweep.json").read_text())["config"]["generations"] == 12
+    assert run_cli("sweep", *ARGS, "--set", "generations=12", "--seeds", "0-2", "--out", longer).returncode == 0
+    assert results(extended) == results(longer)
+    for seed in range(3):
+        path = f"seed-{seed}/best.json"
+        assert (extended / path).read_bytes() == (longer / path).read_bytes(), path
+        assert log_without_times(extended / f"seed-{seed}") == log_without_times(longer / f"seed-{seed}")
+    # Fewer generations than the sweep's, or more with another change, are refused as before.
+    r = run_cli("sweep", *ARGS, "--set", "generations=10", "--seeds", "0", "--out", extended)
+    assert_one_line_error(r, "holds a sweep with config.generations = 12, not 10")
+    r = run_cli("sweep", *ARGS, "--set", "generations=20", "--set", "elitism=2", "--seeds", "0", "--out", extended)
+    assert_one_line_error(r, "holds a sweep with config.generations = 12, not 20")
 
 
 def test_other_settings_are_refused_in_one_line(tmp_path: Path) -> None:

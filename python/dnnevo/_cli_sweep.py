@@ -10,13 +10,14 @@ import re
 import shutil
 import sys
 from pathlib import Path
+from typing import Any
 
 from dnnevo import presets, scheduler, seeding, sweep
 from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.rundir import LOCK_NAME, RunDir, check_settings, write_atomic
+from dnnevo.rundir import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
 from dnnevo.runsview import RunsView
 
 SETTINGS_FILE = "sweep.json"
@@ -24,6 +25,7 @@ SETTINGS_FILE = "sweep.json"
 
 EXAMPLE = """examples:
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
+  dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep --set generations=16   # extend it
   dnnevo sweep landmark --seeds 0-9 --out runs/sweep-lm --eval-trials 100
   dnnevo sweep sequence-1bit --seeds 0-7 --workers 2 --out runs/sweep-dask
   dnnevo sweep sequence-2bit --seeds 0-4 --out runs/inc --seed-from runs/sequence-1bit-seed0 \
@@ -40,8 +42,9 @@ OUT/summary.csv (a row per seed, then a row 'all') and OUT/summary.json.
 
 A sweep records its settings in OUT/sweep.json first. Running the same command again continues
 it: finished seeds are judged again without evolving, stopped ones resume from their checkpoints,
-and seeds not yet begun are run; more seeds may be added. Other settings are refused, naming the
-first that differs. --force starts the sweep afresh: the old summary goes, and so do the old
+and seeds not yet begun are run; more seeds may be added. With more generations (--set
+generations=G) and otherwise the same settings it extends the sweep: every run continues to G
+generations and is judged again. Other settings are refused, naming the first that differs. --force starts the sweep afresh: the old summary goes, and so do the old
 sweep's seed-N run folders (files dnnevo did not write are kept).
 
 With --workers N the seeds run in parallel on a local Dask cluster of N processes, one run each
@@ -68,6 +71,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     with RunDir(args.out).writing(create=True) as folder:
         resuming = not args.force and (manifest.exists() or manifest.is_symlink())
         if resuming:
+            _extend(manifest, settings)
             check_settings(manifest, settings, what="sweep")
         else:
             folder.create(force=args.force, extra=(*sweep.SUMMARY_FILES, SETTINGS_FILE))
@@ -75,6 +79,24 @@ def sweep_command(args: argparse.Namespace) -> int:
                 _clear_other_seeds(args.out, args.seeds)
             write_atomic(manifest, json.dumps(settings, indent=1) + "\n")
         return _sweep(args, config, how, trials, resuming)
+
+
+def _extend(manifest: Path, settings: dict[str, Any]) -> None:
+    """A sweep continued with more generations (``--set generations=G``) and otherwise the same
+    settings is extended: ``manifest`` is rewritten to say so, and each seed's run continues to
+    ``G`` generations when its turn comes. Anything else is left to :func:`check_settings`."""
+    try:
+        found = json.loads(manifest.read_text(encoding="utf-8"))
+        before = found["config"]["generations"]
+        if not isinstance(before, int) or isinstance(before, bool):
+            return
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError):
+        return
+    after = settings["config"]["generations"]
+    if before < after and first_difference(
+            {**found, "config": {**found["config"], "generations": after}}, json.loads(json.dumps(settings))) is None:
+        write_atomic(manifest, json.dumps(settings, indent=1) + "\n")
+        print(f"extending the sweep from {before} to {after} generations")
 
 
 def _clear_other_seeds(out: Path, seeds: list[int]) -> None:

@@ -21,6 +21,7 @@ their uncertainty:
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import math
@@ -128,21 +129,28 @@ def run_seed(
     steps on the same conditions (:func:`~dnnevo.stepcheck.step_check`). With ``seeding`` the
     first population starts from earlier runs' networks (:mod:`dnnevo.seeding`). With ``resume``
     the run in ``out`` (same config and seed, else a :class:`RunFileError`) is continued from its
-    checkpoint, or only judged if it has finished; its wall time then counts every session.
-    ``progress`` shows the run's progress bar."""
+    checkpoint, or only judged if it has finished; its wall time then counts every session. A
+    run made with fewer generations than ``config`` and otherwise the same config is extended to
+    ``config.generations`` (as ``dnnevo resume --generations``). ``progress`` shows the run's
+    progress bar."""
     from dnnevo.evolve import evolve
     from dnnevo.evolve import resume as resume_run
 
     t0 = time.perf_counter()
     if resume:
         found, table = RunDir(out).read_config()
+        # A run of fewer generations, otherwise the same, is one this sweep extends.
+        extend = found.generations < config.generations
+        if extend:
+            found = dataclasses.replace(found, generations=config.generations)
         diff = first_difference(config.to_dict(), found.to_dict())
         if diff is None and table.get("seed") != seed:
             diff = ("run.seed", seed, table.get("seed", "(missing)"))
         if diff is not None:
             raise RunFileError(f"{out}: the run's {diff[0]} is {short(diff[2])}; this sweep's is "
                                f"{short(diff[1])}")
-        result = resume_run(out, threads=threads, progress=progress)
+        result = resume_run(out, threads=threads, progress=progress,
+                            generations=config.generations if extend else None)
         wall = float(result.history["elapsed_s"][-1]) if len(result.history["elapsed_s"]) else 0.0
     else:
         seeds = seeding.networks(config.size, seed) if seeding else None

@@ -65,6 +65,7 @@ def test_more_generations_extend_a_sweep_to_the_results_of_a_longer_one(tmp_path
     assert r.returncode == 0, r.stderr
     assert "extending the sweep from 8 to 12 generations" in r.stdout
     assert "seed 1: resuming at generation 8" in r.stdout
+    assert "seed 2: never met the rule; final champion fail" in r.stdout  # as soon as it is judged
     assert json.loads((extended / "sweep.json").read_text())["config"]["generations"] == 12
     assert run_cli("sweep", *ARGS, "--set", "generations=12", "--seeds", "0-2", "--out", longer).returncode == 0
     assert results(extended) == results(longer)

@@ -138,6 +138,7 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
             runs.append(task.fn(*task.args, **task.kwargs))
             if runs[-1].interrupted:
                 break
+            print(_seed_line(runs[-1]), flush=True)
     # A seed stopped part-way is not a result: its champion is an early one, not the run's.
     stopped = [r.seed for r in runs if r.interrupted]
     finished = [r for r in runs if not r.interrupted]
@@ -176,6 +177,15 @@ def _on_dask(args: argparse.Namespace, tasks: list[scheduler.Task]) -> tuple[lis
     for o in failed:
         sys.stderr.write(f"dnnevo: {o.task.id} failed: {o.message}\n")
     return [o.result for o in outcomes.values() if o.status == "done"], len(failed)
+
+
+def _seed_line(r: sweep.SeedResult) -> str:
+    """One finished seed in a line, printed as soon as it is judged."""
+    w = r.final.weakest
+    rate = f"{w.name} {w.k}/{w.n}" if len(r.final.judged) > 1 else f"{w.k}/{w.n}"
+    met = "never met the rule" if r.first_success is None else f"met the rule at generation {r.first_success}"
+    return (f"seed {r.seed}: {met}; final champion {r.final.verdict} ({rate})"
+            + ("; a step artefact" if r.artefact else ""))
 
 
 def _generation(x: float) -> str:

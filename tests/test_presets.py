@@ -22,3 +22,13 @@ def test_every_preset_runs(name: str, tmp_path: Path) -> None:
     assert (result.best.size, result.best.n_inputs) == (full.size, full.n_inputs)
     result.best.save(tmp_path / "best.json")
     assert dnnevo.Network.load(tmp_path / "best.json") == result.best
+
+
+@pytest.mark.parametrize(("preset", "made_as"), [
+    # The README's results of these presets were made with these commands, before the presets.
+    ("sequence-2bit-direct16-clamp-eval", ("sequence-2bit-direct16", ["task_params.clamp=evaluation"])),
+    ("sequence-2bit-incremental16", ("sequence-2bit", ["size=16", "selection=rank", "elitism=20", "generations=300",
+                                                       "task_params.clamp=evaluation"])),
+])
+def test_a_preset_is_the_config_its_results_were_made_with(preset: str, made_as: tuple[str, list[str]]) -> None:
+    assert presets.get(preset) == presets.get(made_as[0], overrides=made_as[1])

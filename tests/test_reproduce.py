@@ -169,6 +169,11 @@ def test_a_composed_run_uses_the_runs_it_needs(tmp_path: Path) -> None:
         jobs.run_job(job, tmp_path, QUICK, 1)
     table = (tmp_path / "sequence-2bit" / "seed-0" / "config.toml").read_text()
     assert "sequence-1bit/seed-0" in table and "sequence-2bit-alternating/seed-0" in table
+    # The 16-neuron incremental route composes whole populations and 6 spare neurons.
+    job = next(j for j in plan.jobs([0], only=["sequence"]) if j.experiment == "sequence-2bit-incremental16")
+    jobs.run_job(job, tmp_path, QUICK, 1)
+    table = (tmp_path / job.id / "config.toml").read_text()
+    assert 'seeded_with = "populations"' in table and "spare_neurons = 6" in table
 
 
 def test_the_report_says_the_same_in_markdown_and_html(tmp_path: Path) -> None:

@@ -214,7 +214,8 @@ def _evolve(job: plan.Job, root: Path, settings: Settings, threads: int | None, 
     e = job.spec
     config = settings.config(e)
     out = _folder(root, e.name, job.seed)
-    seeding = Seeding(tuple(_folder(root, n, job.seed) for n in e.needs)) if e.needs else None
+    seeding = (Seeding(tuple(_folder(root, n, job.seed) for n in e.needs), populations=e.seed_populations,
+                       spare=e.spare_neurons) if e.needs else None)
     resume = (out / "checkpoint.json").exists()
     run = sweep.run_seed(config, job.seed, out, threads=threads, force=not resume and out.exists(),
                          eval_seed_base=settings.eval_seed, eval_trials=settings.trials(config.task),

@@ -48,6 +48,12 @@ class Experiment:
     """The experiments whose run of the same seed this one uses: for an evolution, the runs whose
     champions seed its first population (composed, the first one's output neuron staying the
     output); for a test, the runs it tests."""
+    seed_populations: bool = False
+    """For an evolution with needs: compose the needed runs' last populations member by member,
+    not their champions (``--seed-populations``)."""
+    spare_neurons: int = 0
+    """For an evolution with needs: unconnected random neurons composed into every seed
+    (``--spare-neurons``)."""
     note: str = ""
     """How dnnevo reads the paper here, for the report."""
 
@@ -98,6 +104,12 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                preset="sequence-2bit-direct16-clamp-eval",
                note="sequence-2bit-direct16 with the score clamped once per evaluation, not per "
                     "trial"),
+    Experiment("sequence-2bit-incremental16", "sequence", EVOLVE, "not in the paper",
+               preset="sequence-2bit-incremental16", needs=("sequence-1bit", "sequence-2bit-alternating"),
+               seed_populations=True, spare_neurons=6,
+               note="the incremental route with sequence-2bit-direct16-clamp-eval's GA: member i of "
+                    "the first population composes member i of the two runs' last populations and "
+                    "6 unconnected random neurons; 300 generations"),
     Experiment("sequence-3bit", "sequence", EVOLVE, "§5.4: 1 success, at generation 700",
                preset="sequence-3bit"),
 )

@@ -51,6 +51,8 @@ _TWO_BIT = ["0", "1", "01", "10"]
 # selection, 20 elites); the paper's 10-neuron direct route fails here as it did there.
 _DIRECT16 = dataclasses.replace(_sequence(_TWO_BIT, 16, 500, 0.002, "generation-mean"), selection="rank",
                                 elitism=20)
+# _DIRECT16 with the score clamped once per evaluation (see the preset that uses it).
+_DIRECT16_CLAMP_EVAL = dataclasses.replace(_DIRECT16, task_params={**_DIRECT16.task_params, "clamp": "evaluation"})
 
 
 def _nav1d(generations: int, size: int, n_inputs: int, **task_params: Any) -> EvolutionConfig:
@@ -101,7 +103,18 @@ PRESETS: dict[str, Preset] = {
     "sequence-2bit-direct16-clamp-eval": Preset(
         "beyond the paper (§5.3): sequence-2bit-direct16 with the score clamped once per "
         "evaluation, not per trial; 1000 x 500",
-        dataclasses.replace(_DIRECT16, task_params={**_DIRECT16.task_params, "clamp": "evaluation"}),
+        _DIRECT16_CLAMP_EVAL,
+        _QUICK,
+    ),
+    # Not in the paper: its incremental route with the GA of sequence-2bit-direct16-clamp-eval,
+    # stopped at 300 generations. The first population is seeded (the preset cannot do that
+    # alone): member i composes member i of a 1-bit run's and of an alternating run's last
+    # populations and 6 unconnected random neurons, without cross weights.
+    "sequence-2bit-incremental16": Preset(
+        "beyond the paper (§5.3): the incremental route, 16 neurons, rank selection, elitism 20, "
+        "score clamped once; --seed-from a sequence-1bit run --seed-from a "
+        "sequence-2bit-alternating run --seed-populations --spare-neurons 6; 1000 x 300",
+        dataclasses.replace(_DIRECT16_CLAMP_EVAL, generations=300),
         _QUICK,
     ),
     # The paper solved these in generations 0, 2 and 5; 30 generations leave room for bad seeds.

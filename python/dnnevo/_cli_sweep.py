@@ -44,8 +44,9 @@ A sweep records its settings in OUT/sweep.json first. Running the same command a
 it: finished seeds are judged again without evolving, stopped ones resume from their checkpoints,
 and seeds not yet begun are run; more seeds may be added. With more generations (--set
 generations=G) and otherwise the same settings it extends the sweep: every run continues to G
-generations and is judged again. Other settings are refused, naming the first that differs. --force starts the sweep afresh: the old summary goes, and so do the old
-sweep's seed-N run folders (files dnnevo did not write are kept).
+generations and is judged again. Other settings are refused, naming the first that differs.
+--force starts the sweep afresh: the old summary goes, and so do the old sweep's seed-N run
+folders (files dnnevo did not write are kept).
 
 With --workers N the seeds run in parallel on a local Dask cluster of N processes, one run each
 at a time with --threads threads (default 1); --scheduler tcp://HOST:8786 uses a running cluster
@@ -181,11 +182,15 @@ def _on_dask(args: argparse.Namespace, tasks: list[scheduler.Task]) -> tuple[lis
 
 def _seed_line(r: sweep.SeedResult) -> str:
     """One finished seed in a line, printed as soon as it is judged."""
-    w = r.final.weakest
-    rate = f"{w.name} {w.k}/{w.n}" if len(r.final.judged) > 1 else f"{w.k}/{w.n}"
     met = "never met the rule" if r.first_success is None else f"met the rule at generation {r.first_success}"
-    return (f"seed {r.seed}: {met}; final champion {r.final.verdict} ({rate})"
+    return (f"seed {r.seed}: {met}; final champion {r.final.verdict} ({_weakest_rate(r)})"
             + ("; a step artefact" if r.artefact else ""))
+
+
+def _weakest_rate(r: sweep.SeedResult) -> str:
+    """The final champion's weakest judged rate as k/n, named when there are several."""
+    w = r.final.weakest
+    return f"{w.name} {w.k}/{w.n}" if len(r.final.judged) > 1 else f"{w.k}/{w.n}"
 
 
 def _generation(x: float) -> str:
@@ -203,7 +208,7 @@ def lines(s: sweep.Summary, eval_seed: int, trials: int, unit: str) -> list[str]
     ]
     for r in s.runs:
         w = r.final.weakest
-        rate = f"{w.name} {w.k}/{w.n}" if len(r.final.judged) > 1 else f"{w.k}/{w.n}"
+        rate = _weakest_rate(r)
         bounds = f"[{w.interval[0]:.1%}, {w.interval[1]:.1%}]"
         out.append(
             f"{r.seed:>5} {r.best_fitness:>8.4f} {r.best_generation:>7} "

@@ -92,6 +92,22 @@ def test_other_settings_are_refused_in_one_line(tmp_path: Path) -> None:
     assert json.loads((out / "sweep.json").read_text())["config"]["elitism"] == 2
 
 
+def test_a_sweep_recorded_before_a_later_setting_continues(tmp_path: Path) -> None:
+    """A sweep.json written before ``champion_step_check`` existed reads as having its default:
+    the sweep continues and is extended; turning the setting on is refused like any change."""
+    out = tmp_path / "s"
+    sweep(out, "0")
+    manifest = out / "sweep.json"
+    recorded = json.loads(manifest.read_text())
+    del recorded["config"]["champion_step_check"]
+    manifest.write_text(json.dumps(recorded))
+    assert "seed 0: finished" in sweep(out, "0")
+    r = run_cli("sweep", *ARGS, "--set", "champion_step_check=true", "--seeds", "0", "--out", out)
+    assert_one_line_error(r, "holds a sweep with config.champion_step_check = False, not True")
+    r = run_cli("sweep", *ARGS, "--set", "generations=10", "--seeds", "0", "--out", out)
+    assert r.returncode == 0 and "extending the sweep from 8 to 10 generations" in r.stdout, r.stderr
+
+
 def test_a_sweep_on_a_local_dask_cluster_gives_the_same_results(tmp_path: Path) -> None:
     pytest.importorskip("distributed")
     here, there = tmp_path / "here", tmp_path / "there"

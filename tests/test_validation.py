@@ -65,6 +65,30 @@ def test_validated_run_resumes_identically(task: str, tmp_path: Path) -> None:
     assert (tmp_path / "full/best.json").read_bytes() == (tmp_path / "part/best.json").read_bytes()
 
 
+@pytest.mark.parametrize("task", sorted(CONFIGS))
+def test_the_step_check_changes_champions_only_and_resumes_identically(task: str, tmp_path: Path) -> None:
+    cfg = config(task, "champion_step_check=true")
+    checked = dnnevo.evolve(task, cfg, seed=3, out=tmp_path / "full", progress=False)
+    plain = dnnevo.evolve(task, config(task), seed=3, progress=False)
+    for key in FITNESS_COLUMNS:
+        np.testing.assert_array_equal(checked.history[key], plain.history[key])
+    assert np.all(np.diff(checked.history["validation_rate"]) >= 0)
+    stop_at_3 = lambda stats, ga: ga.generation >= 3  # noqa: E731
+    dnnevo.evolve(task, cfg, seed=3, out=tmp_path / "part", progress=False, callback=stop_at_3)
+    resumed = dnnevo.resume(tmp_path / "part", progress=False)
+    for key in RESULT_COLUMNS:
+        assert same(checked.history[key], resumed.history[key]), key
+    assert (tmp_path / "full/best.json").read_bytes() == (tmp_path / "part/best.json").read_bytes()
+    two = dnnevo.evolve(task, cfg, seed=3, threads=2, progress=False)
+    assert checked.best == two.best and checked.best_validation == two.best_validation
+
+
+@pytest.mark.parametrize("value", [1, "yes", None])
+def test_bad_champion_step_check_is_a_config_error(value: object) -> None:
+    with pytest.raises(ConfigError, match="champion_step_check is .*; expected true or false"):
+        EvolutionConfig(champion_step_check=value)  # type: ignore[arg-type]
+
+
 def test_validated_run_is_identical_with_one_and_two_threads() -> None:
     cfg = config("landmark")
     one = dnnevo.evolve("landmark", cfg, seed=9, threads=1, progress=False)

@@ -15,7 +15,7 @@ from typing import Any
 from dnnevo import presets, scheduler, seeding, sweep
 from dnnevo._checks import nonnegative
 from dnnevo.assess import DEFAULT_TRIALS, UNITS
-from dnnevo.config import EvolutionConfig
+from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.rundir import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
 from dnnevo.runsview import RunsView
@@ -88,6 +88,7 @@ def _extend(manifest: Path, settings: dict[str, Any]) -> None:
     ``G`` generations when its turn comes. Anything else is left to :func:`check_settings`."""
     try:
         found = json.loads(manifest.read_text(encoding="utf-8"))
+        found = {**found, "config": with_later_defaults(found["config"])}
         before = found["config"]["generations"]
         if not isinstance(before, int) or isinstance(before, bool):
             return

@@ -13,6 +13,7 @@ __all__ = [
     "MUTATION_SCALE",
     "RETRY_STARTS",
     "RUN_DEFAULTS",
+    "STEP_CHECK_FINER",
     "Evolution",
     "Network",
     "Trace",
@@ -56,6 +57,7 @@ RUN_DEFAULTS: str
 MAX_COUNT: int
 MUTATION_SCALE: float
 RETRY_STARTS: int
+STEP_CHECK_FINER: int
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]

@@ -20,7 +20,7 @@ import tomli_w
 from dnnevo import _core
 from dnnevo.errors import ConfigError
 
-__all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides"]
+__all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides", "with_later_defaults"]
 
 _DEFAULTS: dict[str, Any] = json.loads(_core.RUN_DEFAULTS)
 """The Rust core's defaults for a run (``tasks::RunConfig``): every default below is read from
@@ -28,8 +28,21 @@ them, and every value is checked there (:meth:`EvolutionConfig.__post_init__`), 
 cannot drift. Python checks types only."""
 
 #: Settings added after run folders began to carry a config digest. At their defaults they are
-#: left out of the digest (``rundir.config_digest``), so folders written before them still resume.
-LATER_SETTINGS = ("mutation", "mutation_scale")
+#: left out of the digest (``rundir.config_digest``), and a stored config without them reads as
+#: having their defaults (:func:`with_later_defaults`), so folders written before them still resume.
+LATER_SETTINGS = ("mutation", "mutation_scale", "champion_step_check")
+
+
+def with_later_defaults(stored: Any) -> Any:
+    """A config dict read from a file (a sweep's or a reproduction's record), with each of
+    :data:`LATER_SETTINGS` it lacks set to its default; anything else is returned as it is.
+
+    >>> with_later_defaults({"population": 10})["champion_step_check"]
+    False
+    """
+    if not isinstance(stored, Mapping):
+        return stored
+    return {**{name: _DEFAULTS[name] for name in LATER_SETTINGS}, **stored}
 
 
 @dataclass(frozen=True)
@@ -93,6 +106,11 @@ class EvolutionConfig:
     """How many of each generation's best individuals by training fitness are re-scored on the
     task's validation set (fresh conditions, fixed for the run) to choose the champion; 0 chooses
     the champion by training fitness, as the paper does. Evolution itself is unchanged."""
+    champion_step_check: bool = _DEFAULTS["champion_step_check"]
+    """Validate a candidate that would replace the champion again with a step ten times finer
+    (``dt/10``, ten times the substeps) and count the worse of its two validations, so that a
+    network that is right only at the run's step does not become champion. Costs a few
+    validations per change of champion; evolution itself is unchanged."""
     selection: str = _DEFAULTS["selection"]
     """``"proportional"`` (the paper's) or ``"rank"``."""
     fill: str = _DEFAULTS["fill"]
@@ -170,16 +188,19 @@ class EvolutionConfig:
 _TYPES: dict[str, type] = {
     "task": str, "population": int, "generations": int, "crossover_rate": float,
     "mutation_rate": float, "mutation": str, "mutation_scale": float, "elitism": int,
-    "validation_candidates": int, "selection": str, "fill": str, "size": int, "n_inputs": int,
+    "validation_candidates": int, "champion_step_check": bool, "selection": str, "fill": str, "size": int, "n_inputs": int,
 }
 """The type of each plain field of :class:`EvolutionConfig`; the values are checked in Rust."""
 
 
 def _check_type(obj: Any, name: str, kind: type, prefix: str = "") -> None:
-    """``obj.name`` has the type ``kind``: a str; an int (not a bool) >= 0; or a float, which an
-    int may stand for."""
+    """``obj.name`` has the type ``kind``: a str; a bool; an int (not a bool) >= 0; or a float,
+    which an int may stand for."""
     value = getattr(obj, name)
-    if kind is str:
+    if kind is bool:
+        ok = isinstance(value, bool)
+        expected = "true or false"
+    elif kind is str:
         ok = isinstance(value, str)
         expected = "a string"
     elif kind is int:

@@ -25,7 +25,7 @@ from typing import Any
 
 from dnnevo import nav1d, plan, presets, stats, sweep
 from dnnevo.assess import DEFAULT_TRIALS, Assessment, assess
-from dnnevo.config import EvolutionConfig
+from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError
 from dnnevo.rundir import RunDir, RunFileError, first_difference, short, write_atomic
 from dnnevo.seeding import Seeding
@@ -107,7 +107,9 @@ def read_result(root: Path, job: plan.Job, settings: Settings) -> dict[str, Any]
         if not isinstance(found, dict):
             raise ValueError("not a JSON object")
         expected = _header(job, settings)
-        diff = first_difference({k: found.get(k) for k in expected}, expected)
+        stored = {k: found.get(k) for k in expected}
+        stored["config"] = with_later_defaults(stored["config"])
+        diff = first_difference(stored, expected)
         if diff is not None:
             raise RunFileError(f"{path}: its {diff[0]} is {short(diff[1])}, this reproduction's is {short(diff[2])}")
         _check_body(job, found)

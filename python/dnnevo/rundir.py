@@ -39,7 +39,7 @@ from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from dnnevo.config import LATER_SETTINGS, EvolutionConfig
+from dnnevo.config import LATER_SETTINGS, EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError, FormatError
 
 if TYPE_CHECKING:
@@ -193,6 +193,8 @@ def check_settings(manifest: Path, settings: dict[str, Any], *, what: str, force
         raise RunFileError(f"{manifest}: unreadable ({e}); choose another --out{again}") from None
     if not isinstance(found, dict):
         raise RunFileError(f"{manifest}: expected a JSON object of settings; choose another --out{again}")
+    if "config" in found:
+        found = {**found, "config": with_later_defaults(found["config"])}
     diff = first_difference(found, json.loads(json.dumps(settings)))
     if diff is not None:
         raise ConfigError(

@@ -34,8 +34,9 @@ from dnnevo.errors import ConfigError
 
 __all__ = ["FINER", "StepCheck", "step_check", "with_dt"]
 
-FINER = 10
-"""How many times shorter the check's Euler step is than the run's."""
+FINER: int = _core.STEP_CHECK_FINER
+"""How many times shorter the check's Euler step is than the run's (the Rust core's
+``STEP_CHECK_FINER``, which ``champion_step_check`` uses during a run too)."""
 
 
 def with_dt(config: EvolutionConfig, dt: float, name: str = "dt") -> EvolutionConfig:

@@ -19,7 +19,7 @@ use crate::ga::{self, check_fitness, GaConfig};
 use crate::genome::{self, Layout};
 use crate::network::Network;
 use crate::rng::{Purpose, Stream};
-use crate::validation::{candidates, Validation};
+use crate::validation::{candidates, Validation, STEP_CHECK_FINER};
 
 /// A fitness function that scores a whole generation at once, so that it can drive the
 /// population integrator.
@@ -52,6 +52,20 @@ pub trait Task: Send + Sync {
     /// `None` (the default) when the task has none. Must be a pure function of
     /// `(self, network, seed)` for each network, whatever the batch it comes in.
     fn validate(
+        &self,
+        networks: &[Network],
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        let _ = (networks, seed, cancel);
+        Ok(None)
+    }
+
+    /// Each network's [`Validation`] on the same validation set as [`validate`](Self::validate),
+    /// integrated [`STEP_CHECK_FINER`] times finer ([`Integrator::finer`](crate::Integrator::finer)):
+    /// the step check of [`GaConfig::champion_step_check`]. `None` (the default) when the task
+    /// has none. The same purity rule as `validate` holds.
+    fn validate_finer(
         &self,
         networks: &[Network],
         seed: u64,
@@ -121,7 +135,12 @@ pub struct Champion {
 /// over unchanged (an elite) is not re-validated. Validation is a pure function of the genome, so
 /// this changes speed, never results; it is not part of a checkpoint and never compared.
 #[derive(Clone, Debug, Default)]
-pub struct ValidationCache(HashMap<Vec<u64>, Validation>);
+pub struct ValidationCache {
+    /// At the run's integration step.
+    run: HashMap<Vec<u64>, Validation>,
+    /// At the step check's finer step ([`Task::validate_finer`]).
+    finer: HashMap<Vec<u64>, Validation>,
+}
 
 impl PartialEq for ValidationCache {
     fn eq(&self, _: &Self) -> bool {
@@ -339,7 +358,12 @@ impl Evolution {
         let nets = self.networks()?;
         let fitness = task.evaluate(&nets, self.generation, self.seed, cancel)?;
         self.check(&fitness)?;
-        let validated = self.validate(task, &nets, &fitness, cancel)?;
+        let validated = match self.validate(task, &nets, &fitness, cancel)? {
+            Some(list) if self.config.champion_step_check => {
+                Some(self.step_check(task, &nets, list, cancel)?)
+            }
+            other => other,
+        };
         let stats = self.tell_validated(&fitness, validated.as_deref())?;
         Ok((stats, fitness))
     }
@@ -364,7 +388,7 @@ impl Evolution {
             .map(|&i| genome_key(&self.population[i * g..(i + 1) * g]))
             .collect();
         let fresh: Vec<usize> = (0..chosen.len())
-            .filter(|&k| !self.cache.0.contains_key(&keys[k]))
+            .filter(|&k| !self.cache.run.contains_key(&keys[k]))
             .collect();
         let batch: Vec<Network> = fresh.iter().map(|&k| nets[chosen[k]].clone()).collect();
         let scores = if batch.is_empty() {
@@ -390,13 +414,79 @@ impl Evolution {
         for (k, &i) in chosen.iter().enumerate() {
             let v = match cache.get(&keys[k]) {
                 Some(v) => *v,
-                None => self.cache.0[&keys[k]],
+                None => self.cache.run[&keys[k]],
             };
             cache.insert(keys[k].clone(), v);
             out.push((i, v));
         }
-        self.cache = ValidationCache(cache);
+        self.cache.run = cache;
         Ok(Some(out))
+    }
+
+    /// The step check ([`GaConfig::champion_step_check`]): of the `validated` candidates, the
+    /// one whose [`worse`](Validation::worse) validation at the run's step and at the task's
+    /// finer step is best and beats the champion's, alone with that validation; empty when none
+    /// does. Candidates are checked best validation first, and only while their validation at
+    /// the run's step could still win (the worse of two is never better than either), so a
+    /// generation usually checks none or one.
+    fn step_check(
+        &mut self,
+        task: &dyn Task,
+        nets: &[Network],
+        mut validated: Vec<(usize, Validation)>,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<(usize, Validation)>> {
+        validated.sort_by(|a, b| {
+            if a.1.beats(&b.1) {
+                std::cmp::Ordering::Less
+            } else if b.1.beats(&a.1) {
+                std::cmp::Ordering::Greater
+            } else {
+                std::cmp::Ordering::Equal
+            }
+        });
+        let g = self.layout.len();
+        let mut bar = self.champion.as_ref().and_then(|c| c.validation);
+        let mut chosen = Vec::new();
+        let mut finer = HashMap::new();
+        for (i, at_run_step) in validated {
+            if bar.is_some_and(|b| !at_run_step.beats(&b)) {
+                break;
+            }
+            let key = genome_key(&self.population[i * g..(i + 1) * g]);
+            let at_finer_step = match self.cache.finer.get(&key) {
+                Some(v) => *v,
+                None => self.validate_one_finer(task, &nets[i], cancel)?,
+            };
+            finer.insert(key, at_finer_step);
+            let both = at_run_step.worse(&at_finer_step);
+            if bar.is_none_or(|b| both.beats(&b)) {
+                chosen = vec![(i, both)];
+                bar = Some(both);
+            }
+        }
+        self.cache.finer = finer;
+        Ok(chosen)
+    }
+
+    /// `net`'s validation at the task's finer step; an error when the task has none.
+    fn validate_one_finer(
+        &self,
+        task: &dyn Task,
+        net: &Network,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Validation> {
+        match task.validate_finer(std::slice::from_ref(net), self.seed, cancel)? {
+            Some(v) if v.len() == 1 => Ok(v[0]),
+            Some(v) => Err(Error::Fitness(format!(
+                "the task validated {} networks at the finer step; it was given 1",
+                v.len()
+            ))),
+            None => Err(Error::Config(format!(
+                "champion_step_check is on, but the task has no validation {STEP_CHECK_FINER}x \
+                 finer to check champions with"
+            ))),
+        }
     }
 
     /// The champion as a network, if any generation has been scored.

@@ -107,6 +107,17 @@ pub struct GaConfig {
     /// before validation existed), 0.
     #[serde(default)]
     pub validation_candidates: usize,
+    /// Whether a candidate must also pass the task's finer validation to become champion
+    /// ([`Task::validate_finer`](crate::Task::validate_finer)): its validation is then the worse
+    /// of the two ([`crate::validation`]), so a network that is right only at the run's step is
+    /// not chosen. Needs `validation_candidates > 0`. Default false; written only when true, so
+    /// checkpoints without it read and write unchanged.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub champion_step_check: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !b
 }
 
 /// [`GaConfig::mutation_scale`]'s default: a creep step's standard deviation is 5% of the
@@ -139,6 +150,7 @@ impl Default for GaConfig {
             selection: Selection::Proportional,
             ranges: Ranges::default(),
             validation_candidates: VALIDATION_CANDIDATES,
+            champion_step_check: false,
         }
     }
 }
@@ -190,6 +202,13 @@ impl GaConfig {
                 "mutation_scale is {}; it must be in (0, 1]",
                 self.mutation_scale
             )));
+        }
+        if self.champion_step_check && self.validation_candidates == 0 {
+            return Err(Error::Config(
+                "champion_step_check is on but validation_candidates is 0; the step check \
+                 re-validates the validated candidates, so it needs validation_candidates >= 1"
+                    .into(),
+            ));
         }
         if self.elitism >= self.population {
             return Err(Error::Config(format!(

@@ -11,6 +11,13 @@
 //! with the best [`Validation`] seen in any generation. Selection and breeding never see these
 //! scores, so evolution itself is unchanged.
 //!
+//! With [`GaConfig::champion_step_check`](crate::GaConfig::champion_step_check), a candidate that
+//! would replace the champion is validated again with an integration [`STEP_CHECK_FINER`] times
+//! finer ([`Task::validate_finer`](crate::Task::validate_finer)), and counts with the
+//! [`worse`](Validation::worse) of its two validations: a network whose behaviour lives in the
+//! integrator's error at the run's step is not chosen. Only would-be champions are checked, so
+//! the check costs a few validations per replacement of the champion, not one per candidate.
+//!
 //! # Example
 //! ```
 //! use ctrnn::validation::{candidates, Validation};
@@ -40,7 +47,21 @@ impl Validation {
     pub fn beats(&self, other: &Validation) -> bool {
         self.rate > other.rate || (self.rate == other.rate && self.score > other.score)
     }
+
+    /// The lower rate and the lower score of the two: how a network did under both of two
+    /// integrations of the same validation set.
+    pub fn worse(&self, other: &Validation) -> Validation {
+        Validation {
+            rate: self.rate.min(other.rate),
+            score: self.score.min(other.score),
+        }
+    }
 }
+
+/// How many times shorter the step check's integration step is than the run's, each time step
+/// kept as long: `dt / STEP_CHECK_FINER`, `substeps * STEP_CHECK_FINER`
+/// ([`Integrator::finer`](crate::Integrator::finer)).
+pub const STEP_CHECK_FINER: usize = 10;
 
 /// The indices of the `k` highest fitness values (all of them when `k >= fitness.len()`), best
 /// first; among equal fitness the lower index comes first. NaN never occurs here: fitness has

@@ -64,6 +64,7 @@ mod _core {
         m.add("LANES", ctrnn::LANES)?;
         m.add("MAX_COUNT", tasks::MAX_COUNT)?;
         m.add("MUTATION_SCALE", ctrnn::ga::MUTATION_SCALE)?;
+        m.add("STEP_CHECK_FINER", ctrnn::validation::STEP_CHECK_FINER)?;
         // Python's config classes take their defaults from these, so the two cannot drift.
         let defaults = serde_json::to_string(&tasks::RunConfig::default());
         m.add("RUN_DEFAULTS", defaults.expect("defaults always serialise"))?;

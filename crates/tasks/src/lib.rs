@@ -22,6 +22,7 @@ pub mod nav1d;
 pub mod registry;
 mod run_config;
 pub mod sequence;
+mod step_check;
 // Internals for the crate's own integration tests (tests/unit); not public API.
 #[doc(hidden)]
 pub mod testing;
@@ -34,3 +35,4 @@ pub use sequence::{
     performance, Assessment, Clamp, PerfBase, Scores, SequenceConfig, SequenceTask, TargetReport,
     TrialRecord,
 };
+pub use step_check::StepChecked;

@@ -16,10 +16,12 @@
 //! ```
 
 use ctrnn::ga::MutationKind;
+use ctrnn::validation::STEP_CHECK_FINER;
 use ctrnn::{Error, Fill, GaConfig, Integrator, Layout, Ranges, Result, Selection, Task};
 use serde::{Deserialize, Serialize};
 
 use crate::common::{config_from_params, TIME_STEP};
+use crate::StepChecked;
 
 /// Everything an evolution run needs besides its seed. Missing fields take their defaults;
 /// unknown fields are an error.
@@ -45,6 +47,10 @@ pub struct RunConfig {
     pub elitism: usize,
     /// See [`GaConfig::validation_candidates`]. Default 10.
     pub validation_candidates: usize,
+    /// See [`GaConfig::champion_step_check`]; a built-in task then validates would-be champions
+    /// again with its integrator made [`STEP_CHECK_FINER`] times finer ([`StepChecked`]).
+    /// Default false.
+    pub champion_step_check: bool,
     /// See [`GaConfig::selection`]. Default proportional, the paper's.
     pub selection: Selection,
     /// With seed networks, how the rest of the population is filled. Default mutants.
@@ -74,6 +80,7 @@ impl Default for RunConfig {
             mutation_scale: ga.mutation_scale,
             elitism: ga.elitism,
             validation_candidates: ga.validation_candidates,
+            champion_step_check: ga.champion_step_check,
             selection: ga.selection,
             fill: Fill::default(),
             size: 5,
@@ -116,6 +123,9 @@ impl RunConfig {
             Error::InvalidArgument(m) => Error::Config(format!("integrator.{m}")),
             other => other,
         })?;
+        if self.champion_step_check {
+            self.finer_integrator()?;
+        }
         if let Some(key) = SET_BY_RUN
             .iter()
             .find(|k| self.task_params.contains_key(**k))
@@ -125,6 +135,19 @@ impl RunConfig {
             )));
         }
         Ok(())
+    }
+
+    /// The step check's integrator: the run's, [`STEP_CHECK_FINER`] times finer.
+    fn finer_integrator(&self) -> Result<Integrator> {
+        self.integrator
+            .finer(STEP_CHECK_FINER)
+            .map_err(|e| match e {
+                Error::InvalidArgument(m) => Error::Config(format!(
+                    "champion_step_check: integrator.{m}, so it cannot be made \
+                     {STEP_CHECK_FINER}x finer"
+                )),
+                other => other,
+            })
     }
 
     /// The genetic algorithm's part.
@@ -139,6 +162,7 @@ impl RunConfig {
             selection: self.selection,
             ranges: self.ranges,
             validation_candidates: self.validation_candidates,
+            champion_step_check: self.champion_step_check,
         }
     }
 
@@ -159,8 +183,18 @@ impl RunConfig {
         serde_json::Value::Object(params)
     }
 
-    /// Builds the built-in task this config names; a caller's own task name is an error.
+    /// Builds the built-in task this config names, paired with its finer copy when
+    /// `champion_step_check` is on; a caller's own task name is an error.
     pub fn build_task(&self) -> Result<Box<dyn Task>> {
-        crate::build(&self.task, &self.task_params())
+        let task = crate::build(&self.task, &self.task_params())?;
+        if !self.champion_step_check {
+            return Ok(task);
+        }
+        let finer = RunConfig {
+            integrator: self.finer_integrator()?,
+            ..self.clone()
+        };
+        let finer = crate::build(&self.task, &finer.task_params())?;
+        Ok(Box::new(StepChecked::new(task, finer)))
     }
 }

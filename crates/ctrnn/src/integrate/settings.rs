@@ -70,4 +70,28 @@ impl Integrator {
         }
         Ok(())
     }
+
+    /// The same method with a step `factor` times shorter and `factor` times as many steps per
+    /// input row, so an input row lasts as long; an error when the step count overflows.
+    ///
+    /// ```
+    /// let i = ctrnn::Integrator { dt: 0.1, substeps: 10, ..Default::default() };
+    /// let f = i.finer(10)?;
+    /// assert_eq!((f.dt, f.substeps), (0.1 / 10.0, 100));
+    /// # Ok::<(), ctrnn::Error>(())
+    /// ```
+    pub fn finer(&self, factor: usize) -> Result<Integrator> {
+        let substeps = self.substeps.checked_mul(factor).filter(|_| factor > 0);
+        match substeps {
+            Some(substeps) => Ok(Integrator {
+                dt: self.dt / factor as f64,
+                substeps,
+                ..*self
+            }),
+            None => Err(Error::InvalidArgument(format!(
+                "substeps {} x {factor} is not a step count",
+                self.substeps
+            ))),
+        }
+    }
 }

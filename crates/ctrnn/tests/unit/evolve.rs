@@ -295,3 +295,146 @@ fn tell_rejects_nan_and_wrong_length() {
     assert!(evo.tell(&[0.5; 3]).is_err());
     assert_eq!(evo.generation, 0);
 }
+
+/// Lucky, with a step check: at the finer step, a network whose first gene's lowest mantissa
+/// bit is set keeps only a tenth of its rate (a "step artefact"); the others keep it all.
+#[derive(Default)]
+struct Jumpy {
+    lucky: Lucky,
+    checked: std::sync::atomic::AtomicUsize,
+}
+fn artefact(net: &Network) -> bool {
+    genome::encode(net)[0].to_bits() & 1 == 1
+}
+fn at_finer_step(net: &Network) -> Validation {
+    let rate = excite(net) * if artefact(net) { 0.1 } else { 1.0 };
+    Validation { rate, score: 0.0 }
+}
+impl Task for Jumpy {
+    fn layout(&self) -> Layout {
+        self.lucky.layout()
+    }
+    fn evaluate(
+        &self,
+        networks: &[Network],
+        generation: u64,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        self.lucky.evaluate(networks, generation, seed, cancel)
+    }
+    fn validate(
+        &self,
+        networks: &[Network],
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        self.lucky.validate(networks, seed, cancel)
+    }
+    fn validate_finer(
+        &self,
+        networks: &[Network],
+        _seed: u64,
+        _cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        self.checked
+            .fetch_add(networks.len(), std::sync::atomic::Ordering::Relaxed);
+        Ok(Some(networks.iter().map(at_finer_step).collect()))
+    }
+}
+
+fn step_checked() -> GaConfig {
+    GaConfig {
+        champion_step_check: true,
+        elitism: 3,
+        ..config()
+    }
+}
+
+#[test]
+fn the_step_check_keeps_artefacts_from_the_championship_and_leaves_evolution_unchanged() {
+    let task = Jumpy::default();
+    let plain = GaConfig {
+        champion_step_check: false,
+        ..step_checked()
+    };
+    let mut a = Evolution::new(task.layout(), step_checked(), 4, &[], Fill::Mutants).unwrap();
+    let mut b = Evolution::new(task.layout(), plain, 4, &[], Fill::Mutants).unwrap();
+    let (mut differed, mut last) = (false, f64::NEG_INFINITY);
+    for _ in 0..20 {
+        a.step(&task, None).unwrap();
+        b.step(&task, None).unwrap();
+        assert_eq!(
+            a.population, b.population,
+            "the check must not change evolution"
+        );
+        let champ = a.champion_network().unwrap().unwrap();
+        let held = a.champion.as_ref().unwrap().validation.unwrap();
+        let coarse = Validation {
+            rate: excite(&champ),
+            score: 0.0,
+        };
+        assert_eq!(held, coarse.worse(&at_finer_step(&champ)));
+        assert!(
+            held.rate >= last,
+            "the champion's validation never gets worse"
+        );
+        last = held.rate;
+        differed |= a.champion != b.champion;
+        let unchecked = b.champion_network().unwrap().unwrap();
+        if artefact(&unchecked) {
+            assert!(a.champion != b.champion);
+        }
+    }
+    assert!(
+        differed,
+        "some generation's unchecked champion is a step artefact"
+    );
+    let checked = task.checked.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(
+        (1..20 * 10).contains(&checked),
+        "only would-be champions are checked: {checked}"
+    );
+}
+
+#[test]
+fn step_checked_runs_resume_identically_and_old_checkpoints_read_unchanged() {
+    let task = Jumpy::default();
+    let mut a = Evolution::new(task.layout(), step_checked(), 6, &[], Fill::Mutants).unwrap();
+    for _ in 0..3 {
+        a.step(&task, None).unwrap();
+    }
+    let text = a.to_json();
+    assert!(text.contains("\"champion_step_check\":true"));
+    let mut b = Evolution::from_json(&text).unwrap();
+    for _ in 0..3 {
+        a.step(&task, None).unwrap();
+        b.step(&task, None).unwrap();
+    }
+    assert_eq!(a.to_json(), b.to_json());
+    let off = Evolution::new(task.layout(), config(), 6, &[], Fill::Mutants).unwrap();
+    assert!(!off.to_json().contains("champion_step_check"));
+}
+
+#[test]
+fn the_step_check_needs_candidates_and_a_task_that_can_check() {
+    let none = GaConfig {
+        validation_candidates: 0,
+        ..step_checked()
+    };
+    let e = none.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("champion_step_check") && e.contains("validation_candidates"),
+        "{e}"
+    );
+    let mut evo = Evolution::new(Excite.layout(), step_checked(), 1, &[], Fill::Mutants).unwrap();
+    let lucky = Lucky::default();
+    let e = evo.step(&lucky, None).unwrap_err().to_string();
+    assert!(e.contains("champion_step_check is on"), "{e}");
+    let mut plain = Evolution::new(Excite.layout(), step_checked(), 1, &[], Fill::Mutants).unwrap();
+    plain.step(&Excite, None).unwrap();
+    assert!(
+        plain.champion.unwrap().validation.is_none(),
+        "no validation set, nothing to check"
+    );
+}

@@ -87,3 +87,65 @@ fn the_task_gets_the_runs_size_and_integrator() {
     let e = own.build_task().err().unwrap().to_string();
     assert!(e.contains("unknown task \"python:m.f\""), "{e}");
 }
+
+#[test]
+fn the_step_check_validates_again_with_the_task_built_ten_times_finer() {
+    for (task, size, params) in [
+        ("sequence", 5, r#"{"targets": ["0", "1"]}"#),
+        ("nav1d", 4, "{}"),
+    ] {
+        let json = format!(
+            r#"{{"task": "{task}", "size": {size}, "champion_step_check": true, "task_params": {params}}}"#
+        );
+        let config = RunConfig::from_json(&json).unwrap();
+        let plain = RunConfig {
+            champion_step_check: false,
+            ..config.clone()
+        };
+        let finer = RunConfig {
+            integrator: ctrnn::Integrator {
+                dt: 0.01,
+                substeps: 100,
+                ..TIME_STEP
+            },
+            ..plain.clone()
+        };
+        let (checked, plain, finer) = (
+            config.build_task().unwrap(),
+            plain.build_task().unwrap(),
+            finer.build_task().unwrap(),
+        );
+        let nets = tasks::testing::random_networks(checked.layout(), 3, 7);
+        assert_eq!(
+            checked.evaluate(&nets, 2, 5, None).unwrap(),
+            plain.evaluate(&nets, 2, 5, None).unwrap()
+        );
+        assert_eq!(
+            checked.validate(&nets, 5, None).unwrap(),
+            plain.validate(&nets, 5, None).unwrap()
+        );
+        let at_finer = checked.validate_finer(&nets, 5, None).unwrap();
+        assert_eq!(at_finer, finer.validate(&nets, 5, None).unwrap(), "{task}");
+        assert!(at_finer.is_some() && plain.validate_finer(&nets, 5, None).unwrap().is_none());
+        if task == "sequence" {
+            // nav1d's validation counts goals reached, which these random networks reach or miss
+            // at both steps alike; the sequence task's mean trial score moves with the step.
+            assert_ne!(at_finer, plain.validate(&nets, 5, None).unwrap());
+        }
+    }
+}
+
+#[test]
+fn the_step_check_needs_a_step_that_can_be_made_finer_and_candidates() {
+    let huge = format!(
+        r#"{{"champion_step_check": true, "integrator": {{"method": "euler", "dt": 0.1, "substeps": {}}}}}"#,
+        usize::MAX / 2
+    );
+    assert!(
+        error(&huge).contains("champion_step_check: integrator.substeps"),
+        "{}",
+        error(&huge)
+    );
+    let e = error(r#"{"champion_step_check": true, "validation_candidates": 0}"#);
+    assert!(e.contains("needs validation_candidates >= 1"), "{e}");
+}

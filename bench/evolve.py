@@ -21,7 +21,9 @@
 (c) What validated champions cost: for each task, the wall time per generation of a run with the
   default validation_candidates (10) against the same run with validation_candidates = 0
   (evolution is bit-identical, so the difference is the validation and the success checks of the
-  champions it picks), runs interleaved, medians of --validation-repeats.
+  champions it picks), and of the same run with champion_step_check = true (would-be champions
+  validated again at dt/10; its overhead is over the validated run), runs interleaved, medians
+  of --validation-repeats.
 
     python bench/evolve.py [--generations 40] [--py-generations 3] [--repeats 30] [--quick]
 """
@@ -171,14 +173,15 @@ def part_c(args):
     for preset, overrides, generations in VALIDATION_RUNS:
         generations = max(2, generations // 4) if args.quick else generations
         cfg = dnnevo.presets.get(preset, overrides=[*overrides, f"generations={generations}"])
-        off = dataclasses.replace(cfg, validation_candidates=0)
-        times = {"on": [], "off": []}
+        runs = {"on": cfg, "off": dataclasses.replace(cfg, validation_candidates=0),
+                "checked": dataclasses.replace(cfg, champion_step_check=True)}
+        times: dict[str, list[float]] = {key: [] for key in runs}
         for _ in range(args.validation_repeats):
-            for key, c in (("on", cfg), ("off", off)):
+            for key, c in runs.items():
                 result = dnnevo.evolve(cfg.task, c, seed=0, progress=False)
                 times[key].append(float(result.history["elapsed_s"][-1]) / generations)
-        rows.append((preset, cfg.validation_candidates, statistics.median(times["on"]),
-                     statistics.median(times["off"])))
+        rows.append((preset, cfg.validation_candidates,
+                     *(statistics.median(times[key]) for key in ("on", "off", "checked"))))
     return rows
 
 
@@ -269,11 +272,12 @@ def main(argv=None) -> int:
     print(f"(c) validated champions: wall time per generation (medians of "
           f"{args.validation_repeats} interleaved runs each)")
     header = (f"{'preset':<18}  {'candidates':>10}  {'with ms/gen':>11}  {'without ms/gen':>14}  "
-              f"{'overhead':>8}")
+              f"{'overhead':>8}  {'step-checked ms/gen':>19}  {'overhead':>8}")
     print(header)
     print("-" * len(header))
-    for preset, k, on, off in part_c(args):
-        print(f"{preset:<18}  {k:>10}  {on * 1e3:>11.1f}  {off * 1e3:>14.1f}  {on / off - 1:>8.1%}")
+    for preset, k, on, off, checked in part_c(args):
+        print(f"{preset:<18}  {k:>10}  {on * 1e3:>11.1f}  {off * 1e3:>14.1f}  {on / off - 1:>8.1%}  "
+              f"{checked * 1e3:>19.1f}  {checked / on - 1:>8.1%}")
     print(f"total benchmark time: {time.perf_counter() - start:.1f} s")
     return 0 if ok else 1
 

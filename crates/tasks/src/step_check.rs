@@ -12,7 +12,7 @@
 //!     r#"{"task": "sequence", "champion_step_check": true, "task_params": {"targets": ["0"]}}"#,
 //! )?;
 //! let task = config.build_task()?;
-//! let net = ctrnn::Network::new(5, 2)?;
+//! let net = ctrnn::Network::new(vec![1.0; 5], vec![0.0; 5], vec![0.0; 25], vec![0.0; 10], None)?;
 //! assert!(task.validate_finer(&[net], 0, None)?.is_some());
 //! # Ok::<(), ctrnn::Error>(())
 //! ```

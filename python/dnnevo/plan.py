@@ -109,7 +109,8 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                seed_populations=True, spare_neurons=6,
                note="the incremental route with sequence-2bit-direct16-clamp-eval's GA: member i of "
                     "the first population composes member i of the two runs' last populations and "
-                    "6 unconnected random neurons; 300 generations"),
+                    "6 unconnected random neurons; champions validated on 128 trials per target "
+                    "and at dt/10"),
     Experiment("sequence-3bit", "sequence", EVOLVE, "§5.4: 1 success, at generation 700",
                preset="sequence-3bit"),
 )

@@ -534,6 +534,18 @@ def test_unknown_environment_is_a_config_error(tmp_path):
     assert_one_line_error(r, "middle")
 
 
+@pytest.mark.parametrize("setting, needle", [
+    ("task_params.near_first_weight=-0.5", "must be a finite number >= 0"),
+    ("task_params.near_first_weight=nan", "near_first_weight is nan; every number must be finite"),
+])
+def test_a_bad_near_first_weight_is_a_config_error(tmp_path, setting, needle):
+    with pytest.raises(ConfigError, match=needle):
+        cfg = config("nav1d-single", setting)
+        dnnevo.evaluate("nav1d", [landmark_and_reward()], generation=0, seed=0, config=cfg)
+    r = run_cli("run", "nav1d-single", "--quick", "--set", setting, "--out", tmp_path / "bad")
+    assert_one_line_error(r, "near_first_weight")
+
+
 @pytest.mark.parametrize("name, wrong", [("nav1d-far", 2), ("nav1d-classifier", 1)])
 def test_wrong_sensor_count_is_refused(name, wrong):
     cfg = config(name)

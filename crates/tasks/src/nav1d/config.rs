@@ -131,6 +131,16 @@ pub struct Nav1dConfig {
     /// rate, the champion's validation and the success rule, still count goals only. In [0, 1];
     /// default 0 (the goal alone).
     pub classify_weight: f64,
+    /// Shaping toward the landmark-near default (beyond the paper), for `"single"` only: the
+    /// fitness gains `w * k / n` with `w = near_first_weight`, where `k` of the evaluation's `n`
+    /// landmark-near chains reach the goal in their first, unscored, trial. A network whose
+    /// first trial runs the far seeker's strategy is right in no such trial and gains nothing.
+    /// The first trial after a reset is the one trial whose odometer starts from a known state,
+    /// and only the near seeker needs an odometer (it turns back where the landmark should have
+    /// been); a network that starts near and turns to the far strategy after a trial without
+    /// reinforcement can be right in every scored trial. Whether a trial is done right, the
+    /// rate, the champion's validation and the success rule do not change. `>= 0`; default 0.
+    pub near_first_weight: f64,
     /// Fresh chains (of the success check's length) in a run's validation set, on which the best
     /// candidates of each generation are judged to choose the champion. Default 40.
     pub validation_chains: usize,
@@ -170,6 +180,7 @@ impl Default for Nav1dConfig {
             aggregate: Aggregate::Mean,
             sharing: false,
             classify_weight: 0.0,
+            near_first_weight: 0.0,
             validation_chains: 40,
             start_jitter: 0.0,
             landmark_jitter: 0.0,
@@ -236,6 +247,17 @@ impl Nav1dConfig {
         if w != 0.0 && self.objective != Objective::Single {
             return config(format!(
                 "classify_weight is {w}; it applies to the \"single\" objective only"
+            ));
+        }
+        let w = self.near_first_weight;
+        if !(w >= 0.0 && w.is_finite()) {
+            return config(format!(
+                "near_first_weight is {w}; it must be a finite number >= 0"
+            ));
+        }
+        if w != 0.0 && self.objective != Objective::Single {
+            return config(format!(
+                "near_first_weight is {w}; it applies to the \"single\" objective only"
             ));
         }
         if self.objective == Objective::Single && self.trials_per_environment < 2 {

@@ -278,11 +278,11 @@ impl Nav1dTask {
                     .map(move |_| of_type)
             })
             .collect();
-        let mut scores = by_block(
+        let scores = by_block(
             networks,
             chains.len(),
             cancel,
-            |len| vec![Vec::with_capacity(trial_types.len()); len],
+            |len| vec![(Vec::with_capacity(trial_types.len()), 0usize); len],
             |scores, _, block, c| {
                 let chain = &chains[c];
                 let outcome = run_chains(
@@ -293,10 +293,13 @@ impl Nav1dTask {
                     |_, _, _| {},
                 )?;
                 for (t, condition) in chain.iter().enumerate() {
-                    for (l, lane) in scores.iter_mut().enumerate() {
+                    for (l, (lane, near_first)) in scores.iter_mut().enumerate() {
                         let (r, c) = (outcome.reached[t][l], outcome.classification[t][l]);
                         if let Some((score, _)) = self.judge(t, condition, r, c) {
                             lane.push(score);
+                        }
+                        if t == 0 && r && condition.environment == Environment::Near {
+                            *near_first += 1;
                         }
                     }
                 }
@@ -304,13 +307,23 @@ impl Nav1dTask {
             },
             |scores| scores,
         )?;
+        let (mut scores, near_first): (Vec<Vec<f64>>, Vec<usize>) = scores.into_iter().unzip();
         if self.config.sharing {
             share(&mut scores);
         }
         let aggregate = self.config.aggregate;
+        let near_chains = chains
+            .iter()
+            .filter(|chain| chain[0].environment == Environment::Near)
+            .count();
+        let bonus = |reached: usize| match (self.config.near_first_weight, near_chains) {
+            (w, n) if w > 0.0 && n > 0 => w * reached as f64 / n as f64,
+            _ => 0.0,
+        };
         Ok(scores
             .iter()
-            .map(|s| fitness(s, &trial_types, types.len(), aggregate))
+            .zip(near_first)
+            .map(|(s, n)| fitness(s, &trial_types, types.len(), aggregate) + bonus(n))
             .collect())
     }
 

@@ -335,6 +335,64 @@ fn classify_weight_blends_the_goal_with_the_classifier_on_scored_trials() {
 }
 
 #[test]
+fn near_first_weight_adds_the_landmark_near_first_trials_reached() {
+    // Recomputed from records: the unshaped fitness plus w times the fraction of landmark-near
+    // chains whose first trial reaches the goal; landmark-far first trials count nothing.
+    let plain = jittered(Objective::Single, World::Continuous);
+    let base = task(plain.clone());
+    let nets = random_networks(23, 5, 2, 8);
+    let chains = base.chains(9, 4);
+    let w = 0.625;
+    let shaped = task(Nav1dConfig {
+        near_first_weight: w,
+        ..plain
+    });
+    let (fitness, unshaped) = (
+        shaped.evaluate(&nets, 4, 9, None).unwrap(),
+        base.evaluate(&nets, 4, 9, None).unwrap(),
+    );
+    let near: Vec<_> = chains
+        .iter()
+        .filter(|c| c[0].environment == Environment::Near)
+        .collect();
+    assert!(!near.is_empty());
+    let mut gained = 0;
+    for (p, net) in nets.iter().enumerate() {
+        let reached = near
+            .iter()
+            .filter(|chain| base.record(net, chain, true).unwrap().reached[0])
+            .count();
+        let want = unshaped[p] + w * reached as f64 / near.len() as f64;
+        assert!(
+            (fitness[p] - want).abs() < 1e-12,
+            "{p}: {} vs {want}",
+            fitness[p]
+        );
+        gained += usize::from(reached > 0);
+    }
+    assert!(gained > 0, "no network reached a landmark-near first goal");
+    for net in &nets[..3] {
+        assert_eq!(
+            base.assess(net, 6, 2).unwrap().rate,
+            shaped.assess(net, 6, 2).unwrap().rate
+        );
+    }
+    for (params, needle) in [
+        (
+            serde_json::json!({"objective": "single", "near_first_weight": -0.5}),
+            ">= 0",
+        ),
+        (
+            serde_json::json!({"objective": "classify", "near_first_weight": 0.5}),
+            "\"single\"",
+        ),
+    ] {
+        let e = Nav1dTask::from_params(&params).unwrap_err().to_string();
+        assert!(e.contains("near_first_weight") && e.contains(needle), "{e}");
+    }
+}
+
+#[test]
 fn min_aggregates_score_the_worst_environment_type() {
     // Per type, the mean over that type's scored trials, recomputed from records in chain order.
     for objective in [Objective::Goal, Objective::Single] {

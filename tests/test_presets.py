@@ -31,6 +31,8 @@ def test_every_preset_runs(name: str, tmp_path: Path) -> None:
     ("sequence-2bit-incremental16", ("sequence-2bit", ["size=16", "selection=rank", "elitism=20",
                                                        "task_params.clamp=evaluation", "champion_step_check=true",
                                                        "task_params.validation_trials=128"])),
+    ("nav1d-single-incremental", ("nav1d-single", ["task_params.near_first_weight=0.5", "selection=rank",
+                                                   "elitism=20", "generations=500", "champion_step_check=true"])),
 ])
 def test_a_preset_is_the_config_its_results_were_made_with(preset: str, made_as: tuple[str, list[str]]) -> None:
     assert presets.get(preset) == presets.get(made_as[0], overrides=made_as[1])

@@ -87,6 +87,11 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                note="the integrated system with the chained goal seekers"),
     Experiment("nav1d-single", "nav1d", EVOLVE, "§4.2: failed (not quantified)",
                preset="nav1d-single"),
+    Experiment("nav1d-single-incremental", "nav1d", EVOLVE, "not in the paper",
+               preset="nav1d-single-incremental", needs=("nav1d-near-chained",), spare_neurons=3,
+               note="one network for the whole task, seeded from the chained near seeker and 3 "
+                    "unconnected random neurons, paid for reaching the goal in landmark-near first "
+                    "trials (near_first_weight 0.5)"),
     Experiment("sequence-1bit", "sequence", EVOLVE, "§5.2: success in 2 of 2 runs",
                preset="sequence-1bit"),
     Experiment("sequence-2bit-alternating", "sequence", EVOLVE, "§5.3: success (not quantified)",

@@ -149,6 +149,21 @@ PRESETS: dict[str, Preset] = {
                trials_per_environment=5, chains_per_environment=2, max_steps=300),
         _QUICK,
     ),
+    # Not in the paper: nav1d-single seeded from a chained near seeker (the first population is
+    # that champion composed with 3 unconnected random neurons, its motors staying the motors),
+    # with the fitness paying for the near seeker's strategy in trial 1 (near_first_weight, see
+    # docs/nav1d.md), rank selection, 20 elites and champions validated at dt/10 as well.
+    "nav1d-single-incremental": Preset(
+        "beyond the paper (§4.2): one network for the whole task, seeded from a chained near "
+        "seeker, near_first_weight 0.5, rank selection, elitism 20, champions checked at dt/10; "
+        "--seed-from a chained nav1d-near run --spare-neurons 3; 8 neurons, 1000 x 500",
+        dataclasses.replace(
+            _nav1d(500, 8, 2, objective="single", environments=["far", "near"],
+                   trials_per_environment=5, chains_per_environment=2, max_steps=300,
+                   near_first_weight=0.5),
+            selection="rank", elitism=20, champion_step_check=True),
+        _QUICK,
+    ),
     # The paper solved it by generation 15; 100 generations (4 s) leave room for slower seeds.
     "landmark": Preset(
         "paper §3: tell two landmarks apart from a wall-following robot's sonar; "

@@ -11,7 +11,7 @@ alternating network, probed by hand.
    and its sensor weights set to 0, the cross weight to +-16 and its threshold to half of it.
 
 Each network is judged as ``dnnevo evaluate`` judges (``sequence.assess``) on fresh timings of
-the ``sequence-2bit`` preset; the table gives, per target, the fraction of trials right after the
+the ``sequence-2bit-paper`` preset; the table gives, per target, the fraction of trials right after the
 warm-up.
 """
 
@@ -38,7 +38,7 @@ def champion(run: str) -> dnnevo.Network:
 def identical_outputs(one_bit: dnnevo.Network, composite: dnnevo.Network, timings: int,
                       seed: int) -> tuple[int, int]:
     """On how many (timing, target) trials the composite's output equals the 1-bit part's."""
-    two_bit = presets.get("sequence-2bit")
+    two_bit = presets.get("sequence-2bit-paper")
     same = total = 0
     for t in range(timings):
         timing = sequence.timings(two_bit, seed, 0, t)
@@ -88,7 +88,7 @@ def main(argv: list[str] | None = None) -> None:
     composite = dnnevo.compose(one_bit, alternating)
     same, total = identical_outputs(one_bit, composite, args.timings, args.seed)
     print(f"composite output identical to the 1-bit part's on {same} of {total} trials")
-    config = presets.get("sequence-2bit")
+    config = presets.get("sequence-2bit-paper")
     print(f"{'network':44} " + " ".join(f"{t + '*':>6}" for t in TARGETS))
     for name, net in variants(composite, one_bit.size).items():
         report = sequence.assess(config, net, args.trials, args.seed)

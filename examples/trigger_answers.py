@@ -2,7 +2,7 @@
 
     python examples/trigger_answers.py runs/sequence-2bit-seed0 --trials 3 --seed 999001
 
-For each target of the preset (``sequence-2bit``'s four unless ``--targets`` is given) and each
+For each target of the preset (``sequence-2bit-paper``'s four unless ``--targets`` is given) and each
 trial, one line: the wanted bits, the network's answers (its mean output over each response window,
 thresholded at 0.5) and ``+`` where the answer is judged correct. The timings are fresh ones drawn
 from ``--seed``, as ``dnnevo evaluate`` draws them, so they are not the ones the network was
@@ -47,7 +47,7 @@ def answers(config: dnnevo.EvolutionConfig, net: dnnevo.Network, targets: list[s
 def main(argv: list[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("run", help="a run folder, or a network file (judged under --preset)")
-    p.add_argument("--preset", default="sequence-2bit", help="settings for a network file")
+    p.add_argument("--preset", default="sequence-2bit-paper", help="settings for a network file")
     p.add_argument("--targets", help="comma-separated targets (default: the config's)")
     p.add_argument("--trials", type=int, default=3, help="trials per target")
     p.add_argument("--seed", type=int, default=999001, help="seed of the fresh timings")

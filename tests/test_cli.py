@@ -100,7 +100,7 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     for name in ("a", "b"):
         r = dnnevo("run", "sequence-1bit", *small, "--out", str(tmp_path / name))
         assert r.returncode == 0, r.stderr
-    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "c"),
+    r = dnnevo("run", "sequence-2bit-paper", *small, "--out", str(tmp_path / "c"),
                "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
     assert r.returncode == 0, r.stderr
     run = tomllib.loads((tmp_path / "c" / "config.toml").read_text())["run"]
@@ -110,7 +110,7 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     assert "seeded_from" not in plain
     # Whole populations, member by member: the composite of the two runs' first members is the
     # new run's first genome.
-    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "d"), "--seed-populations",
+    r = dnnevo("run", "sequence-2bit-paper", *small, "--out", str(tmp_path / "d"), "--seed-populations",
                "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
     assert r.returncode == 0, r.stderr
     assert tomllib.loads((tmp_path / "d" / "config.toml").read_text())["run"]["seeded_with"] == "populations"
@@ -141,16 +141,16 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     assert not (crossed[0].weights[:na, na:] == crossed[1].weights[:na, na:]).all()
     other_seed = Seeding((tmp_path / "a", tmp_path / "b"), populations=True, cross_scale=2.0).networks(10, seed=8)
     assert not (other_seed[0].weights == crossed[0].weights).all()
-    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "f"), "--cross-scale", "1",
+    r = dnnevo("run", "sequence-2bit-paper", *small, "--out", str(tmp_path / "f"), "--cross-scale", "1",
                "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
     assert r.returncode == 0, r.stderr
     assert tomllib.loads((tmp_path / "f" / "config.toml").read_text())["run"]["cross_scale"] == 1.0
     for bad, fragment in ((["--cross-scale", "1"], "--cross-scale needs"),
                           (["--cross-scale", "-1", "--seed-from", str(tmp_path / "a")], "--cross-scale is -1.0"),
                           (["--cross-scale", "nan", "--seed-from", str(tmp_path / "a")], "--cross-scale is nan")):
-        r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "g"), *bad)
+        r = dnnevo("run", "sequence-2bit-paper", *small, "--out", str(tmp_path / "g"), *bad)
         assert r.returncode == 2 and fragment in r.stderr and "Traceback" not in r.stderr, r.stderr
-    r = dnnevo("run", "sequence-2bit", *small, "--out", str(tmp_path / "e"), "--seed-populations")
+    r = dnnevo("run", "sequence-2bit-paper", *small, "--out", str(tmp_path / "e"), "--seed-populations")
     assert r.returncode == 2 and "--seed-populations needs" in r.stderr
     # Spare neurons: a random network composed last, unconnected, so neuron 0 answers as before.
     spared = Seeding((tmp_path / "a", tmp_path / "b"), populations=True, spare=3).networks(13, seed=7)
@@ -162,7 +162,7 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     assert (seeds[0].run(inputs).outputs[:, 0] == spared[0].run(inputs).outputs[:, 0]).all()
     with pytest.raises(dn.ConfigError, match="make 13 neurons; the run has 12"):
         Seeding((tmp_path / "a", tmp_path / "b"), spare=3).networks(12, seed=7)
-    r = dnnevo("run", "sequence-2bit", *small, "--set", "size=12", "--out", str(tmp_path / "h"), "--spare-neurons",
+    r = dnnevo("run", "sequence-2bit-paper", *small, "--set", "size=12", "--out", str(tmp_path / "h"), "--spare-neurons",
                "2", "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
     assert r.returncode == 0, r.stderr
     assert tomllib.loads((tmp_path / "h" / "config.toml").read_text())["run"]["spare_neurons"] == 2
@@ -175,7 +175,7 @@ def test_a_sweep_seeds_every_run_from_earlier_runs(tmp_path: Path) -> None:
     small = ["--quick", "--set", "generations=1", "--set", "population=10"]
     for name in ("a", "b"):
         assert dnnevo("run", "sequence-1bit", *small, "--out", str(tmp_path / name)).returncode == 0
-    r = dnnevo("sweep", "sequence-2bit", *small, "--seeds", "0,1", "--out", str(tmp_path / "s"),
+    r = dnnevo("sweep", "sequence-2bit-paper", *small, "--seeds", "0,1", "--out", str(tmp_path / "s"),
                "--eval-trials", "4", "--no-dt-check", "--seed-populations", "--cross-scale", "0.5",
                "--seed-from", str(tmp_path / "a"), "--seed-from", str(tmp_path / "b"))
     assert r.returncode == 0, r.stderr

@@ -167,10 +167,10 @@ def test_a_composed_run_uses_the_runs_it_needs(tmp_path: Path) -> None:
     order = plan.jobs([0], only=["sequence"])[:3]
     for job in order:
         jobs.run_job(job, tmp_path, QUICK, 1)
-    table = (tmp_path / "sequence-2bit" / "seed-0" / "config.toml").read_text()
+    table = (tmp_path / "sequence-2bit-paper" / "seed-0" / "config.toml").read_text()
     assert "sequence-1bit/seed-0" in table and "sequence-2bit-alternating/seed-0" in table
     # The 16-neuron incremental route composes whole populations and 6 spare neurons.
-    job = next(j for j in plan.jobs([0], only=["sequence"]) if j.experiment == "sequence-2bit-incremental16")
+    job = next(j for j in plan.jobs([0], only=["sequence"]) if j.experiment == "sequence-2bit")
     jobs.run_job(job, tmp_path, QUICK, 1)
     table = (tmp_path / job.id / "config.toml").read_text()
     assert 'seeded_with = "populations"' in table and "spare_neurons = 6" in table
@@ -206,7 +206,7 @@ def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path)
     for name in report.REPORT_FILES:
         assert (out / name).stat().st_size > 1000
     md = (out / "report.md").read_text()
-    assert "| sequence-2bit | §5.3: success in 2 of 2 runs | 1/1 |" in md
+    assert "| sequence-2bit-paper | §5.3: success in 2 of 2 runs | 1/1 |" in md
     assert "sequence-3bit" in md and "landmark" not in md.split("## Environment")[0]
     again = run_cli(*args)
     assert again.returncode == 0 and f"({n} already done)" in again.stdout, again.stderr

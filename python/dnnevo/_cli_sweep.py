@@ -28,8 +28,8 @@ EXAMPLE = """examples:
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep --set generations=16   # extend it
   dnnevo sweep landmark --seeds 0-9 --out runs/sweep-lm --eval-trials 100
   dnnevo sweep sequence-1bit --seeds 0-7 --workers 2 --out runs/sweep-dask
-  dnnevo sweep sequence-2bit --seeds 0-4 --out runs/inc --seed-from runs/sequence-1bit-seed0 \
-      --seed-from runs/sequence-2bit-alternating-seed0 --seed-populations --cross-scale 1
+  dnnevo sweep sequence-2bit --seeds 0-9 --out runs/inc --seed-from runs/sequence-1bit-seed0 \
+      --seed-from runs/sequence-2bit-alternating-seed0 --seed-populations --spare-neurons 6
 
 Reports the seeds whose run met the task's rule (k/n with a 95% Wilson interval), the median
 first-success generation (95% bootstrap interval, fixed bootstrap seed; a seed that never

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -13,6 +14,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "examples"))
 
 import incremental_plateau  # noqa: E402
+import nav1d_transfer  # noqa: E402
 import trigger_answers  # noqa: E402
 
 
@@ -40,3 +42,27 @@ def test_trigger_answers(capsys: pytest.CaptureFixture[str]) -> None:
                                      for word in ("wanted", "answered", "correct"))
         assert len(wanted) == len(answered) == len(correct) >= 8
         assert correct.endswith("++++") and answered.endswith(wanted[-4:])
+
+
+def test_nav1d_transfer(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """One row per run; its first cell is the champion's rate in its own world, as
+    dnnevo.nav1d.assess gives it, and the other cells judge changed worlds."""
+    from cli_helpers import run_cli
+
+    from dnnevo import nav1d
+
+    run = tmp_path / "single"
+    r = run_cli("run", "nav1d-single", "--quick", "--set", "generations=2", "--out", run, "--seed", "3")
+    assert r.returncode == 0, r.stderr
+    nav1d_transfer.main([str(run), "--chains", "6", "--seed", "11"])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "| run | " + " | ".join(nav1d_transfer.VARIANTS) + " |" and len(lines) == 3
+    cells = lines[2].strip("| ").split(" | ")[1:]
+    assert len(cells) == len(nav1d_transfer.VARIANTS)
+    part = nav1d.load_part(run)
+    own = nav1d.assess(part.config, part.network, 6, 11)
+    assert cells[0] == f"{100 * own['rate']:.1f}%" + ("" if own["success"] else " (fail)")
+    longer = nav1d.assess(dataclasses.replace(part.config, task_params={**part.config.task_params,
+                                                                        "trials_per_environment": 10}),
+                          part.network, 6, 11)
+    assert cells[1] == f"{100 * longer['rate']:.1f}%" + ("" if longer["success"] else " (fail)")

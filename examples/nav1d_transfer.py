@@ -20,9 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import dnnevo
 from dnnevo import nav1d
-from dnnevo.rundir import RunDir
 
 VARIANTS: dict[str, dict[str, Any]] = {
     "as trained": {},
@@ -36,10 +34,8 @@ VARIANTS: dict[str, dict[str, Any]] = {
 
 def judge(run: Path, chains: int, seed: int) -> list[tuple[float, bool]]:
     """``(rate, success)`` of the champion of ``run`` under each of :data:`VARIANTS`."""
-    config, _ = RunDir(run).read_config()
-    if config.task != "nav1d":
-        raise dnnevo.ConfigError(f"{run} is a {config.task} run; this script judges nav1d runs")
-    net = dnnevo.Network.load(run / "best.json")
+    part = nav1d.load_part(run)
+    config, net = part.config, part.network
     out = []
     for changes in VARIANTS.values():
         changed = dataclasses.replace(config, task_params={**config.task_params, **changes})

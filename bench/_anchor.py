@@ -30,12 +30,15 @@ def locate(path: str | None) -> Path | None:
     return DEFAULT if (DEFAULT / "impl_c.py").is_file() else None
 
 
-def load(folder: Path):
-    """Builds the anchor (`bash c/build.sh`, a few seconds) and returns its `impl_c` module,
-    whose `run_simd_omp(params, T)` integrates a population on 2 threads."""
-    built = subprocess.run(["bash", str(folder / "c" / "build.sh")], capture_output=True, text=True)
-    if built.returncode != 0:
-        raise SystemExit(f"error: building the C anchor failed:\n{built.stderr.strip()}")
+def load(folder: Path, build: bool = True, env: dict | None = None):
+    """Builds the anchor (`bash c/build.sh`, a few seconds; with `env` as its environment, for
+    example ANCHOR_MARCH) unless `build` is false, and returns its `impl_c` module, whose
+    `run_simd_omp(params, T)` integrates a population on 2 threads."""
+    if build:
+        built = subprocess.run(["bash", str(folder / "c" / "build.sh")], capture_output=True,
+                               text=True, env=env)
+        if built.returncode != 0:
+            raise SystemExit(f"error: building the C anchor failed:\n{built.stderr.strip()}")
     sys.path.insert(0, str(folder))
     try:
         return importlib.import_module("impl_c")

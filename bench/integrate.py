@@ -39,6 +39,7 @@ import dnnevo
 from _common import describe_machine, interleaved_medians, median_time
 
 SIZES = (5, 10, 30)
+POPULATION, STEPS = 1000, 1000  # networks and Euler steps of the full workload
 TARGETS = {5: 20.0, 10: 16.0, 30: 10.0}  # minimum dnnevo / numpy speed-up
 ANCHOR_TARGET = 1.25  # minimum dnnevo / C anchor speed-up, every N
 DT = 0.1
@@ -176,7 +177,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error("--repeats must be >= 1")
-    args.population, args.steps = 1000, 1000
+    args.population, args.steps = POPULATION, STEPS
     args.numpy_repeats = max(1, min(args.repeats, 3))
     if args.quick:
         args.population, args.steps = 200, 200

@@ -74,13 +74,19 @@ def timed(fn):
 WARMUP_SECONDS = 0.25
 
 
+def warm_up(fn):
+    """Calls `fn()` until WARMUP_SECONDS have passed (at least once); the last result."""
+    start = time.perf_counter()
+    result = fn()
+    while time.perf_counter() - start < WARMUP_SECONDS:
+        result = fn()
+    return result
+
+
 def median_time(fn, repeats: int):
     """(median seconds of `repeats` timed calls `fn(i)`, i = 0 .. repeats-1, after warm-up
     calls `fn(0)` for at least WARMUP_SECONDS; the last call's result)."""
-    start = time.perf_counter()
-    result = fn(0)  # warm-up
-    while time.perf_counter() - start < WARMUP_SECONDS:
-        result = fn(0)
+    result = warm_up(lambda: fn(0))
     times = []
     for i in range(repeats):
         t, result = timed(lambda: fn(i))
@@ -88,14 +94,21 @@ def median_time(fn, repeats: int):
     return statistics.median(times), result
 
 
+# Timed calls of one contender in a row in `interleaved_medians`, after its own warm-up.
+TURN_CALLS = 7
+
+
 def interleaved_medians(fns: dict, repeats: int) -> dict:
-    """Median seconds of `repeats` timed calls of each `fns[name]()`, the contenders taking turns
-    call by call (after a warm-up of each), so that a burst of load from other jobs hits every
-    contender alike."""
-    for fn in fns.values():
-        median_time(lambda _: fn(), 1)
+    """Median seconds of `repeats` timed calls of each `fns[name]()`. The contenders take turns,
+    so that a burst of load from other jobs hits every contender alike; a turn is a warm-up
+    (WARMUP_SECONDS) and then up to TURN_CALLS timed calls. Turns of one call each would time
+    every call just after another contender's: after a call of the C anchor its OpenMP thread
+    spins for a while on one core, and dnnevo at N = 5 measured 0.31x the anchor that way
+    against 0.89x with warmed-up turns (2026-11-27, Zen 5)."""
     times = {name: [] for name in fns}
-    for _ in range(repeats):
+    while any(len(t) < repeats for t in times.values()):
         for name, fn in fns.items():
-            times[name].append(timed(fn)[0])
+            calls = min(TURN_CALLS, repeats - len(times[name]))
+            warm_up(fn)
+            times[name] += [timed(fn)[0] for _ in range(calls)]
     return {name: statistics.median(t) for name, t in times.items()}

@@ -10,8 +10,9 @@ Contenders, each in network-steps per second (P x steps / seconds):
   - the C anchor (bench/_anchor.py; found in ../shared/anchors, or --anchor DIR): SIMD across
     networks, libmvec's vector exp, -ffast-math, OpenMP on 2 threads, on the same networks.
     Its inputs are its own (a pulse and a state-dependent second input, computed each step),
-    slightly more work than dnnevo's. dnnevo and C take turns call by call, and the medians of
-    --repeats calls are compared: the goal is dnnevo >= 1.25x C (issue #14);
+    slightly more work than dnnevo's. dnnevo and C take turns (each turn a warm-up, then a few
+    timed calls; see _common.interleaved_medians), and the medians of --repeats calls are
+    compared: the goal is dnnevo >= 1.25x C (issue #14);
   - NumPy with the same equations, batched over the population with einsum, on one core
     (NumPy's einsum does not thread), median of at most 3 runs. NumPy may be timed over fewer
     steps (--numpy-steps): the figure is a per-step throughput.

@@ -8,8 +8,9 @@ HEAD whose sigmoid is replaced by a clamp to [0, 1] (about the cheapest function
 call; its RESULTS ARE WRONG and are never compared), installs it into a temporary virtual
 environment, and times, on the same networks, the C anchor, dnnevo as installed here, and the
 copy. Each round runs both builds in turn, each in its own process, which times the C anchor and
-then dnnevo on each size (each warmed up, then the median of 5 calls, as anchor.py does); each
-ratio is to the C anchor timed in the same process, and the medians over rounds are printed.
+then dnnevo on each size (each warmed up, then the median of 5 calls, much as anchor.py does);
+each ratio is to the C anchor timed in the same process, and the medians over rounds are
+printed.
 
     python bench/sigmoid_ceiling.py [--rounds 7] [--one-thread] [--kernel avx2] [--anchor DIR]
 
@@ -34,7 +35,7 @@ import numpy as np
 
 import _anchor
 import dnnevo
-from _common import median_time
+from _common import interleaved_medians
 from integrate import ANCHOR_TARGET, DT, N_INPUTS, POPULATION, SIZES, STEPS, pulse_inputs
 
 REPO = Path(__file__).resolve().parent.parent
@@ -72,7 +73,7 @@ def build_free_copy(into: Path) -> Path:
 
 def measure(anchor_dir: str, one_thread: bool) -> dict:
     """In this process: {N: {"c": seconds, "dnnevo": seconds}}, each the median of REPEATS
-    calls after a warm-up."""
+    calls after a warm-up (one turn each of _common.interleaved_medians)."""
     anchor = _anchor.load(Path(anchor_dir), build=False)
     run_c = anchor.run_simd if one_thread else anchor.run_simd_omp
     inputs = pulse_inputs(STEPS)
@@ -82,14 +83,10 @@ def measure(anchor_dir: str, one_thread: bool) -> dict:
         stacked = [np.stack([getattr(x, a) for x in nets])
                    for a in ("tau", "theta", "weights", "sensor_weights", "state")]
         c_params = _anchor.params(*stacked)
-        # One contender after the other, each warmed up first, as anchor.py does: taking turns
-        # call by call, each dnnevo call would share a core with the anchor's OpenMP thread,
-        # which spins for a while after every call.
-        out[str(n)] = {
-            "c": median_time(lambda _: run_c(c_params, STEPS), REPEATS)[0],
-            "dnnevo": median_time(lambda _: dnnevo.run_population(nets, inputs, dt=DT,
-                                                                  record=False), REPEATS)[0],
-        }
+        out[str(n)] = interleaved_medians({
+            "c": lambda: run_c(c_params, STEPS),
+            "dnnevo": lambda: dnnevo.run_population(nets, inputs, dt=DT, record=False),
+        }, REPEATS)
     return out
 
 

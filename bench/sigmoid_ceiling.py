@@ -110,6 +110,8 @@ def main(argv=None) -> int:
         return 0
     if args.rounds < 1:
         ap.error("--rounds must be >= 1")
+    if args.kernel and args.kernel not in dnnevo.build_info()["kernels"]:
+        ap.error(f"--kernel {args.kernel}: this CPU runs {', '.join(dnnevo.build_info()['kernels'])}")
     folder = _anchor.locate(args.anchor)
     if folder is None:
         raise SystemExit(f"error: no C anchor found (--anchor DIR or ${_anchor.ENV})")

@@ -119,17 +119,19 @@ def compare(ours, theirs, params, inputs, tol=1e-9):
     return len(ours) - bad.size, bad[explained], bad[~explained]
 
 
+def random_population(n: int, population: int):
+    """The workload's networks of size `n` (Network.random with seeds 0 .. population-1) and
+    their stacked parameters (tau, theta, weights, sensor_weights, state)."""
+    nets = [dnnevo.Network.random(n, N_INPUTS, seed=k) for k in range(population)]
+    params = tuple(np.stack([getattr(net, name) for net in nets])
+                   for name in ("tau", "theta", "weights", "sensor_weights", "state"))
+    return nets, params
+
+
 def bench_size(n: int, args, anchor) -> dict:
-    nets = [dnnevo.Network.random(n, N_INPUTS, seed=k) for k in range(args.population)]
+    nets, params = random_population(n, args.population)
     inputs = pulse_inputs(args.steps)
     p = len(nets)
-    params = (
-        np.stack([net.tau for net in nets]),
-        np.stack([net.theta for net in nets]),
-        np.stack([net.weights for net in nets]),
-        np.stack([net.sensor_weights for net in nets]),
-        np.stack([net.state for net in nets]),
-    )
 
     def run_dnnevo():
         return dnnevo.run_population(nets, inputs, dt=DT, substeps=1, method="euler",

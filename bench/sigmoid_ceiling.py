@@ -31,12 +31,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 import _anchor
 import dnnevo
 from _common import interleaved_medians
-from integrate import ANCHOR_TARGET, DT, N_INPUTS, POPULATION, SIZES, STEPS, pulse_inputs
+from integrate import ANCHOR_TARGET, DT, POPULATION, SIZES, STEPS, pulse_inputs, random_population
 
 REPO = Path(__file__).resolve().parent.parent
 REPEATS = 5  # timed calls per contender and size in one process
@@ -79,10 +77,8 @@ def measure(anchor_dir: str, one_thread: bool) -> dict:
     inputs = pulse_inputs(STEPS)
     out = {"kernel": dnnevo.build_info()["kernel"]}
     for n in SIZES:
-        nets = [dnnevo.Network.random(n, N_INPUTS, seed=k) for k in range(POPULATION)]
-        stacked = [np.stack([getattr(x, a) for x in nets])
-                   for a in ("tau", "theta", "weights", "sensor_weights", "state")]
-        c_params = _anchor.params(*stacked)
+        nets, params = random_population(n, POPULATION)
+        c_params = _anchor.params(*params)
         out[str(n)] = interleaved_medians({
             "c": lambda: run_c(c_params, STEPS),
             "dnnevo": lambda: dnnevo.run_population(nets, inputs, dt=DT, record=False),

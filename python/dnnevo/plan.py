@@ -67,6 +67,13 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                "§3: the real robot right in 17 of 20 trials (10/10 and 7/10)", needs=("landmark",),
                note="a simulated stand-in for the real robot: sonar noise, specular misses and a "
                     "jittered room, none of which training saw"),
+    Experiment("landmark-robust", "landmark", EVOLVE, "not in the paper", preset="landmark-robust",
+               note="trained on varied trials (robot speed, landmark pose and size, sonar), so that "
+                    "the champion transfers to the robot-like test"),
+    Experiment("landmark-robust-robot", "landmark", ROBOT_LIKE,
+               "§3: the real robot right in 17 of 20 trials (10/10 and 7/10)",
+               needs=("landmark-robust",),
+               note="landmark-robust's champion on the same robot-like stand-in as landmark-robot"),
     Experiment("nav1d-classifier", "nav1d", EVOLVE, "§4.2: solved at generation 5",
                preset="nav1d-classifier"),
     Experiment("nav1d-far", "nav1d", EVOLVE, "§4.2: solved at generation 0", preset="nav1d-far"),

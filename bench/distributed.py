@@ -34,8 +34,10 @@ sys.path = [p for p in sys.path if Path(p or ".").resolve() != HERE] + [str(HERE
 
 from _common import describe_machine  # noqa: E402
 
-from dnnevo import presets, scheduler, sweep  # noqa: E402
-from dnnevo.runsview import RunsView  # noqa: E402
+from dnnevo.experiments import presets
+from dnnevo.experiments import scheduler
+from dnnevo.experiments import sweep# noqa: E402
+from dnnevo.experiments.runsview import RunsView  # noqa: E402
 
 PRESET = "sequence-1bit"
 EVAL_TRIALS = 20

@@ -13,7 +13,7 @@
   numpy GA      the same operators in NumPy (selection by cumsum + searchsorted, one-point
                 crossover at neuron boundaries, per-gene resampling, statistics and champion)
 
-(b) Evaluations per second inside dnnevo.evolve: the built-in "sequence" task against a Python
+(b) Evaluations per second inside dnnevo.evolution.evolve: the built-in "sequence" task against a Python
   fitness callable (tests/sequence_reference.py, batched NumPy, with the same timings), for a few
   generations each. Both runs start from the same seed; their per-generation mean fitness is
   compared as a check that the callable computes the same fitness.
@@ -41,9 +41,9 @@ from pathlib import Path
 import numpy as np
 
 import dnnevo
-import dnnevo.sequence
-from dnnevo.evolve import CHECKPOINT_SECONDS, LOG_SECONDS
-from dnnevo.rundir import RunDir
+import dnnevo.tasks.sequence
+from dnnevo.evolution.evolve import CHECKPOINT_SECONDS, LOG_SECONDS
+from dnnevo.runs.rundir import RunDir
 from _common import describe_machine, load_reference, median_time
 
 TARGET_SHARE = 0.01
@@ -144,7 +144,7 @@ def part_b(cfg, args):
 
     def fitness(networks):
         nonlocal generation
-        timings = [dnnevo.sequence.timings(cfg, seed, generation, t) for t in range(n_trials)]
+        timings = [dnnevo.tasks.sequence.timings(cfg, seed, generation, t) for t in range(n_trials)]
         generation += 1
         f, _ = ref.fitness(ref.stack_networks(networks), p["targets"], timings,
                            p["trials_per_target"], perf_base=p["perf_base"],
@@ -172,7 +172,7 @@ def part_c(args):
     rows = []
     for preset, overrides, generations in VALIDATION_RUNS:
         generations = max(2, generations // 4) if args.quick else generations
-        cfg = dnnevo.presets.get(preset, overrides=[*overrides, f"generations={generations}"])
+        cfg = dnnevo.experiments.presets.get(preset, overrides=[*overrides, f"generations={generations}"])
         runs = {"on": cfg, "off": dataclasses.replace(cfg, validation_candidates=0),
                 "checked": dataclasses.replace(cfg, champion_step_check=True)}
         times: dict[str, list[float]] = {key: [] for key in runs}
@@ -188,7 +188,7 @@ def part_c(args):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--generations", type=int, default=40,
-                    help="generations of the timed dnnevo.evolve run in (a) (default 40)")
+                    help="generations of the timed dnnevo.evolution.evolve run in (a) (default 40)")
     ap.add_argument("--py-generations", type=int, default=3,
                     help="generations of each run in (b) (default 3; the NumPy fitness takes "
                          "about 1-2 s per generation)")
@@ -211,7 +211,7 @@ def main(argv=None) -> int:
     if min(args.generations, args.py_generations, args.repeats, args.validation_repeats) < 1:
         ap.error("--generations, --py-generations, --repeats and --validation-repeats must be >= 1")
 
-    cfg = dnnevo.presets.get("sequence-1bit")
+    cfg = dnnevo.experiments.presets.get("sequence-1bit")
     describe_machine()
     print(f"workload: preset sequence-1bit, P = {cfg.population}, N = {cfg.size}, crossover "
           f"{cfg.crossover_rate}, mutation {cfg.mutation_rate}{' [quick]' if args.quick else ''}")
@@ -251,7 +251,7 @@ def main(argv=None) -> int:
     b = part_b(cfg, args)
     p = cfg.population
     print()
-    print(f"(b) evaluations per second inside dnnevo.evolve, {args.py_generations} generations "
+    print(f"(b) evaluations per second inside dnnevo.evolution.evolve, {args.py_generations} generations "
           f"of P = {p} (median over generations; wall time includes setup)")
     header = f"{'fitness':<38}  {'evals/s':>10}  {'s/generation':>12}  {'wall s':>7}"
     print(header)

@@ -11,9 +11,9 @@ Figures, in seconds per generation (median of timed runs after a quarter-second 
   dnnevo evaluate   dnnevo.evaluate("sequence", genomes, generation=g, seed=0, config=cfg), all cores
                     (and with threads=1, for a per-core comparison)
   dnnevo generation one whole generation of the GA on the Rust side (evaluate + breed), as
-                    dnnevo.evolve runs it (GeneticAlgorithm.step)
+                    dnnevo.evolution.evolve runs it (GeneticAlgorithm.step)
   numpy evaluate    tests/sequence_reference.py, batched over P with einsum, one core, with the
-                    same timings (dnnevo.sequence.timings); --numpy-repeats runs (default 1)
+                    same timings (dnnevo.tasks.sequence.timings); --numpy-repeats runs (default 1)
 The projection is 500 generations (the paper's run) at that rate, against the target of 60 s.
 The fitness values of dnnevo and NumPy are compared network by network (atol 1e-9).
 
@@ -32,7 +32,7 @@ import time
 import numpy as np
 
 import dnnevo
-import dnnevo.sequence
+import dnnevo.tasks.sequence
 from _common import describe_machine, load_reference, median_time, threads, timed
 
 GENERATIONS = 500  # the paper's 1-bit run
@@ -47,7 +47,7 @@ def numpy_fitness(cfg, params, generation: int, seed: int):
     """The reference fitness of one generation, with the timings evolution draws."""
     p = cfg.task_params
     n_trials = len(p["targets"]) * p["trials_per_target"]
-    timings = [dnnevo.sequence.timings(cfg, seed, generation, t) for t in range(n_trials)]
+    timings = [dnnevo.tasks.sequence.timings(cfg, seed, generation, t) for t in range(n_trials)]
     f, _ = ref.fitness(params, p["targets"], timings, p["trials_per_target"],
                        perf_base=p["perf_base"], dt=cfg.integrator.dt,
                        substeps=cfg.integrator.substeps)
@@ -68,7 +68,7 @@ def main(argv=None) -> int:
     if args.repeats < 1 or args.numpy_repeats < 1:
         ap.error("--repeats and --numpy-repeats must be >= 1")
 
-    cfg = dnnevo.presets.get("sequence-1bit")
+    cfg = dnnevo.experiments.presets.get("sequence-1bit")
     seed = 0
     ga = dnnevo.GeneticAlgorithm(cfg, seed=seed)
     genomes = ga.ask().genomes

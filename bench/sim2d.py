@@ -45,7 +45,8 @@ import time
 import numpy as np
 
 import dnnevo
-from dnnevo import landmark, presets
+from dnnevo.tasks import landmark
+from dnnevo.experiments import presets
 from _common import describe_machine, median_time, threads
 
 MAX_DISTANCE = 6.5  # the sonar's range, m

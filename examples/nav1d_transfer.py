@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from dnnevo import nav1d
+from dnnevo.tasks import nav1d
 
 VARIANTS: dict[str, dict[str, Any]] = {
     "as trained": {},

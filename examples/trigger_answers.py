@@ -16,8 +16,9 @@ import dataclasses
 from pathlib import Path
 
 import dnnevo
-from dnnevo import presets, sequence
-from dnnevo.rundir import RunDir
+from dnnevo.experiments import presets
+from dnnevo.tasks import sequence
+from dnnevo.runs.rundir import RunDir
 
 
 def load(run: str, preset: str) -> tuple[dnnevo.EvolutionConfig, dnnevo.Network]:

@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 import dnnevo
-from dnnevo import _core, analysis, assess, presets
+from dnnevo import _core, analysis
+from dnnevo.evaluation import assessment as assess
+from dnnevo.experiments import presets
 from dnnevo.errors import InvalidArgumentError
 
 
@@ -285,7 +287,7 @@ def test_an_even_count_is_searched_again_by_the_cores_rule() -> None:
     weak = analysis.bifurcation(net, 0, -4.0, 4.0, steps=41, starts=2, retry_starts=3)
     assert weak.even and set(weak.even) <= set(weak.retried)
     assert weak.to_dict()["even"] == weak.even
-    from dnnevo._cli_analyze import summary
+    from dnnevo.cli.analyze import summary
 
     lines = summary([analysis.attractors(net, [0.0])], weak, None, "input 0")
     assert any("count stays even" in line for line in lines), lines
@@ -299,7 +301,7 @@ def test_folds_at_one_value_are_told_apart_in_the_report() -> None:
     then 7 equilibria); the report must not read as one fold printed twice."""
     net = dnnevo.Network.load(DATA / "sequence-3bit-seed0-champion.json")
     b = analysis.bifurcation(net, 1, 0.0, 1.0, steps=101)
-    from dnnevo._cli_analyze import event_texts
+    from dnnevo.cli.analyze import event_texts
 
     texts = event_texts(b.events)
     assert len(set(texts)) == len(texts), texts

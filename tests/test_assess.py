@@ -1,4 +1,4 @@
-"""dnnevo.assess: every task's assessment in one shape, with hand-built networks whose rates are
+"""dnnevo.evaluation.assessment: every task's assessment in one shape, with hand-built networks whose rates are
 known exactly."""
 
 from __future__ import annotations
@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 
 import dnnevo
-from dnnevo import assess, presets, stats
+from dnnevo.evaluation import assessment as assess
+from dnnevo.experiments import presets
+from dnnevo.evaluation import stats
 from dnnevo.errors import ConfigError, InvalidArgumentError
 
 
@@ -105,7 +107,7 @@ def test_nav1d_clusters_the_trials_of_a_chain() -> None:
 def test_shaped_single_networks_show_their_classifier_by_trial() -> None:
     from pathlib import Path
 
-    from dnnevo import _cli_nav1d
+    from dnnevo.cli import nav1d_parts as _cli_nav1d
 
     says_near = constant([8.0, -8.0, -50.0], 8, 2)  # drives right; f(v_C) ~ 1 says near
     plain = presets.get("nav1d-single")

@@ -115,13 +115,13 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     assert tomllib.loads((tmp_path / "d" / "config.toml").read_text())["run"]["seeded_with"] == "populations"
     import dnnevo as dn
-    from dnnevo.rundir import RunDir
+    from dnnevo.runs.rundir import RunDir
 
     def population(run: Path) -> list[dn.Network]:
         state = RunDir(run).read_checkpoint().state
         return dn.GeneticAlgorithm.from_state_dict(state).ask().networks
 
-    from dnnevo.seeding import Seeding
+    from dnnevo.evolution.seeding import Seeding
 
     a, b = population(tmp_path / "a"), population(tmp_path / "b")
     seeds = Seeding((tmp_path / "a", tmp_path / "b"), populations=True).networks(10, seed=0)

@@ -11,9 +11,10 @@ import pytest
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 import dnnevo
-from dnnevo import analysis, rundir
+from dnnevo import analysis
+from dnnevo.runs import rundir
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir
+from dnnevo.runs.rundir import RunDir
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
 PRESETS = ("sequence-1bit", "nav1d-classifier", "nav1d-single", "landmark")
@@ -107,7 +108,7 @@ def test_analyze_help_has_an_example() -> None:
 def test_nav1d_single_records_a_whole_chain(runs: dict[str, Path]) -> None:
     """nav1d-single's network learns its environment in trial 1 of a 5-trial chain and keeps its
     state between trials: analyze records such a chain, not the 2 trials of the classifier."""
-    from dnnevo import nav1d
+    from dnnevo.tasks import nav1d
 
     run = RunDir(runs["nav1d-single"])
     config, raw = run.read_config()

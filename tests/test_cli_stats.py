@@ -15,9 +15,14 @@ import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
 import dnnevo
-from dnnevo import _cli_evaluate, assess, cli, presets, sequence, stats
+from dnnevo.cli import evaluate as _cli_evaluate
+from dnnevo.evaluation import assessment as assess
+from dnnevo.cli import command as cli
+from dnnevo.experiments import presets
+from dnnevo.tasks import sequence
+from dnnevo.evaluation import stats
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir
+from dnnevo.runs.rundir import RunDir
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
 

@@ -88,7 +88,7 @@ def test_seeding_puts_networks_first() -> None:
 
 
 def test_builtin_run_is_identical_with_one_and_two_threads(tmp_path: Path) -> None:
-    config = dnnevo.presets.get("sequence-1bit", quick=True)
+    config = dnnevo.experiments.presets.get("sequence-1bit", quick=True)
     one = dnnevo.evolve("sequence", config, seed=5, threads=1, out=tmp_path / "1", progress=False)
     two = dnnevo.evolve("sequence", config, seed=5, threads=2, out=tmp_path / "2", progress=False)
     for key in ("best", "mean", "std", "min"):
@@ -98,7 +98,7 @@ def test_builtin_run_is_identical_with_one_and_two_threads(tmp_path: Path) -> No
 
 
 def test_evaluate_matches_in_run_scores() -> None:
-    config = dnnevo.presets.get("sequence-1bit", quick=True)
+    config = dnnevo.experiments.presets.get("sequence-1bit", quick=True)
     ga = dnnevo.GeneticAlgorithm(config, seed=11)
     genomes, networks = ga.ask()
     from_genomes = dnnevo.evaluate("sequence", genomes, generation=0, seed=11, config=config)
@@ -239,7 +239,7 @@ def test_creep_mutation_runs_deterministically_and_differs_from_uniform() -> Non
 def test_settings_added_later_leave_old_digests_unchanged() -> None:
     """A folder written before ``mutation`` existed carries a digest of a config without it."""
     from dnnevo.config import LATER_SETTINGS
-    from dnnevo.rundir import config_digest
+    from dnnevo.runs.rundir import config_digest
 
     config = EvolutionConfig()
     old = {k: v for k, v in config.to_dict().items() if k not in LATER_SETTINGS}
@@ -262,7 +262,7 @@ def test_env_thread_count_does_not_change_results(tmp_path: Path) -> None:
 
 
 def test_a_preset_name_with_its_config_runs_the_presets_task() -> None:
-    config = dnnevo.presets.get("nav1d-far", quick=True, overrides=["generations=2"])
+    config = dnnevo.experiments.presets.get("nav1d-far", quick=True, overrides=["generations=2"])
     by_name = dnnevo.evolve("nav1d-far", config, seed=1, progress=False)
     by_task = dnnevo.evolve("nav1d", config, seed=1, progress=False)
     assert by_name.best_fitness == by_task.best_fitness

@@ -46,10 +46,10 @@ def test_trigger_answers(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_nav1d_transfer(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """One row per run; its first cell is the champion's rate in its own world, as
-    dnnevo.nav1d.assess gives it, and the other cells judge changed worlds."""
+    dnnevo.tasks.nav1d.assess gives it, and the other cells judge changed worlds."""
     from cli_helpers import run_cli
 
-    from dnnevo import nav1d
+    from dnnevo.tasks import nav1d
 
     run = tmp_path / "single"
     r = run_cli("run", "nav1d-single", "--quick", "--set", "generations=2", "--out", run, "--seed", "3")

@@ -26,7 +26,7 @@ from cli_helpers import assert_one_line_error, run_cli
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from dnnevo.rundir import RunDir
+from dnnevo.runs.rundir import RunDir
 
 FULL = os.environ.get("DNNEVO_FULL_HARDENING") == "1"
 SMALL = ["--set", "population=12", "--set", "generations=6"]
@@ -312,8 +312,8 @@ KILLS = 30 if FULL else 8
 KILL_GENERATIONS = 100
 KILL_RUN = ["sequence-1bit", "--quick", "--set", "population=40", "--set", f"generations={KILL_GENERATIONS}"]
 #: The command, checkpointing after every generation so that kills land inside writes too.
-FREQUENT = ("import sys, dnnevo; e = sys.modules['dnnevo.evolve']; e.CHECKPOINT_SECONDS = 0.0; "
-            "e.LOG_SECONDS = 0.0; from dnnevo.cli import main; sys.exit(main(sys.argv[1:]))")
+FREQUENT = ("import sys, dnnevo; e = sys.modules['dnnevo.evolution.evolve']; e.CHECKPOINT_SECONDS = 0.0; "
+            "e.LOG_SECONDS = 0.0; from dnnevo.cli.command import main; sys.exit(main(sys.argv[1:]))")
 
 
 def test_kill_at_random_moments_then_resume_is_bit_identical(tmp_path: Path) -> None:
@@ -427,7 +427,11 @@ nets = [dnnevo.Network.random(5, 2, seed=0)]
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=-1, seed=0), InvalidArgumentError, "generation is -1")
 refused(lambda: dnnevo.evaluate("sequence", nets, generation=0, seed=0, threads=-2), InvalidArgumentError, "threads is -2")
 refused(lambda: dnnevo.EvolutionConfig(task_params={"perf_base": float("nan")}), ConfigError, "task_params.perf_base is nan")
-from dnnevo import analysis, landmark, nav1d, presets, sequence
+from dnnevo import analysis
+from dnnevo.tasks import landmark
+from dnnevo.tasks import nav1d
+from dnnevo.experiments import presets
+from dnnevo.tasks import sequence
 refused(lambda: nets[0].run(np.zeros((3, 2)), substeps=2**64), InvalidArgumentError, "substeps is 18446744073709551616")
 refused(lambda: dnnevo.run_population(nets, np.zeros((3, 2)), substeps=2**70), InvalidArgumentError, "substeps is")
 refused(lambda: analysis.equilibria(nets[0], [0.0, 0.0], starts=2**70), InvalidArgumentError, "starts is")

@@ -19,7 +19,10 @@ import numpy as np
 import pytest
 
 import dnnevo
-from dnnevo import landmark, nav1d, presets, sequence
+from dnnevo.tasks import landmark
+from dnnevo.tasks import nav1d
+from dnnevo.experiments import presets
+from dnnevo.tasks import sequence
 
 DELAY = 0.5
 """Seconds from the call's start to SIGINT."""

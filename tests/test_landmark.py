@@ -16,7 +16,9 @@ from hypothesis import strategies as st
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 import dnnevo
-from dnnevo import assess, landmark, presets
+from dnnevo.evaluation import assessment as assess
+from dnnevo.tasks import landmark
+from dnnevo.experiments import presets
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 

@@ -19,8 +19,10 @@ from cli_helpers import assert_one_line_error, assert_png, run_cli
 import nav1d_reference as ref
 
 import dnnevo
-from dnnevo.stats import wilson
-from dnnevo import assess, nav1d, presets
+from dnnevo.evaluation.stats import wilson
+from dnnevo.evaluation import assessment as assess
+from dnnevo.tasks import nav1d
+from dnnevo.experiments import presets
 from dnnevo.config import apply_overrides
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 

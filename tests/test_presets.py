@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import dnnevo
-from dnnevo import presets
+from dnnevo.experiments import presets
 
 
 @pytest.mark.parametrize("name", presets.names())

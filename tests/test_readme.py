@@ -1,13 +1,17 @@
-"""The README's Python example runs as written."""
+"""The README is the front door: short, without dates, and its examples run as written.
+
+Its ``dnnevo`` commands are parsed by tests/test_docs.py, with those of the docs pages.
+"""
 
 from __future__ import annotations
 
 import os
 import re
-import shutil
 from pathlib import Path
 
 import pytest
+
+from test_docs import run_python_blocks
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 
@@ -16,17 +20,24 @@ def test_python_example_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                              capsys: pytest.CaptureFixture[str]) -> None:
     """Every Python block runs from a folder that has the repository's ``tests/data``, and what a
     block prints is quoted in the README right after it (wrapped lines joined)."""
-    text = README.read_text(encoding="utf-8")
-    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
-    assert blocks, "the README has a Python example"
-    shutil.copytree(README.parent / "tests" / "data", tmp_path / "tests" / "data")
-    monkeypatch.chdir(tmp_path)
-    flat = " ".join(text.split())
-    for code in blocks:
-        exec(compile(code, str(README), "exec"), {"__name__": "readme"})
-        printed = capsys.readouterr().out.strip()
-        for line in filter(None, printed.splitlines()):
-            assert " ".join(line.split()) in flat, f"the README does not quote what its example prints: {line}"
+    assert run_python_blocks(README, tmp_path, monkeypatch, capsys), "the README has a Python example"
     assert (tmp_path / "net.json").is_file()
     assert sorted(os.listdir(tmp_path / "runs" / "py")) == [
         ".dnnevo.lock", "best.json", "checkpoint.json", "config.toml", "log.csv"]
+
+
+def test_readme_is_short_and_undated() -> None:
+    """At most 250 lines, no dates: what changed goes to CHANGELOG.md, results to docs/."""
+    text = README.read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 250
+    assert not re.findall(r"20\d\d-[01]\d-[0-3]\d", text)
+
+
+def test_quick_start_commands() -> None:
+    """The two set-up commands, verbatim, and the results table's markers in their section."""
+    text = README.read_text(encoding="utf-8")
+    assert "pip install . && dnnevo run sequence-1bit\n" in text
+    assert 'pip install ".[test]" && python -m pytest && cargo test\n' in text
+    results = text[text.index("\n## Results\n"):]
+    begin, end = "<!-- results-table:begin -->", "<!-- results-table:end -->"
+    assert results.index(begin) < results.index(end)

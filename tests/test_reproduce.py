@@ -20,9 +20,13 @@ import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
 import dnnevo
-from dnnevo import jobs, plan, report, runsview, scheduler
+from dnnevo.experiments import jobs
+from dnnevo.experiments import plan
+from dnnevo.experiments import report
+from dnnevo.experiments import runsview
+from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError
-from dnnevo.rundir import RunFileError
+from dnnevo.runs.rundir import RunFileError
 
 QUICK = jobs.Settings(quick=True, eval_trials=10, dt_check=False)
 
@@ -177,7 +181,7 @@ def test_a_composed_run_uses_the_runs_it_needs(tmp_path: Path) -> None:
 
 
 def test_the_report_says_the_same_in_markdown_and_html(tmp_path: Path) -> None:
-    from dnnevo.scheduler import Outcome, Task
+    from dnnevo.experiments.scheduler import Outcome, Task
 
     order = [j for j in plan.jobs([0, 1], only=["landmark"]) if j.experiment in ("landmark", "landmark-robot")]
     tasks = {j.id: Task(j.id, j.needs, jobs.run_job) for j in order}
@@ -217,8 +221,8 @@ def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path)
 #: The command, checkpointing every generation, with Ctrl-C's default handler (a test's
 #: background process may start with SIGINT ignored).
 FREQUENT = ("import signal, sys, dnnevo; signal.signal(signal.SIGINT, signal.default_int_handler); "
-            "sys.modules['dnnevo.evolve'].CHECKPOINT_SECONDS = 0.0; "
-            "from dnnevo.cli import main; sys.exit(main(sys.argv[1:]))")
+            "sys.modules['dnnevo.evolution.evolve'].CHECKPOINT_SECONDS = 0.0; "
+            "from dnnevo.cli.command import main; sys.exit(main(sys.argv[1:]))")
 
 
 def test_ctrl_c_stops_a_reproduction_that_then_continues_to_the_same_results(tmp_path: Path) -> None:
@@ -306,7 +310,7 @@ def test_a_killed_worker_s_run_resumes_to_the_same_bits(tmp_path: Path) -> None:
     with scheduler.dask_client(workers=1, scheduler=None) as client:
         pids = list(client.run(os.getpid).values())
         # A checkpoint every generation on this worker (every 10 s otherwise), so it dies mid-run.
-        client.run(exec, "import sys, dnnevo; sys.modules['dnnevo.evolve'].CHECKPOINT_SECONDS = 0.0")
+        client.run(exec, "import sys, dnnevo; sys.modules['dnnevo.evolution.evolve'].CHECKPOINT_SECONDS = 0.0")
         future = client.submit(jobs.run_job, job, str(tmp_path / "dask"), settings, 1, pure=False)
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline and not _at_generation(checkpoint, 3):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 
-from dnnevo.runsview import RunsView
+from dnnevo.experiments.runsview import RunsView
 
 
 class _Terminal(io.StringIO):

@@ -1,7 +1,7 @@
 """The sequence-learning task against the independent NumPy reference in sequence_reference.py.
 
 One trial (R values and the output trace), the trial timings, the batched fitness of
-``dnnevo.evaluate("sequence", ...)`` and the shape of ``dnnevo.sequence.assess``.
+``dnnevo.evaluate("sequence", ...)`` and the shape of ``dnnevo.tasks.sequence.assess``.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import pytest
 import sequence_reference as ref
 
 import dnnevo
-import dnnevo.sequence as seq
+import dnnevo.tasks.sequence as seq
 
 
 TOL = 1e-9
@@ -22,7 +22,7 @@ TOL = 1e-9
 def config(**task_params):
     """The sequence-1bit preset, with ``size`` and the integrator as keyword arguments and
     anything else overriding its task_params."""
-    base = dnnevo.presets.get("sequence-1bit")
+    base = dnnevo.experiments.presets.get("sequence-1bit")
     d = base.to_dict()
     for key in ("size", "integrator"):
         if key in task_params:
@@ -271,7 +271,7 @@ def test_assess_reports_every_target():
 
 
 def test_fig5_shows_the_papers_pair_when_the_task_has_it() -> None:
-    from dnnevo._cli_sequence import fig5_pair
+    from dnnevo.cli.sequence_parts import fig5_pair
 
     assert fig5_pair(["0", "1", "01", "10"]) == ("01", "0")
     assert fig5_pair(["0", "1"]) == ("1", "0")

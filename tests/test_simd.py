@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import dnnevo
-from dnnevo import presets
+from dnnevo.experiments import presets
 
 KERNELS = dnnevo.build_info()["kernels"]
 
@@ -116,7 +116,7 @@ def test_a_bad_environment_variable_fails_the_import_and_the_command_in_one_line
     done = run_with_simd("avx513", "import dnnevo")
     assert done.returncode != 0
     assert "InvalidArgumentError" in done.stderr and "DNNEVO_SIMD" in done.stderr
-    done = run_with_simd("avx513", "import sys; from dnnevo.cli import main; sys.exit(main())")
+    done = run_with_simd("avx513", "import sys; from dnnevo.cli.command import main; sys.exit(main())")
     assert done.returncode != 0
     env = {**os.environ, "DNNEVO_SIMD": "avx513"}
     command = subprocess.run([sys.executable, "-m", "dnnevo", "--help"], env=env, capture_output=True,

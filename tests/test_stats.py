@@ -1,4 +1,4 @@
-"""dnnevo.stats: Wilson intervals against published values and by their defining property, the
+"""dnnevo.evaluation.stats: Wilson intervals against published values and by their defining property, the
 verdict, the trials that would decide, and the censored median with its bootstrap interval."""
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from dnnevo import stats
+from dnnevo.evaluation import stats
 from dnnevo.errors import InvalidArgumentError
-from dnnevo.stats import Z95, bootstrap_median, censored_median, trials_to_decide, verdict, wilson
+from dnnevo.evaluation.stats import Z95, bootstrap_median, censored_median, trials_to_decide, verdict, wilson
 
 INF = math.inf
 

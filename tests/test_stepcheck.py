@@ -1,4 +1,4 @@
-"""dnnevo.stepcheck: which champions the time-step check calls step artefacts, on hand-made
+"""dnnevo.evaluation.stepcheck: which champions the time-step check calls step artefacts, on hand-made
 assessments, and the finer integrations it compares with."""
 
 from __future__ import annotations
@@ -7,7 +7,8 @@ import doctest
 
 import pytest
 
-from dnnevo import assess, stepcheck
+from dnnevo.evaluation import assessment as assess
+from dnnevo.evaluation import stepcheck
 from dnnevo.config import EvolutionConfig, IntegratorConfig
 from dnnevo.errors import ConfigError
 
@@ -62,7 +63,8 @@ def test_a_champion_that_depends_on_the_step_is_flagged() -> None:
     # in at most 10% when integrated 10x finer or with RK4.
     from pathlib import Path
 
-    from dnnevo import _core, presets
+    from dnnevo import _core
+    from dnnevo.experiments import presets
 
     net = _core.Network.load(Path(__file__).parent / "data" / "landmark-step-artefact.json")
     config = presets.get("landmark")

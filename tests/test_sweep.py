@@ -1,4 +1,4 @@
-"""dnnevo.sweep: the statistics of a sweep, on hand-made seed results (no runs)."""
+"""dnnevo.experiments.sweep: the statistics of a sweep, on hand-made seed results (no runs)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,9 @@ import math
 
 import pytest
 
-from dnnevo import assess, stats, sweep
+from dnnevo.evaluation import assessment as assess
+from dnnevo.evaluation import stats
+from dnnevo.experiments import sweep
 from dnnevo.errors import InvalidArgumentError
 
 
@@ -63,7 +65,7 @@ def test_empty_sweep_is_an_error() -> None:
 
 
 def test_summary_counts_step_artefacts() -> None:
-    from dnnevo.stepcheck import StepCheck
+    from dnnevo.evaluation.stepcheck import StepCheck
 
     runs = [seed_result(0, 4, 100), seed_result(1, 9, 100), seed_result(2, None, 50)]
     fine = [seed_result(s, None, k).final for s, k in ((0, 100), (1, 20), (2, 10))]

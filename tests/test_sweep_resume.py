@@ -11,7 +11,7 @@ import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
 import dnnevo
-from dnnevo import presets
+from dnnevo.experiments import presets
 
 OVERRIDES = ["population=12", "generations=8"]
 ARGS = ["sequence-1bit", "--quick", *(a for o in OVERRIDES for a in ("--set", o)),
@@ -46,7 +46,7 @@ def test_a_stopped_sweep_continues_to_the_same_results(tmp_path: Path) -> None:
     config = presets.get("sequence-1bit", quick=True, overrides=OVERRIDES)
     dnnevo.evolve(config.task, config, seed=1, out=parts / "seed-1", progress=False,
                   callback=lambda stats, ga: ga.generation >= 3)
-    assert len(dnnevo.rundir.RunDir(parts / "seed-1").read_checkpoint().history) == 3
+    assert len(dnnevo.runs.rundir.RunDir(parts / "seed-1").read_checkpoint().history) == 3
     printed = sweep(parts, "0-2")
     assert "seed 0: finished; judging its champion again" in printed
     assert "seed 1: resuming at generation 3" in printed
@@ -145,8 +145,8 @@ def test_a_sweep_stopped_by_ctrl_c_leaves_the_stopped_seed_out_and_exits_130(tmp
     # Ctrl-C's default handler (a test's background process may start with SIGINT ignored) and a
     # checkpoint every generation, so the stop lands inside seed 1.
     launcher = ("import signal, sys, dnnevo; signal.signal(signal.SIGINT, signal.default_int_handler); "
-                "sys.modules['dnnevo.evolve'].CHECKPOINT_SECONDS = 0.0; "
-                "from dnnevo.cli import main; sys.exit(main(sys.argv[1:]))")
+                "sys.modules['dnnevo.evolution.evolve'].CHECKPOINT_SECONDS = 0.0; "
+                "from dnnevo.cli.command import main; sys.exit(main(sys.argv[1:]))")
     out = tmp_path / "s"
     args = ["sweep", "sequence-1bit", "--quick", "--set", "population=12", "--set", "generations=400",
             "--eval-trials", "5", "--no-dt-check", "--threads", "1", "--seeds", "0-2", "--out", str(out)]

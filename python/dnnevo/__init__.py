@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dnnevo import _startup
 
-_startup.defer_interrupts()  # the command's start-up: Ctrl-C waits for dnnevo.cli.main
+_startup.defer_interrupts()  # the command's start-up: Ctrl-C waits for dnnevo.cli.command.main
 
 import sys as _sys  # noqa: E402
 from types import TracebackType as _TracebackType
@@ -40,7 +40,8 @@ if _sys.excepthook is _sys.__excepthook__:
 
 from dnnevo.errors import DnnevoError  # noqa: E402
 
-from dnnevo import _core, plot, presets  # noqa: E402
+from dnnevo import _core, plot
+from dnnevo.experiments import presets# noqa: E402
 from dnnevo._core import (
     LANES,
     Network,
@@ -59,8 +60,8 @@ from dnnevo.errors import (
     InvalidArgumentError,
     InvalidNetworkError,
 )
-from dnnevo.evolve import EvolutionResult, evaluate, evolve, resume
-from dnnevo.ga import GeneticAlgorithm
+from dnnevo.evolution.evolve import EvolutionResult, evaluate, evolve, resume
+from dnnevo.evolution.ga import GeneticAlgorithm
 
 _core.apply_simd_env()  # DNNEVO_SIMD, if set, names the kernel; a bad value fails the import
 

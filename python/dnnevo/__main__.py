@@ -1,5 +1,5 @@
 """``python -m dnnevo``: the same as the ``dnnevo`` command."""
 
-from dnnevo.cli import main
+from dnnevo.cli.command import main
 
 raise SystemExit(main())

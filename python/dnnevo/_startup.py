@@ -5,7 +5,7 @@ the core, and Python does not always deliver it as a ``KeyboardInterrupt``: a C 
 being imported may turn it into an ``ImportError``, and Python 3.11 wraps one raised while a class
 is created in a ``RuntimeError``. So when this process is the command (the console script or
 ``python -m dnnevo``), SIGINT is blocked from the first line of ``dnnevo/__init__.py`` until
-``dnnevo.cli.main`` starts, which unblocks it inside its own ``KeyboardInterrupt`` handler. A
+``dnnevo.cli.command.main`` starts, which unblocks it inside its own ``KeyboardInterrupt`` handler. A
 program that merely imports dnnevo is left alone.
 """
 

@@ -14,7 +14,7 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
   imaginary axis) located; optionally the attracting cycles followed as :class:`CycleBranch` es,
   each with where it appears and disappears;
 - :func:`clamp`, :func:`cut` and :func:`lesions`: a neuron held at a constant output, or a
-  connection removed, and the champion re-scored on fresh trials by :func:`dnnevo.assess.assess`.
+  connection removed, and the champion re-scored on fresh trials by :func:`dnnevo.evaluation.assessment.assess`.
 
 The numerical work is in Rust (``ctrnn::analysis``); this module turns its results into
 dataclasses. The analysis is of the continuous-time system; tasks integrate it with Euler steps
@@ -43,7 +43,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import nonnegative
+from dnnevo.tasks._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 
@@ -485,24 +485,24 @@ class LesionTable:
 def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -> list[tuple[_Array, _Array]]:
     """Real trials of ``config``'s task drawn from ``seed``, each as (firing rates (T, N), inputs
     (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain
-    (nav1d) of the task's chain length (:func:`dnnevo.nav1d.chain_len`: 5 trials for nav1d-single,
+    (nav1d) of the task's chain length (:func:`dnnevo.tasks.nav1d.chain_len`: 5 trials for nav1d-single,
     whose network learns its environment in trial 1), at least 2."""
     nonnegative("seed", seed)
     out: list[tuple[_Array, _Array]] = []
     if config.task == "sequence":
-        from dnnevo import sequence
+        from dnnevo.tasks import sequence
 
         for k, target in enumerate(sequence.target_list(config)):
             r = sequence.run_trial(config, net, target, sequence.timings(config, seed, 0, k))
             out.append((r.outputs, np.column_stack([r.trigger, r.reinforcement])))
     elif config.task == "landmark":
-        from dnnevo import landmark
+        from dnnevo.tasks import landmark
 
         for which in (1, 2):
             lr = landmark.record(config, net, which, seed=seed)
             out.append((lr.outputs, lr.input.reshape(-1, 1)))
     elif config.task == "nav1d":
-        from dnnevo import nav1d
+        from dnnevo.tasks import nav1d
 
         chain = nav1d.fresh_chains(config, 1, max(2, nav1d.chain_len(config)), seed)[0]
         nr = nav1d.record(config, net, chain)
@@ -566,9 +566,9 @@ def lesions(
 ) -> LesionTable:
     """Re-scores ``net`` with each neuron clamped at its mean output, and with each of its
     ``cuts`` strongest connections (by ``|w|``; default N, 0 for none) cut, on ``trials`` fresh
-    trials from ``seed`` (the trials :func:`dnnevo.assess.assess` draws, the same for every
+    trials from ``seed`` (the trials :func:`dnnevo.evaluation.assessment.assess` draws, the same for every
     lesion). ``mean_outputs`` defaults to the mean over :func:`trial_outputs` of ``seed``."""
-    from dnnevo import assess
+    from dnnevo.evaluation import assessment as assess
 
     base = assess.assess(config, net, trials, seed=seed)
     if mean_outputs is None:

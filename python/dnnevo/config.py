@@ -1,6 +1,6 @@
 """Evolution settings: a frozen dataclass that reads and writes TOML.
 
-Every field has one meaning and one default here; presets (``dnnevo.presets``) override fields by
+Every field has one meaning and one default here; presets (``dnnevo.experiments.presets``) override fields by
 name. A run folder's ``config.toml`` is this dataclass plus the run's seed and dnnevo's version,
 so a run can always be repeated from its folder.
 """

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dnnevo.rundir import RunDir, save_figure
+from dnnevo.runs.rundir import RunDir, save_figure
 
 __all__ = ["draw_run"]
 
@@ -19,7 +19,9 @@ def draw_run(path: str | Path, *, seed: int = 0, animate: bool = False) -> list[
     any figure is written."""
     import matplotlib.pyplot as plt
 
-    from dnnevo import _cli_landmark, _cli_nav1d, _cli_sequence
+    from dnnevo.cli import landmark_parts as _cli_landmark
+    from dnnevo.cli import nav1d_parts as _cli_nav1d
+    from dnnevo.cli import sequence_parts as _cli_sequence
     from dnnevo.plot import plot_fitness
 
     run = RunDir(path)

@@ -16,9 +16,9 @@ if TYPE_CHECKING:
 
     from dnnevo._core import Network
     from dnnevo.analysis import Attractors, Bifurcation, LesionTable
-    from dnnevo.landmark import Record as LandmarkRecord
-    from dnnevo.nav1d import Record as Nav1dRecord
-    from dnnevo.sequence import TrialRecord
+    from dnnevo.tasks.landmark import Record as LandmarkRecord
+    from dnnevo.tasks.nav1d import Record as Nav1dRecord
+    from dnnevo.tasks.sequence import TrialRecord
 
 __all__ = ["plot_basins", "plot_bifurcation", "plot_fitness", "plot_fitness_seeds", "plot_landmark_world", "plot_lesions", "plot_nav1d_path",
            "plot_nav1d_traces", "plot_phase_portrait", "plot_sequence_trial", "plot_traces"]

@@ -18,10 +18,18 @@ from pathlib import Path
 
 import numpy as np
 
-from dnnevo import _cli_analyze, _cli_evaluate, _cli_nav1d, _cli_reproduce, _cli_sweep, _startup, figures, presets, seeding, sweep
-from dnnevo.assess import DEFAULT_TRIALS
+from dnnevo import _startup, figures
+from dnnevo.cli import analyze as _cli_analyze
+from dnnevo.cli import evaluate as _cli_evaluate
+from dnnevo.cli import nav1d_parts as _cli_nav1d
+from dnnevo.cli import reproduce as _cli_reproduce
+from dnnevo.cli import sweep as _cli_sweep
+from dnnevo.experiments import presets
+from dnnevo.evolution import seeding
+from dnnevo.experiments import sweep
+from dnnevo.evaluation.assessment import DEFAULT_TRIALS
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.rundir import RunDir, save_figure
+from dnnevo.runs.rundir import RunDir, save_figure
 
 EXAMPLES = """examples:
   dnnevo presets                                   list the experiments

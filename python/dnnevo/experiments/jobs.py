@@ -1,4 +1,4 @@
-"""Doing one job of ``dnnevo reproduce`` (:mod:`dnnevo.plan`), so that doing it again is safe.
+"""Doing one job of ``dnnevo reproduce`` (:mod:`dnnevo.experiments.plan`), so that doing it again is safe.
 
 A job's folder ``EXPERIMENT/seed-N`` is an ordinary run folder (for an evolution) and its result
 is ``EXPERIMENT/seed-N.json``, written atomically when the job is done. :func:`run_job`:
@@ -8,7 +8,7 @@ is ``EXPERIMENT/seed-N.json``, written atomically when the job is done. :func:`r
   run's bits are those of an uninterrupted run;
 - starts afresh a folder that holds no checkpoint yet.
 
-Every result file is checked when read: a malformed one is a :class:`~dnnevo.rundir.RunFileError`
+Every result file is checked when read: a malformed one is a :class:`~dnnevo.runs.rundir.RunFileError`
 naming it, and one written under other settings is refused.
 
 The function is what a Dask worker runs, so it takes and returns plain data.
@@ -23,12 +23,16 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from dnnevo import nav1d, plan, presets, stats, sweep
-from dnnevo.assess import DEFAULT_TRIALS, Assessment, assess
+from dnnevo.tasks import nav1d
+from dnnevo.experiments import plan
+from dnnevo.experiments import presets
+from dnnevo.evaluation import stats
+from dnnevo.experiments import sweep
+from dnnevo.evaluation.assessment import DEFAULT_TRIALS, Assessment, assess
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError
-from dnnevo.rundir import RunDir, RunFileError, first_difference, short, write_atomic
-from dnnevo.seeding import Seeding
+from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.evolution.seeding import Seeding
 
 __all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "Settings", "Stopped", "result_path", "read_result", "run_job"]
 
@@ -53,7 +57,7 @@ class Settings:
     """Each preset's quick variant (small population, few generations)."""
     eval_trials: int | None = None
     """Fresh trials judging each final champion, in the task's unit (default: the task's
-    :data:`~dnnevo.assess.DEFAULT_TRIALS`); also the robot-like test's trials per landmark."""
+    :data:`~dnnevo.evaluation.assessment.DEFAULT_TRIALS`); also the robot-like test's trials per landmark."""
     eval_seed: int = sweep.EVAL_SEED_BASE
     """Seed s's final champion is judged on fresh conditions from ``eval_seed + s``."""
     dt_check: bool = True

@@ -84,7 +84,7 @@ def _check_z(z: float) -> float:
 
 def wilson(k: float, n: float, z: float = Z95) -> tuple[float, float]:
     """The Wilson score interval ``(lo, hi)`` of ``k`` successes in ``n`` trials; 95% by
-    default. ``k`` may be fractional (an effective count, see :mod:`dnnevo.assess`).
+    default. ``k`` may be fractional (an effective count, see :mod:`dnnevo.evaluation.assessment`).
 
     >>> wilson(0, 10)                        # hi = z^2 / (n + z^2)
     (0.0, 0.2775327998628892)

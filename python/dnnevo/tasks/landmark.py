@@ -10,7 +10,7 @@ output ``f`` is read: ``f < 0.5`` means landmark 1 (two crates pushed together),
 Success rule: at least 95% of fresh trials classified right. ``robot_like=True`` adds sonar
 noise, specular misses and a jittered room: our stand-in for the paper's real-robot test.
 
->>> from dnnevo import landmark
+>>> from dnnevo.tasks import landmark
 >>> world = landmark.default_world(2)
 >>> world["room"], len(world["boxes"])
 ([6.0, 5.0], 2)
@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import bounded_count, nonnegative, task_params
+from dnnevo.tasks._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 

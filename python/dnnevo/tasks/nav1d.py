@@ -13,7 +13,8 @@ Success rule: on fresh conditions, at least 95% of the scored trials are done ri
 reached, or the environment classified right: ``f(v_C) >= 0.5`` means landmark-near).
 
 >>> import dnnevo
->>> from dnnevo import nav1d, presets
+>>> from dnnevo.tasks import nav1d
+>>> from dnnevo.experiments import presets
 >>> config = presets.get("nav1d-far")
 >>> a, b = nav1d.cases(config)[:2]
 >>> (a.environment, a.goal, a.landmark, b.goal, b.landmark)
@@ -32,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import bounded_count, nonnegative, task_params
+from dnnevo.tasks._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 
@@ -190,7 +191,7 @@ def _by_environment(episodes: Sequence[dict[str, Any]],
 def load_part(run_dir: str | Path, role: str | None = None) -> Part:
     """The config and champion of a ``nav1d`` run folder; ``role`` (e.g. ``"--far"``) names the
     folder in errors."""
-    from dnnevo.rundir import RunDir
+    from dnnevo.runs.rundir import RunDir
 
     where = f"{role} {run_dir}" if role else str(run_dir)
     run = RunDir(Path(run_dir))

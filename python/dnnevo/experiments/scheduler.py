@@ -14,7 +14,7 @@ need it are skipped; the others go on. On Dask:
 Dask is optional (``pip install "dnnevo[cluster]"``); without it only :func:`run_in_process`
 works.
 
->>> from dnnevo.runsview import RunsView
+>>> from dnnevo.experiments.runsview import RunsView
 >>> import io
 >>> tasks = [Task("a", (), abs, (-2,)), Task("b", ("a",), divmod, (7, 0)), Task("c", ("b",), abs, (1,))]
 >>> outcomes = run_in_process(tasks, RunsView(3, stream=io.StringIO()), errors=(ZeroDivisionError,))
@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 from dnnevo.errors import ConfigError, DnnevoError
 
 if TYPE_CHECKING:
-    from dnnevo.runsview import RunsView
+    from dnnevo.experiments.runsview import RunsView
 
 __all__ = ["CLUSTER_EXTRA", "Outcome", "Task", "check_options", "dask_client", "describe", "run_in_process", "run_on_dask"]
 

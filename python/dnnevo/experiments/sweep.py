@@ -4,16 +4,16 @@ their uncertainty:
 - **success rate**: the fraction of seeds whose run found a champion meeting the task's rule
   (:attr:`~dnnevo.EvolutionResult.first_success` is not None), with its Wilson interval;
 - **median first-success generation**, with a 95% percentile bootstrap interval (fixed seed
-  :data:`~dnnevo.stats.BOOTSTRAP_SEED`, 10,000 resamples). A seed that never succeeded is
+  :data:`~dnnevo.evaluation.stats.BOOTSTRAP_SEED`, 10,000 resamples). A seed that never succeeded is
   censored at its run's last generation and counts as +infinity, so the median is "not
   reached" when more than half the seeds are censored;
 - **final champions passing**: each seed's final champion (``best.json``) judged by
-  :func:`dnnevo.assess.assess` on fresh conditions from seed :data:`EVAL_SEED_BASE` + the run's
+  :func:`dnnevo.evaluation.assessment.assess` on fresh conditions from seed :data:`EVAL_SEED_BASE` + the run's
   seed, which no run uses; the fraction that pass, with its Wilson interval;
-- **step artefacts**: final champions that the time-step check (:mod:`dnnevo.stepcheck`: the same
+- **step artefacts**: final champions that the time-step check (:mod:`dnnevo.evaluation.stepcheck`: the same
   conditions at a 10x finer step and with RK4) finds failing where the run's step did not.
 
->>> from dnnevo import sweep
+>>> from dnnevo.experiments import sweep
 >>> sweep.eval_seed(3)
 1000006
 """
@@ -31,14 +31,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from dnnevo import stats
-from dnnevo.assess import Assessment, assess
+from dnnevo.evaluation import stats
+from dnnevo.evaluation.assessment import Assessment, assess
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
-from dnnevo.rundir import RunDir, RunFileError, first_difference, short, write_atomic
-from dnnevo.seeding import Seeding
-from dnnevo.stats import Verdict
-from dnnevo.stepcheck import StepCheck, step_check
+from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.evolution.seeding import Seeding
+from dnnevo.evaluation.stats import Verdict
+from dnnevo.evaluation.stepcheck import StepCheck, step_check
 
 __all__ = ["EVAL_SEED_BASE", "CSV_COLUMNS", "SUMMARY_FILES", "SeedResult", "Summary", "eval_seed", "run_seed", "summarize"]
 
@@ -125,16 +125,16 @@ def run_seed(
 ) -> SeedResult:
     """Runs ``config`` with ``seed`` into ``out``, then judges the final champion (``out /
     best.json``) on fresh conditions from :func:`eval_seed` with ``eval_trials`` (default: the
-    task's :data:`~dnnevo.assess.DEFAULT_TRIALS`), and, with ``dt_check``, checks it at finer
-    steps on the same conditions (:func:`~dnnevo.stepcheck.step_check`). With ``seeding`` the
-    first population starts from earlier runs' networks (:mod:`dnnevo.seeding`). With ``resume``
+    task's :data:`~dnnevo.evaluation.assessment.DEFAULT_TRIALS`), and, with ``dt_check``, checks it at finer
+    steps on the same conditions (:func:`~dnnevo.evaluation.stepcheck.step_check`). With ``seeding`` the
+    first population starts from earlier runs' networks (:mod:`dnnevo.evolution.seeding`). With ``resume``
     the run in ``out`` (same config and seed, else a :class:`RunFileError`) is continued from its
     checkpoint, or only judged if it has finished; its wall time then counts every session. A
     run made with fewer generations than ``config`` and otherwise the same config is extended to
     ``config.generations`` (as ``dnnevo resume --generations``). ``progress`` shows the run's
     progress bar."""
-    from dnnevo.evolve import evolve
-    from dnnevo.evolve import resume as resume_run
+    from dnnevo.evolution.evolve import evolve
+    from dnnevo.evolution.evolve import resume as resume_run
 
     t0 = time.perf_counter()
     if resume:

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from dnnevo import _core
-from dnnevo.assess import Assessment, assess
+from dnnevo.evaluation.assessment import Assessment, assess
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 
@@ -123,7 +123,7 @@ def step_check(
     config: EvolutionConfig, net: _core.Network, trials: int | None = None, *, seed: int,
     robot_like: bool = False, base: Assessment | None = None,
 ) -> StepCheck:
-    """Judges ``net`` as :func:`~dnnevo.assess.assess` does at the run's step (or takes ``base``,
+    """Judges ``net`` as :func:`~dnnevo.evaluation.assessment.assess` does at the run's step (or takes ``base``,
     that assessment, already made) and at each of :func:`finer_configs`, on the same conditions."""
     if base is None:
         base = assess(config, net, trials, seed=seed, robot_like=robot_like)

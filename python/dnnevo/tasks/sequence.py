@@ -17,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import bounded_count, nonnegative, task_params
+from dnnevo.tasks._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 
 __all__ = ["SWITCH_AFTER", "SWITCH_HOLD", "Switch", "TrialRecord", "assess", "fresh_timings", "run_trial", "switch_table", "switch_trial",

@@ -1,5 +1,5 @@
 """The ``dnnevo evaluate`` command: a run's champion judged on fresh conditions by
-:func:`dnnevo.assess.assess`, printed as text (default) or JSON (``--json``). The exit status is
+:func:`dnnevo.evaluation.assessment.assess`, printed as text (default) or JSON (``--json``). The exit status is
 the verdict: 0 pass, 1 fail, 3 undecided (2 is an error)."""
 
 from __future__ import annotations
@@ -12,11 +12,14 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from dnnevo import _cli_landmark, _cli_nav1d, _cli_sequence, assess
-from dnnevo.assess import Assessment, Rate
+from dnnevo.cli import landmark_parts as _cli_landmark
+from dnnevo.cli import nav1d_parts as _cli_nav1d
+from dnnevo.cli import sequence_parts as _cli_sequence
+from dnnevo.evaluation import assessment as assess
+from dnnevo.evaluation.assessment import Assessment, Rate
 from dnnevo.errors import ConfigError
-from dnnevo.rundir import RunDir
-from dnnevo.stepcheck import StepCheck, step_check, with_dt
+from dnnevo.runs.rundir import RunDir
+from dnnevo.evaluation.stepcheck import StepCheck, step_check, with_dt
 
 EXAMPLE = """examples:
   dnnevo evaluate runs/demo                      the champion on fresh trials, default counts

@@ -6,10 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from dnnevo import _core, sequence
-from dnnevo.assess import Assessment
+from dnnevo import _core
+from dnnevo.tasks import sequence
+from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir, save_figure
+from dnnevo.runs.rundir import RunDir, save_figure
 
 
 SWITCH_TRIALS = 20

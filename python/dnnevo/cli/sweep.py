@@ -1,5 +1,5 @@
 """The ``dnnevo sweep`` command: independent runs over seeds, each final champion judged on fresh
-conditions, and the statistics of :mod:`dnnevo.sweep` printed and written to ``summary.csv`` and
+conditions, and the statistics of :mod:`dnnevo.experiments.sweep` printed and written to ``summary.csv`` and
 ``summary.json``."""
 
 from __future__ import annotations
@@ -12,13 +12,16 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from dnnevo import presets, scheduler, seeding, sweep
-from dnnevo._checks import nonnegative
-from dnnevo.assess import DEFAULT_TRIALS, UNITS
+from dnnevo.experiments import presets
+from dnnevo.experiments import scheduler
+from dnnevo.evolution import seeding
+from dnnevo.experiments import sweep
+from dnnevo.tasks._checks import nonnegative
+from dnnevo.evaluation.assessment import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.rundir import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
-from dnnevo.runsview import RunsView
+from dnnevo.runs.rundir import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
+from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "sweep.json"
 """The settings a sweep folder was begun with, so that running the command again continues it."""

@@ -24,12 +24,12 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo._checks import nonnegative
+from dnnevo.tasks._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError
-from dnnevo.ga import GeneticAlgorithm
-from dnnevo.progress import Progress
-from dnnevo.rundir import RunDir, RunFileError, first_difference, short
+from dnnevo.evolution.ga import GeneticAlgorithm
+from dnnevo.evolution.progress import Progress
+from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short
 
 __all__ = ["EvolutionResult", "evaluate", "evolve", "resume"]
 
@@ -98,7 +98,7 @@ def evaluate(
 
 def _task_config(task: str, config: EvolutionConfig | None) -> EvolutionConfig:
     """The config for a built-in task name or preset name."""
-    from dnnevo import presets
+    from dnnevo.experiments import presets
 
     if config is not None:
         named = presets.get(task).task if task in presets.names() else task
@@ -132,7 +132,7 @@ def evolve(
 
     ``task`` is a built-in task or preset name, or a Python callable ``fitness(networks) ->
     array`` (slower, but works with everything else, checkpoints included). With ``out`` the run
-    writes a run folder (see :mod:`dnnevo.rundir`); an existing non-empty folder is refused unless
+    writes a run folder (see :mod:`dnnevo.runs.rundir`); an existing non-empty folder is refused unless
     ``force``. ``callback(stats, ga)`` runs after every generation; returning True stops the run.
     ``seeds`` are networks placed first in the initial population (e.g. from :func:`compose`).
     ``run_info`` adds entries to the ``[run]`` table of ``config.toml``, e.g. where the seeds

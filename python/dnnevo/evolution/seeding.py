@@ -34,8 +34,8 @@ from typing import Any
 
 from dnnevo import _core
 from dnnevo.errors import ConfigError
-from dnnevo.ga import GeneticAlgorithm
-from dnnevo.rundir import RunDir
+from dnnevo.evolution.ga import GeneticAlgorithm
+from dnnevo.runs.rundir import RunDir
 
 __all__ = ["SPARE_SEED_STRIDE", "Seeding", "add_arguments"]
 

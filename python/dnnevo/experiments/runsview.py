@@ -15,7 +15,7 @@ import sys
 import time
 from typing import Any, TextIO
 
-from dnnevo.progress import clock
+from dnnevo.evolution.progress import clock
 
 __all__ = ["RunsView"]
 

@@ -12,10 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from dnnevo import nav1d
-from dnnevo.assess import Assessment
+from dnnevo.tasks import nav1d
+from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir, save_figure, write_atomic
+from dnnevo.runs.rundir import RunDir, save_figure, write_atomic
 
 SYSTEM_EXAMPLE = (
     "example: dnnevo nav1d-system --classifier runs/nav1d-classifier-seed0 "
@@ -134,7 +134,7 @@ def add_system_parser(sub: Any) -> None:
 def system(args: argparse.Namespace) -> int:
     """``dnnevo nav1d-system``."""
     from dnnevo.errors import ConfigError
-    from dnnevo.stats import wilson
+    from dnnevo.evaluation.stats import wilson
 
     if args.environments < 1 or args.trials < 1 or args.seed < 0:
         raise ConfigError("--environments and --trials must be >= 1 and --seed >= 0")

@@ -1,6 +1,6 @@
-"""The ``dnnevo reproduce`` command: every experiment of the paper over seeds (:mod:`dnnevo.plan`),
-run in this process or on Dask (:mod:`dnnevo.scheduler`), resumable, with a report
-(:mod:`dnnevo.report`)."""
+"""The ``dnnevo reproduce`` command: every experiment of the paper over seeds (:mod:`dnnevo.experiments.plan`),
+run in this process or on Dask (:mod:`dnnevo.experiments.scheduler`), resumable, with a report
+(:mod:`dnnevo.experiments.report`)."""
 
 from __future__ import annotations
 
@@ -13,10 +13,13 @@ import time
 from pathlib import Path
 from typing import Any
 
-from dnnevo import jobs, plan, report, scheduler
+from dnnevo.experiments import jobs
+from dnnevo.experiments import plan
+from dnnevo.experiments import report
+from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.rundir import LOCK_NAME, RunDir, check_settings, write_atomic
-from dnnevo.runsview import RunsView
+from dnnevo.runs.rundir import LOCK_NAME, RunDir, check_settings, write_atomic
+from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "reproduce.json"
 """The settings a reproduction's folder was begun with, so that running the command again

@@ -21,13 +21,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from dnnevo import plan, stats, sweep
-from dnnevo.assess import Assessment
-from dnnevo.jobs import ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings
-from dnnevo.rundir import save_figure, write_atomic
-from dnnevo.scheduler import Outcome
+from dnnevo.experiments import plan
+from dnnevo.evaluation import stats
+from dnnevo.experiments import sweep
+from dnnevo.evaluation.assessment import Assessment
+from dnnevo.experiments.jobs import ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings
+from dnnevo.runs.rundir import save_figure, write_atomic
+from dnnevo.experiments.scheduler import Outcome
 
-__all__ = ["Block", "build", "write", "REPORT_FILES"]
+__all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "SUMMARY_HEADER",
+           "REPORT_FILES"]
 
 REPORT_FILES = ("report.md", "report.html")
 """The files the report is written to, in the reproduction's folder."""
@@ -69,7 +72,9 @@ def _runs(name: str, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) ->
             and (o := outcomes[j.id]).status == "done" and o.result is not None]
 
 
-def _summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> tuple[str, ...]:
+def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> tuple[str, ...]:
+    """``e``'s row of the paper-vs-dnnevo table (:data:`SUMMARY_HEADER`), from the results in
+    ``outcomes`` alone (no run folder is read)."""
     planned = [j for j in order if j.experiment == e.name]
     done = [outcomes[j.id] for j in planned if outcomes[j.id].status == "done"]
     walls = [float(o.result["wall_s"]) for o in done if o.result is not None]
@@ -99,7 +104,9 @@ SUMMARY_HEADER = ("experiment", "paper", "runs done", "seeds meeting the rule du
                   "median first-success generation (95% interval)", "step artefacts", "wall time per run (median)")
 
 
-def _seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> Block | None:
+def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> Block | None:
+    """``e``'s table of one row per seed, from the results in ``outcomes`` alone; None when
+    ``order`` has no job of ``e``."""
     rows: list[tuple[str, ...]] = []
     for job in (j for j in order if j.experiment == e.name):
         o = outcomes[job.id]
@@ -146,10 +153,11 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
     seed's own figures."""
     import matplotlib.pyplot as plt
 
-    from dnnevo import figures, nav1d
-    from dnnevo._cli_nav1d import draw_system
+    from dnnevo import figures
+    from dnnevo.tasks import nav1d
+    from dnnevo.cli.nav1d_parts import draw_system
     from dnnevo.plot import plot_fitness_seeds
-    from dnnevo.rundir import RunDir
+    from dnnevo.runs.rundir import RunDir
 
     done = [j for j in order if j.experiment == e.name and outcomes[j.id].status == "done"]
     if not done:
@@ -181,6 +189,18 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
     return blocks
 
 
+def describe(e: plan.Experiment) -> str:
+    """What the paper says of ``e`` and how dnnevo runs it, in a sentence or three."""
+    what = f"Paper: {e.paper}."
+    if e.preset:
+        what += f" Preset `{e.preset}`" + (f" with `{' '.join(e.overrides)}`" if e.overrides else "") + "."
+    if e.needs:
+        what += f" Uses the runs of {', '.join(e.needs)} of the same seed."
+    if e.note:
+        what += f" {e.note[0].upper()}{e.note[1:]}."
+    return what
+
+
 def build(root: Path, order: Sequence[plan.Job], outcomes: dict[str, Outcome], *, settings: Settings,
           environment: dict[str, str], command: str, draw: bool = True) -> list[Block]:
     """The report of the jobs ``order`` run with ``settings`` and what became of them; ``draw``
@@ -200,7 +220,7 @@ def build(root: Path, order: Sequence[plan.Job], outcomes: dict[str, Outcome], *
         Block("h1", "dnnevo: Yamauchi & Beer, reproduced"),
         Block("p", intro),
         Block("h2", "Paper and dnnevo"),
-        Block("table", rows=(SUMMARY_HEADER, *(_summary_row(e, order, outcomes) for e in present))),
+        Block("table", rows=(SUMMARY_HEADER, *(summary_row(e, order, outcomes) for e in present))),
     ]
     missing = [o for o in outcomes.values() if o.status != "done"]
     if missing:
@@ -210,15 +230,8 @@ def build(root: Path, order: Sequence[plan.Job], outcomes: dict[str, Outcome], *
     blocks.append(Block("h2", "Experiments"))
     for e in present:
         blocks.append(Block("h3", e.name))
-        what = f"Paper: {e.paper}."
-        if e.preset:
-            what += f" Preset `{e.preset}`" + (f" with `{' '.join(e.overrides)}`" if e.overrides else "") + "."
-        if e.needs:
-            what += f" Uses the runs of {', '.join(e.needs)} of the same seed."
-        if e.note:
-            what += f" {e.note[0].upper()}{e.note[1:]}."
-        blocks.append(Block("p", what))
-        table = _seed_table(e, order, outcomes)
+        blocks.append(Block("p", describe(e)))
+        table = seed_table(e, order, outcomes)
         if table is not None:
             blocks.append(table)
         if draw:

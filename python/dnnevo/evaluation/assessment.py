@@ -1,9 +1,9 @@
 """One assessment for every task: a champion judged on fresh conditions, each success rate with
-its 95% Wilson interval and a pass / fail / undecided verdict (see :mod:`dnnevo.stats`).
+its 95% Wilson interval and a pass / fail / undecided verdict (see :mod:`dnnevo.evaluation.stats`).
 ``dnnevo evaluate`` prints it and ``dnnevo sweep`` applies it to every seed's final champion.
 
-It wraps each task's own assessment (:func:`dnnevo.sequence.assess`, :func:`dnnevo.nav1d.assess`,
-:func:`dnnevo.landmark.assess`), which runs the trials, and judges its counts:
+It wraps each task's own assessment (:func:`dnnevo.tasks.sequence.assess`, :func:`dnnevo.tasks.nav1d.assess`,
+:func:`dnnevo.tasks.landmark.assess`), which runs the trials, and judges its counts:
 
 - ``sequence``: one rate per target, the fraction of trials in which every trigger after the
   warm-up was right; threshold 0.9. The run passes when every target passes, fails when any
@@ -23,7 +23,8 @@ A trial count ``trials`` means what ``dnnevo evaluate --trials`` means: trials p
 defaults.
 
 >>> import dnnevo
->>> from dnnevo import assess, presets
+>>> from dnnevo.evaluation import assessment as assess
+>>> from dnnevo.experiments import presets
 >>> config = presets.get("nav1d-far")
 >>> a = assess.assess(config, dnnevo.Network.random(5, 1, seed=0), 50, seed=1)
 >>> a.task, a.trials, a.rates[-1].name, a.verdict in ("pass", "fail", "undecided")
@@ -37,11 +38,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from dnnevo import _core, stats
-from dnnevo._checks import nonnegative
+from dnnevo import _core
+from dnnevo.evaluation import stats
+from dnnevo.tasks._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
-from dnnevo.stats import Verdict
+from dnnevo.evaluation.stats import Verdict
 
 __all__ = [
     "CONFIDENCE",
@@ -245,7 +247,7 @@ _INDEPENDENT = "Wilson score interval, 95%; trials are independent"
 
 
 def _sequence(config: EvolutionConfig, net: _core.Network, trials: int, seed: int) -> Assessment:
-    from dnnevo import sequence
+    from dnnevo.tasks import sequence
 
     report = sequence.assess(config, net, trials, seed)
     threshold = THRESHOLDS["sequence"]
@@ -260,7 +262,7 @@ def _sequence(config: EvolutionConfig, net: _core.Network, trials: int, seed: in
 
 
 def _landmark(config: EvolutionConfig, net: _core.Network, trials: int, seed: int, robot_like: bool) -> Assessment:
-    from dnnevo import landmark
+    from dnnevo.tasks import landmark
 
     report = landmark.assess(config, net, trials, seed, robot_like=robot_like)
     (a, b), (c, d) = report["confusion"]
@@ -293,7 +295,7 @@ def scored_trials(objective: str, episode: dict[str, Any]) -> list[bool]:
 
 
 def _nav1d(config: EvolutionConfig, net: _core.Network, trials: int, seed: int) -> Assessment:
-    from dnnevo import nav1d
+    from dnnevo.tasks import nav1d
 
     report = nav1d.assess(config, net, trials, seed)
     objective = report["objective"]
@@ -313,7 +315,7 @@ def _nav1d(config: EvolutionConfig, net: _core.Network, trials: int, seed: int) 
     overall = rate("overall", [s for _, s in scored], THRESHOLDS["nav1d"])
     if abs(overall.rate - report["rate"]) > 1e-12:
         raise RuntimeError(f"nav1d: the scored trials give {overall.rate} but the task's rate is "
-                          f"{report['rate']}; dnnevo.assess and the task disagree on what is scored")
+                          f"{report['rate']}; dnnevo.evaluation.assessment and the task disagree on what is scored")
     method = (f"Wilson score interval, 95%, clustered by chain: the {per_chain} scored trials of a "
               "chain share the network's state, so each chain counts as one observation (the "
               "worst case; never too narrow)" if clustered

@@ -6,10 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from dnnevo import landmark
-from dnnevo.assess import Assessment
+from dnnevo.tasks import landmark
+from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig
-from dnnevo.rundir import RunDir, save_figure, write_atomic_with
+from dnnevo.runs.rundir import RunDir, save_figure, write_atomic_with
 
 
 def preface(where: Path, a: Assessment) -> list[str]:

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from dnnevo import tasks
 import dnnevo
 from dnnevo import _core, analysis
 from dnnevo.evaluation import assessment as assess
@@ -167,14 +168,14 @@ def test_lesioning_a_neuron_without_outgoing_weights_changes_no_score(preset: st
     seed = 11
     size, n_inputs = _core.task_layout(config.to_json())
     net = without_outgoing(dnnevo.Network.random(size, n_inputs, seed=7), size - 1)
-    base = assess.assess(config, net, trials, seed=seed)
-    silent = assess.assess(config, analysis.clamp(net, config.size - 1, 0.7), trials, seed=seed)
+    base = tasks.assess(config, net, trials, seed=seed)
+    silent = tasks.assess(config, analysis.clamp(net, config.size - 1, 0.7), trials, seed=seed)
     assert silent.report == base.report
     # The control: clamping a neuron that drives the others (neuron 0's inputs) does change them.
     driver = int(np.argmax(np.abs(net.weights[0, :-1])))
     if driver == 0:
         driver = 1
-    changed = assess.assess(config, analysis.clamp(net, driver, 0.0 if net.outputs[driver] > 0.5 else 1.0),
+    changed = tasks.assess(config, analysis.clamp(net, driver, 0.0 if net.outputs[driver] > 0.5 else 1.0),
                             trials, seed=seed)
     assert changed.report != base.report
     table = analysis.lesions(config, net, trials, seed=seed, cuts=2)

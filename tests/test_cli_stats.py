@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
+from dnnevo import tasks
 import dnnevo
 from dnnevo.cli import evaluate as _cli_evaluate
 from dnnevo.evaluation import assessment as assess
@@ -71,7 +72,7 @@ def check_rate(rate: dict, threshold: float | None) -> None:
 def same_as_api(run: Path, d: dict, **kwargs: bool) -> None:
     """The JSON is the Python API's assessment on the same fresh conditions."""
     config = EvolutionConfig.from_toml((run / "config.toml").read_text())
-    a = assess.assess(config, dnnevo.Network.load(run / "best.json"), d["trials"], seed=d["seed"], **kwargs)
+    a = tasks.assess(config, dnnevo.Network.load(run / "best.json"), d["trials"], seed=d["seed"], **kwargs)
     assert {**a.to_dict(), "run": str(run)} == {k: v for k, v in d.items() if k != "switch_test"}
 
 
@@ -84,7 +85,7 @@ def test_evaluate_json_sequence(runs: dict[str, Path]) -> None:
         assert rate["n"] == 30
         check_rate(rate, 0.9)
     assert d["verdict"] == assess.combine([r["verdict"] for r in d["rates"]])
-    assert status == assess.EXIT_STATUS[d["verdict"]]
+    assert status == _cli_evaluate.EXIT_STATUS[d["verdict"]]
     switch = d["switch_test"]
     assert (switch["switch_after"], switch["trials"]) == (8, 20)
     assert [(p["first"], p["second"]) for p in switch["pairs"]] == [("0", "1"), ("1", "0")]
@@ -109,7 +110,7 @@ def test_evaluate_json_nav1d_clusters_by_chain(runs: dict[str, Path]) -> None:
     for rate in d["rates"][:-1]:
         check_rate(rate, None)
     assert sum(r["n"] for r in d["rates"][:-1]) == 100
-    assert status == assess.EXIT_STATUS[d["verdict"]] and d["verdict"] == overall["verdict"]
+    assert status == _cli_evaluate.EXIT_STATUS[d["verdict"]] and d["verdict"] == overall["verdict"]
     same_as_api(runs["nav1d-single"], d)
 
 
@@ -126,7 +127,7 @@ def test_evaluate_json_landmark(runs: dict[str, Path], robot_like: bool) -> None
     check_rate(one, None)
     check_rate(two, None)
     check_rate(overall, 0.95)
-    assert status == assess.EXIT_STATUS[d["verdict"]]
+    assert status == _cli_evaluate.EXIT_STATUS[d["verdict"]]
     same_as_api(runs["landmark"], d, robot_like=robot_like)
 
 
@@ -168,7 +169,7 @@ def test_exit_status_is_the_verdict(tmp_path: Path) -> None:
 
 
 def test_hint_when_the_rate_is_the_threshold() -> None:
-    rate = assess._rate("1*", 9, 10, threshold=0.9)
+    rate = assess.rate("1*", 9, 10, threshold=0.9)
     assert rate.verdict == "undecided" and rate.trials_to_decide is None
     assert "equals the threshold (90.0%), so no number of trials decides it" in _cli_evaluate.hint(rate, "trials")
 

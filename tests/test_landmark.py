@@ -15,6 +15,8 @@ from hypothesis import strategies as st
 
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
+from dnnevo import tasks
+from dnnevo.cli import evaluate as _cli_evaluate
 import dnnevo
 from dnnevo.evaluation import assessment as assess
 from dnnevo.tasks import landmark
@@ -349,7 +351,8 @@ def test_plots_draw_what_the_record_holds():
     from matplotlib.figure import Figure
     from matplotlib.patches import Rectangle
 
-    from dnnevo.plot import plot_landmark_world, plot_traces
+    from dnnevo.plot import plot_traces
+    from dnnevo.tasks.landmark import plot_world as plot_landmark_world
 
     world = world_with_box((3.0, 2.5), (1.0, 1.0), 45.0)
     rec = landmark.record(with_task_params(config(), landmark1=world),
@@ -548,9 +551,9 @@ def test_quick_run_and_evaluate(run, robot_like):
     report = landmark.assess(saved, champion, 10, seed=1, robot_like=robot_like)
     assert confusion_rows(r.stdout) == report["confusion"]
     assert sum(map(sum, report["confusion"])) == 20
-    judged = assess.assess(saved, champion, 10, seed=1, robot_like=robot_like)
+    judged = tasks.assess(saved, champion, 10, seed=1, robot_like=robot_like)
     assert f"overall: {report['rate']:.1%} right; success needs >= 95%: {judged.verdict}" in r.stdout
-    assert assess.EXIT_STATUS[judged.verdict] == r.returncode
+    assert _cli_evaluate.EXIT_STATUS[judged.verdict] == r.returncode
 
 
 def test_the_robust_preset_trains_on_varied_trials_and_runs(tmp_path):

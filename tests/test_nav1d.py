@@ -18,6 +18,8 @@ from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 import nav1d_reference as ref
 
+from dnnevo import tasks
+from dnnevo.cli import evaluate as _cli_evaluate
 import dnnevo
 from dnnevo.evaluation.stats import wilson
 from dnnevo.evaluation import assessment as assess
@@ -461,9 +463,9 @@ def test_quick_run_evaluate_and_plot(runs, name):
     part = nav1d.load_part(run)
     assert part.config == presets.get(name, quick=True)
     report = nav1d.assess(part.config, part.network, 40, seed=1)
-    judged = assess.assess(part.config, part.network, 40, seed=1)
+    judged = tasks.assess(part.config, part.network, 40, seed=1)
     assert f"overall: {report['rate']:.1%} right; success needs >= 95%: {judged.verdict}" in r.stdout
-    assert assess.EXIT_STATUS[judged.verdict] == r.returncode
+    assert _cli_evaluate.EXIT_STATUS[judged.verdict] == r.returncode
     r = run_cli("plot", run)
     assert r.returncode == 0, r.stderr
     pictures = ["fitness.png", "fig2-paths.png"]

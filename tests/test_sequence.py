@@ -271,7 +271,7 @@ def test_assess_reports_every_target():
 
 
 def test_fig5_shows_the_papers_pair_when_the_task_has_it() -> None:
-    from dnnevo.cli.sequence_parts import fig5_pair
+    from dnnevo.tasks.sequence import fig5_pair
 
     assert fig5_pair(["0", "1", "01", "10"]) == ("01", "0")
     assert fig5_pair(["0", "1"]) == ("1", "0")

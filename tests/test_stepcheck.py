@@ -7,6 +7,7 @@ import doctest
 
 import pytest
 
+from dnnevo import tasks
 from dnnevo.evaluation import assessment as assess
 from dnnevo.evaluation import stepcheck
 from dnnevo.config import EvolutionConfig, IntegratorConfig
@@ -18,7 +19,7 @@ def test_doctests() -> None:
 
 
 def assessment(*rights: int, n: int = 200) -> assess.Assessment:
-    rates = [assess._rate(f"{i}*", k, n, threshold=0.9) for i, k in enumerate(rights)]
+    rates = [assess.rate(f"{i}*", k, n, threshold=0.9) for i, k in enumerate(rights)]
     return assess.Assessment(task="sequence", trials=n, unit="trials per target", seed=1, rates=rates,
                              verdict=assess.combine([r.verdict or "fail" for r in rates]), method="m")
 
@@ -68,7 +69,7 @@ def test_a_champion_that_depends_on_the_step_is_flagged() -> None:
 
     net = _core.Network.load(Path(__file__).parent / "data" / "landmark-step-artefact.json")
     config = presets.get("landmark")
-    check = stepcheck.step_check(config, net, 20, seed=2)
+    check = stepcheck.step_check(lambda c: tasks.assess(c, net, 20, seed=2), config)
     assert check.base.verdict != "fail" and check.base.judged[0].rate >= 0.95
     assert check.artefacts == ["dt/10: overall", "rk4: overall"]
     assert all(a.judged[0].rate <= 0.1 for a in check.checks.values())

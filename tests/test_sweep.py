@@ -19,7 +19,7 @@ def test_doctests() -> None:
 
 
 def seed_result(seed: int, first_success: int | None, k: int, n: int = 100) -> sweep.SeedResult:
-    rate = assess._rate("overall", k, n, threshold=0.95)
+    rate = assess.rate("overall", k, n, threshold=0.95)
     final = assess.Assessment(task="nav1d", trials=n, unit="chains", seed=sweep.eval_seed(seed),
                               rates=[rate], verdict=assess.combine([rate.verdict or "fail"]), method="m")
     return sweep.SeedResult(seed=seed, best_fitness=0.5, best_generation=3, first_success=first_success,

@@ -14,7 +14,7 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
   imaginary axis) located; optionally the attracting cycles followed as :class:`CycleBranch` es,
   each with where it appears and disappears;
 - :func:`clamp`, :func:`cut` and :func:`lesions`: a neuron held at a constant output, or a
-  connection removed, and the champion re-scored on fresh trials by :func:`dnnevo.evaluation.assessment.assess`.
+  connection removed, and the champion re-scored on fresh trials by :func:`dnnevo.tasks.assess`.
 
 The numerical work is in Rust (``ctrnn::analysis``); this module turns its results into
 dataclasses. The analysis is of the continuous-time system; tasks integrate it with Euler steps
@@ -42,8 +42,8 @@ from typing import Any, Literal, cast
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo import _core
-from dnnevo.tasks._checks import nonnegative
+from dnnevo import _core, tasks
+from dnnevo._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 
@@ -488,28 +488,10 @@ def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -
     (nav1d) of the task's chain length (:func:`dnnevo.tasks.nav1d.chain_len`: 5 trials for nav1d-single,
     whose network learns its environment in trial 1), at least 2."""
     nonnegative("seed", seed)
-    out: list[tuple[_Array, _Array]] = []
-    if config.task == "sequence":
-        from dnnevo.tasks import sequence
-
-        for k, target in enumerate(sequence.target_list(config)):
-            r = sequence.run_trial(config, net, target, sequence.timings(config, seed, 0, k))
-            out.append((r.outputs, np.column_stack([r.trigger, r.reinforcement])))
-    elif config.task == "landmark":
-        from dnnevo.tasks import landmark
-
-        for which in (1, 2):
-            lr = landmark.record(config, net, which, seed=seed)
-            out.append((lr.outputs, lr.input.reshape(-1, 1)))
-    elif config.task == "nav1d":
-        from dnnevo.tasks import nav1d
-
-        chain = nav1d.fresh_chains(config, 1, max(2, nav1d.chain_len(config)), seed)[0]
-        nr = nav1d.record(config, net, chain)
-        out.append((nr.outputs, np.column_stack([nr.landmark, nr.reinforcement][: net.n_inputs])))
-    else:
+    task = tasks.find(config.task)
+    if task is None:
         raise InvalidArgumentError(f"task {config.task!r} has no recorded trials to analyse")
-    return out
+    return task.recorded_trials(config, net, seed=seed)
 
 
 def trial_outputs(config: EvolutionConfig, net: _core.Network, *, seed: int) -> tuple[_Array, _Array]:
@@ -566,11 +548,10 @@ def lesions(
 ) -> LesionTable:
     """Re-scores ``net`` with each neuron clamped at its mean output, and with each of its
     ``cuts`` strongest connections (by ``|w|``; default N, 0 for none) cut, on ``trials`` fresh
-    trials from ``seed`` (the trials :func:`dnnevo.evaluation.assessment.assess` draws, the same for every
+    trials from ``seed`` (the trials :func:`dnnevo.tasks.assess` draws, the same for every
     lesion). ``mean_outputs`` defaults to the mean over :func:`trial_outputs` of ``seed``."""
-    from dnnevo.evaluation import assessment as assess
 
-    base = assess.assess(config, net, trials, seed=seed)
+    base = tasks.assess(config, net, trials, seed=seed)
     if mean_outputs is None:
         mean = trial_outputs(config, net, seed=seed)[0].mean(axis=0)
     else:
@@ -581,7 +562,7 @@ def lesions(
     out: list[Lesion] = []
 
     def add(name: str, kind: str, neurons: tuple[int, ...], lesioned: _core.Network) -> None:
-        a = assess.assess(config, lesioned, trials, seed=seed)
+        a = tasks.assess(config, lesioned, trials, seed=seed)
         out.append(Lesion(name, kind, neurons, _score(a), score - _score(a), a.verdict))
 
     for i in range(net.size):

@@ -6,7 +6,7 @@ matplotlib is imported here only, so ``import dnnevo`` stays light.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -16,23 +16,38 @@ if TYPE_CHECKING:
 
     from dnnevo._core import Network
     from dnnevo.analysis import Attractors, Bifurcation, LesionTable
-    from dnnevo.tasks.landmark import Record as LandmarkRecord
-    from dnnevo.tasks.nav1d import Record as Nav1dRecord
-    from dnnevo.tasks.sequence import TrialRecord
 
-__all__ = ["plot_basins", "plot_bifurcation", "plot_fitness", "plot_fitness_seeds", "plot_landmark_world", "plot_lesions", "plot_nav1d_path",
-           "plot_nav1d_traces", "plot_phase_portrait", "plot_sequence_trial", "plot_traces"]
+__all__ = ["axes", "close", "plot_basins", "plot_bifurcation", "plot_fitness", "plot_fitness_seeds", "plot_lesions",
+           "plot_phase_portrait", "plot_traces", "pyplot", "subplots"]
 
 
-def _axes(ax: Axes | None) -> Axes:
-    if ax is not None:
-        return ax
+def pyplot() -> Any:
+    """matplotlib's pyplot, on the non-interactive Agg backend unless one was chosen. The one
+    place dnnevo imports it, and only when a figure is drawn: it takes about half a second, which
+    ``import dnnevo`` and every command that draws nothing should not pay."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    _, ax = plt.subplots(figsize=(7, 4), layout="constrained")
+    return plt
+
+
+def subplots(*args: Any, **kwargs: Any) -> Any:
+    """``pyplot.subplots(*args, **kwargs)``: a new figure and its Axes."""
+    return pyplot().subplots(*args, **kwargs)
+
+
+def close(fig: Any) -> None:
+    """Frees a figure that was saved."""
+    pyplot().close(fig)
+
+
+def axes(ax: Axes | None) -> Axes:
+    """``ax``, or the Axes of a new 7 x 4 in figure when None."""
+    if ax is not None:
+        return ax
+    _, ax = subplots(figsize=(7, 4), layout="constrained")
     return ax
 
 
@@ -40,7 +55,7 @@ def plot_fitness(
     history: Mapping[str, npt.ArrayLike], ax: Axes | None = None, *, title: str | None = None
 ) -> Axes:
     """Best and mean fitness over generations, with a ±1 std band around the mean."""
-    ax = _axes(ax)
+    ax = axes(ax)
     gen = np.asarray(history["generation"])
     best, mean, std = (np.asarray(history[k]) for k in ("best", "mean", "std"))
     ax.fill_between(gen, mean - std, mean + std, color="tab:blue", alpha=0.2, label="mean ± std")
@@ -60,7 +75,7 @@ def plot_fitness_seeds(
 ) -> Axes:
     """The best fitness over generations of several runs, one line per seed (solid), with each
     run's mean fitness (dotted, same colour)."""
-    ax = _axes(ax)
+    ax = axes(ax)
     for i, (seed, h) in enumerate(sorted(histories.items())):
         gen = np.asarray(h["generation"])
         colour = f"C{i % 10}"
@@ -72,81 +87,6 @@ def plot_fitness_seeds(
         ax.legend(loc="lower right", fontsize="small")
     if title:
         ax.set_title(title)
-    return ax
-
-
-def plot_sequence_trial(
-    record: TrialRecord,
-    ax: Axes | None = None,
-    *,
-    follow: TrialRecord | None = None,
-    title: str | None = None,
-) -> Axes:
-    """The paper's Fig. 4/5: trigger and reinforcement inputs and the output neuron over time,
-    with each trigger's expected bit. ``follow`` appends a second trial run without a reset."""
-    ax = _axes(ax)
-    records = [record] if follow is None else [record, follow]
-    trigger = np.concatenate([r.trigger for r in records])
-    reinforcement = np.concatenate([r.reinforcement for r in records])
-    output = np.concatenate([r.output for r in records])
-    t = np.arange(len(output))
-    ax.fill_between(t, 0, trigger, step="pre", color="0.85", label="trigger")
-    ax.plot(t, reinforcement, drawstyle="steps-pre", color="tab:green", label="reinforcement")
-    ax.plot(t, output, color="tab:red", label="output f(v0)")
-    ax.axhline(0.5, color="0.5", lw=0.6, ls=":")
-    starts = np.flatnonzero(np.diff(np.concatenate([[0.0], trigger])) > 0)
-    bits = np.concatenate([r.targets for r in records])
-    for s, bit in zip(starts, bits, strict=False):
-        ax.text(float(s) + 5, 1.05, str(bit), ha="center", fontsize=8)
-    if follow is not None:
-        ax.axvline(len(record.output), color="k", lw=0.8, ls="--")
-    ax.set_ylim(-0.05, 1.15)
-    ax.set_xlim(0, len(t))
-    ax.set_xlabel("time step")
-    ax.legend(loc="center right", fontsize=7)
-    if title:
-        ax.set_title(title, fontsize=10)
-    return ax
-
-
-def plot_nav1d_path(
-    record: Nav1dRecord,
-    ax: Axes | None = None,
-    *,
-    half_length: float = 20.0,
-    landmark_width: float = 4.0,
-    title: str | None = None,
-) -> Axes:
-    """The paper's Fig. 2: the agent's position over time in a chain of trials, with each
-    trial's landmark (shaded) and goal (a star at its end) marked, and trial boundaries dashed."""
-    ax = _axes(ax)
-    t = np.arange(1, len(record.x) + 1)
-    x = np.where(record.moving, record.x, np.nan)
-    ax.plot(t, x, color="tab:blue", lw=1.4, label="agent x(t)")
-    bounds = np.flatnonzero(np.diff(record.trial)) + 1
-    edges = np.concatenate([[0], bounds, [len(t)]])
-    for k, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-        if k >= len(record.conditions):
-            break
-        c = record.conditions[k]
-        ax.fill_between([a, b], c.landmark - landmark_width / 2, c.landmark + landmark_width / 2,
-                        color="tab:orange", alpha=0.3, lw=0, label="landmark" if k == 0 else None)
-        goal = half_length if c.goal == "right" else -half_length
-        reached = k < len(record.reached) and record.reached[k]
-        ax.plot([b if reached else a], [goal], marker="*", ms=11, ls="none",
-                color="tab:green" if reached else "tab:red",
-                label=("goal" if k == 0 else None))
-        if k:
-            ax.axvline(a, color="k", lw=0.6, ls="--")
-    ax.axhline(half_length, color="0.4", lw=0.8)
-    ax.axhline(-half_length, color="0.4", lw=0.8)
-    ax.set_ylim(-1.1 * half_length, 1.1 * half_length)
-    ax.set_xlim(0, len(t))
-    ax.set_xlabel("time step")
-    ax.set_ylabel("position x")
-    ax.legend(loc="lower right", fontsize=7)
-    if title:
-        ax.set_title(title, fontsize=10)
     return ax
 
 
@@ -162,7 +102,7 @@ def plot_traces(
     """Stacked traces in the style of the paper's Figs. 1 and 3: each input, then each neuron's
     firing rate (columns of the (T, N) ``outputs``), one band per trace, all on [0, 1]. The band of
     neuron ``highlight`` gets a 0.5 line."""
-    ax = _axes(ax)
+    ax = axes(ax)
     out = np.asarray(outputs, dtype=float)
     series = [(name, np.asarray(v, dtype=float), "tab:green") for name, v in inputs.items()]
     names = labels or [f"neuron {i}" for i in range(out.shape[1])]
@@ -180,53 +120,6 @@ def plot_traces(
     ax.set_yticks([p for p, _ in ticks], [n for _, n in ticks], fontsize=8)
     ax.set_xlim(0, len(t))
     ax.set_xlabel("time step")
-    if title:
-        ax.set_title(title, fontsize=10)
-    return ax
-
-
-def plot_nav1d_traces(
-    record: Nav1dRecord, ax: Axes | None = None, *, classifier: int = 2,
-    motors: tuple[int, int] = (0, 1), title: str | None = None,
-) -> Axes:
-    """The paper's Fig. 3: landmark and reinforcement inputs and every neuron's output over a
-    trial, with the classifier's 0.5 line."""
-    n = record.outputs.shape[1]
-    labels = [f"neuron {i}" for i in range(n)]
-    labels[motors[0]] = f"left motor ({motors[0]})"
-    labels[motors[1]] = f"right motor ({motors[1]})"
-    if classifier < n:
-        labels[classifier] = f"classifier ({classifier})"
-    return plot_traces({"landmark": record.landmark, "reinforcement": record.reinforcement},
-                       record.outputs, ax, labels=labels, highlight=classifier if classifier < n else None,
-                       title=title)
-
-
-def plot_landmark_world(
-    record: LandmarkRecord, ax: Axes | None = None, *, title: str | None = None
-) -> Axes:
-    """A top-down view of a landmark trial: the room's walls, the boxes, the robot's path (start
-    marked) and where the sonar's echoes landed."""
-    from matplotlib.patches import Rectangle
-
-    ax = _axes(ax)
-    w, h = record.world["room"]
-    ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2.5, color="0.2"))
-    for box in record.world["boxes"]:
-        (cx, cy), (sx, sy) = box["center"], box["size"]
-        ax.add_patch(Rectangle((cx - sx / 2, cy - sy / 2), sx, sy, angle=box.get("angle_deg", 0.0),
-                               rotation_point="center", color="tab:brown", alpha=0.8))
-    ax.plot(record.poses[:, 0], record.poses[:, 1], color="tab:blue", lw=1.2, label="robot path")
-    ax.plot(*record.poses[0, :2], marker="o", color="tab:blue", ls="none", label="start")
-    hit = ~np.isnan(record.echoes[:, 0])
-    ax.scatter(record.echoes[hit, 0], record.echoes[hit, 1], s=4, color="tab:red", alpha=0.5,
-               label="sonar echoes")
-    ax.set_xlim(-0.3, w + 0.3)
-    ax.set_ylim(-0.3, h + 0.3)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.legend(loc="upper right", fontsize=7)
     if title:
         ax.set_title(title, fontsize=10)
     return ax
@@ -256,7 +149,7 @@ def plot_phase_portrait(
 
     from dnnevo.analysis import vector_field
 
-    ax = _axes(ax)
+    ax = axes(ax)
     i, j = neurons
     theta = np.asarray(net.theta)
     if trajectory is not None:
@@ -312,7 +205,7 @@ def plot_bifurcation(
     highest rate over the orbit) as a band of its own colour, with its ends marked (a star where
     it starts or ends at a Hopf point, a cross where it is lost: a fold of cycles or a homoclinic
     orbit); and the folds (F) and Hopf points (H) marked by dotted lines."""
-    ax = _axes(ax)
+    ax = axes(ax)
     for s, color in STABILITY_COLORS.items():
         pts = [(v, e.outputs[neuron]) for v, row in zip(result.values, result.equilibria, strict=True)
                for e in row if e.stability == s]
@@ -357,7 +250,7 @@ def plot_bifurcation(
 def plot_lesions(table: LesionTable, ax: Axes | None = None, *, title: str | None = None) -> Axes:
     """One bar per lesion: how much the score drops (intact score minus lesioned score); red
     where the lesion changes the verdict."""
-    ax = _axes(ax)
+    ax = axes(ax)
     names = [x.name for x in table.lesions]
     drops = [x.drop for x in table.lesions]
     colors = ["tab:red" if x.verdict != table.verdict else "tab:blue" for x in table.lesions]
@@ -385,7 +278,7 @@ def plot_basins(
     would settle in if the input were switched off (white where none). ``boundaries`` are the
     steps where a new trial starts; ``levels`` are input values drawn as dotted lines (for example
     the folds of a sweep), labelled ``level_label``."""
-    ax = _axes(ax)
+    ax = axes(ax)
     b = np.asarray(basins)
     t = np.arange(len(b))
     edges = np.flatnonzero(np.diff(b)) + 1

@@ -21,13 +21,13 @@ import numpy as np
 from dnnevo import _startup, figures
 from dnnevo.cli import analyze as _cli_analyze
 from dnnevo.cli import evaluate as _cli_evaluate
-from dnnevo.cli import nav1d_parts as _cli_nav1d
+from dnnevo.cli import nav1d_system as _cli_nav1d_system
 from dnnevo.cli import reproduce as _cli_reproduce
 from dnnevo.cli import sweep as _cli_sweep
 from dnnevo.experiments import presets
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
-from dnnevo.evaluation.assessment import DEFAULT_TRIALS
+from dnnevo.tasks import DEFAULT_TRIALS
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.runs.rundir import RunDir, save_figure
 
@@ -201,7 +201,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="landmark runs: also write a GIF of a trial (slower)")
 
     _cli_analyze.add_parser(sub)
-    _cli_nav1d.add_system_parser(sub)
+    _cli_nav1d_system.add_parser(sub)
     _cli_reproduce.add_parser(sub, _parse_seeds, _positive)
     return parser
 
@@ -270,7 +270,7 @@ COMMANDS = {
     "evaluate": _cli_evaluate.evaluate,
     "plot": _cmd_plot,
     "analyze": _cli_analyze.analyze,
-    "nav1d-system": _cli_nav1d.system,
+    "nav1d-system": _cli_nav1d_system.system,
     "reproduce": _cli_reproduce.reproduce,
 }
 

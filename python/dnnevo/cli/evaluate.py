@@ -1,5 +1,5 @@
 """The ``dnnevo evaluate`` command: a run's champion judged on fresh conditions by
-:func:`dnnevo.evaluation.assessment.assess`, printed as text (default) or JSON (``--json``). The exit status is
+:func:`dnnevo.tasks.assess`, printed as text (default) or JSON (``--json``). The exit status is
 the verdict: 0 pass, 1 fail, 3 undecided (2 is an error)."""
 
 from __future__ import annotations
@@ -8,15 +8,13 @@ import argparse
 import dataclasses
 import json
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from dnnevo.cli import landmark_parts as _cli_landmark
-from dnnevo.cli import nav1d_parts as _cli_nav1d
-from dnnevo.cli import sequence_parts as _cli_sequence
-from dnnevo.evaluation import assessment as assess
+from dnnevo import tasks
 from dnnevo.evaluation.assessment import Assessment, Rate
+from dnnevo.evaluation.stats import Verdict
 from dnnevo.errors import ConfigError
 from dnnevo.runs.rundir import RunDir
 from dnnevo.evaluation.stepcheck import StepCheck, step_check, with_dt
@@ -40,6 +38,9 @@ Euler runs), and calls it a step artefact when a rate that does not fail at the 
 at either; an artefact's exit status is 1, whatever the run's step says.
 Exit status: 0 pass, 1 fail, 3 undecided, 2 error."""
 
+EXIT_STATUS: dict[Verdict, int] = {"pass": 0, "fail": 1, "undecided": 3}
+"""``dnnevo evaluate``'s exit status per verdict (2 is a usage or input error, 130 Ctrl-C)."""
+
 
 def evaluate(args: argparse.Namespace) -> int:
     """``dnnevo evaluate``."""
@@ -51,45 +52,36 @@ def evaluate(args: argparse.Namespace) -> int:
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
     if args.dt is not None:
         config = with_dt(config, args.dt, "--dt")
-    a = assess.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
-    extra = _cli_sequence.switch_test(config, champion, seed) if a.task == "sequence" else {}
+    task = tasks.get(config.task)
+    a = tasks.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
+    extra = task.evaluate_extra(config, champion, seed)
     if args.dt is not None:
         extra = {"integrator": dataclasses.asdict(config.integrator), **extra}
     check = None
     if args.dt_check:
-        check = step_check(config, champion, seed=seed, robot_like=args.robot_like, base=a)
+        check = step_check(lambda c: tasks.assess(c, champion, a.trials, seed=seed, robot_like=args.robot_like),
+                           config, base=a)
         extra = {**extra, "step_check": check.to_dict()}
     if args.json:
         print(json.dumps({"run": str(args.dir), **a.to_dict(), **extra}, indent=1))
     else:
         print("\n".join(text(args.dir, a, extra) + (step_lines(check) if check else [])))
     if check is not None and check.artefact:
-        return assess.EXIT_STATUS["fail"]
-    return assess.EXIT_STATUS[a.verdict]
-
-
-PREFACES: dict[str, Callable[[Path, Assessment], list[str]]] = {
-    "sequence": _cli_sequence.preface,
-    "landmark": _cli_landmark.preface,
-    "nav1d": _cli_nav1d.preface,
-}
-"""Each task's first lines: what was run, and the task's own table."""
+        return EXIT_STATUS["fail"]
+    return EXIT_STATUS[a.verdict]
 
 
 def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:
     """The human report of ``a`` on the run in ``where``."""
-    column = None
-    if a.task == "sequence":
-        column = ("mean P", {f"{t}*": f"{p:.3f}" for t, p in a.details["mean_performance"].items()})
-    lines = [*PREFACES[a.task](where, a), *rate_table(a.rates, column), overall(a)]
+    task = tasks.get(a.task)
+    lines = [*task.preface(where, a), *rate_table(a.rates, task.rate_column(a)), task.overall(a)]
     lines += [hint(r, a.unit) for r in a.judged if r.verdict == "undecided"]
     lines.append(f"intervals: {a.method}")
     if "integrator" in extra:
         i = extra["integrator"]
         lines.append(f"integrated with dt = {i['dt']:g}, {i['substeps']} steps per time step "
                      "(--dt); the run was evolved with its config's step")
-    if "switch_test" in extra:
-        lines += _cli_sequence.switch_lines(extra["switch_test"])
+    lines += task.extra_lines(extra)
     return lines
 
 
@@ -139,19 +131,6 @@ def rate_table(rates: Sequence[Rate], column: tuple[str, dict[str, str]] | None 
                 f"{needs:>7}  {r.verdict or '-':<9}")
         lines.append(line + (f"  {column[1].get(r.name, ''):>8}" if column else "").rstrip())
     return [line.rstrip() for line in lines]
-
-
-def overall(a: Assessment) -> str:
-    """The verdict line."""
-    if a.task == "sequence":
-        failing = [r.name for r in a.judged if r.verdict == "fail"]
-        open_ = [r.name for r in a.judged if r.verdict == "undecided"]
-        why = {"pass": "every target passes",
-               "fail": f"{', '.join(failing)} {'fails' if len(failing) == 1 else 'fail'}; every target must pass",
-               "undecided": f"no target fails, but {', '.join(open_)} {'is' if len(open_) == 1 else 'are'} undecided"}
-        return f"overall: {a.verdict} ({why[a.verdict]})"
-    r = a.judged[0]
-    return f"overall: {r.rate:.1%} right; success needs >= {r.threshold:.0%}: {a.verdict}"
 
 
 def hint(r: Rate, unit: str) -> str:

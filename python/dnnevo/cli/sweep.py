@@ -16,8 +16,8 @@ from dnnevo.experiments import presets
 from dnnevo.experiments import scheduler
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
-from dnnevo.tasks._checks import nonnegative
-from dnnevo.evaluation.assessment import DEFAULT_TRIALS, UNITS
+from dnnevo._checks import nonnegative
+from dnnevo.tasks import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.runs.rundir import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic

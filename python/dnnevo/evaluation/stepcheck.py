@@ -25,14 +25,15 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from collections.abc import Callable
 from typing import Any
 
 from dnnevo import _core
-from dnnevo.evaluation.assessment import Assessment, assess
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
+from dnnevo.evaluation.assessment import Assessment
 
-__all__ = ["FINER", "StepCheck", "step_check", "with_dt"]
+__all__ = ["FINER", "Judge", "StepCheck", "finer_configs", "step_check", "with_dt"]
 
 FINER: int = _core.STEP_CHECK_FINER
 """How many times shorter the check's Euler step is than the run's (the Rust core's
@@ -119,17 +120,18 @@ class StepCheck:
         return check
 
 
-def step_check(
-    config: EvolutionConfig, net: _core.Network, trials: int | None = None, *, seed: int,
-    robot_like: bool = False, base: Assessment | None = None,
-) -> StepCheck:
-    """Judges ``net`` as :func:`~dnnevo.evaluation.assessment.assess` does at the run's step (or takes ``base``,
-    that assessment, already made) and at each of :func:`finer_configs`, on the same conditions."""
+Judge = Callable[[EvolutionConfig], Assessment]
+"""How a champion is judged under a config: the same network, trials and seed every call (for
+example ``lambda c: dnnevo.tasks.assess(c, net, trials, seed=seed)``)."""
+
+
+def step_check(judge: Judge, config: EvolutionConfig, *, base: Assessment | None = None) -> StepCheck:
+    """Judges a champion with ``judge`` at the run's step (or takes ``base``, that assessment,
+    already made) and at each of :func:`finer_configs`, on the same conditions."""
     if base is None:
-        base = assess(config, net, trials, seed=seed, robot_like=robot_like)
-    trials = base.trials
+        base = judge(config)
     finer = finer_configs(config)
-    checks = {name: assess(c, net, trials, seed=seed, robot_like=robot_like) for name, c in finer.items()}
+    checks = {name: judge(c) for name, c in finer.items()}
     integrators = {"run": dataclasses.asdict(config.integrator),
                    **{name: dataclasses.asdict(c.integrator) for name, c in finer.items()}}
     return StepCheck(base=base, checks=checks, integrators=integrators)

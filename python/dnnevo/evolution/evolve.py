@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo.tasks._checks import nonnegative
+from dnnevo._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError
 from dnnevo.evolution.ga import GeneticAlgorithm

@@ -23,12 +23,13 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from dnnevo import tasks
 from dnnevo.tasks import nav1d
 from dnnevo.experiments import plan
 from dnnevo.experiments import presets
 from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
-from dnnevo.evaluation.assessment import DEFAULT_TRIALS, Assessment, assess
+from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError
 from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short, write_atomic
@@ -57,7 +58,7 @@ class Settings:
     """Each preset's quick variant (small population, few generations)."""
     eval_trials: int | None = None
     """Fresh trials judging each final champion, in the task's unit (default: the task's
-    :data:`~dnnevo.evaluation.assessment.DEFAULT_TRIALS`); also the robot-like test's trials per landmark."""
+    :data:`~dnnevo.tasks.DEFAULT_TRIALS`); also the robot-like test's trials per landmark."""
     eval_seed: int = sweep.EVAL_SEED_BASE
     """Seed s's final champion is judged on fresh conditions from ``eval_seed + s``."""
     dt_check: bool = True
@@ -87,7 +88,7 @@ class Settings:
 
     def trials(self, task: str) -> int:
         """The fresh trials judging a champion of ``task``."""
-        return self.eval_trials if self.eval_trials is not None else DEFAULT_TRIALS[task]
+        return self.eval_trials if self.eval_trials is not None else tasks.DEFAULT_TRIALS[task]
 
     def to_dict(self) -> dict[str, Any]:
         """The settings and every evolution's config, as plain JSON types."""
@@ -235,7 +236,7 @@ def _robot_like(job: plan.Job, root: Path, settings: Settings, threads: int | No
                 progress: bool) -> dict[str, Any]:
     run = RunDir(_folder(root, job.spec.needs[0], job.seed))
     config, table = run.read_config()
-    a = assess(config, run.read_best(config, table), settings.trials(config.task),
+    a = tasks.assess(config, run.read_best(config, table), settings.trials(config.task),
                seed=ROBOT_SEED_BASE + job.seed, robot_like=True)
     return {"assessment": a.to_dict()}
 

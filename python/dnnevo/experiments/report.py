@@ -155,7 +155,6 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
 
     from dnnevo import figures
     from dnnevo.tasks import nav1d
-    from dnnevo.cli.nav1d_parts import draw_system
     from dnnevo.plot import plot_fitness_seeds
     from dnnevo.runs.rundir import RunDir
 
@@ -183,7 +182,7 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
         first = done[0]
         parts = [nav1d.load_part(root / plan.job_id(n, first.seed)) for n in e.needs]
         (root / first.id).mkdir(parents=True, exist_ok=True)
-        draw_system(parts, SYSTEM_TRIALS, root / first.id / "fig2-system.png")
+        nav1d.draw_system(parts, SYSTEM_TRIALS, root / first.id / "fig2-system.png")
         blocks.append(Block("img", f"{e.name}, seed {first.seed}: Fig. 2 of the integrated system",
                             path=f"{first.id}/fig2-system.png"))
     return blocks

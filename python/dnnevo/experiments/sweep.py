@@ -8,7 +8,7 @@ their uncertainty:
   censored at its run's last generation and counts as +infinity, so the median is "not
   reached" when more than half the seeds are censored;
 - **final champions passing**: each seed's final champion (``best.json``) judged by
-  :func:`dnnevo.evaluation.assessment.assess` on fresh conditions from seed :data:`EVAL_SEED_BASE` + the run's
+  :func:`dnnevo.tasks.assess` on fresh conditions from seed :data:`EVAL_SEED_BASE` + the run's
   seed, which no run uses; the fraction that pass, with its Wilson interval;
 - **step artefacts**: final champions that the time-step check (:mod:`dnnevo.evaluation.stepcheck`: the same
   conditions at a 10x finer step and with RK4) finds failing where the run's step did not.
@@ -31,8 +31,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from dnnevo import tasks
 from dnnevo.evaluation import stats
-from dnnevo.evaluation.assessment import Assessment, assess
+from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short, write_atomic
@@ -125,7 +126,7 @@ def run_seed(
 ) -> SeedResult:
     """Runs ``config`` with ``seed`` into ``out``, then judges the final champion (``out /
     best.json``) on fresh conditions from :func:`eval_seed` with ``eval_trials`` (default: the
-    task's :data:`~dnnevo.evaluation.assessment.DEFAULT_TRIALS`), and, with ``dt_check``, checks it at finer
+    task's :data:`~dnnevo.tasks.DEFAULT_TRIALS`), and, with ``dt_check``, checks it at finer
     steps on the same conditions (:func:`~dnnevo.evaluation.stepcheck.step_check`). With ``seeding`` the
     first population starts from earlier runs' networks (:mod:`dnnevo.evolution.seeding`). With ``resume``
     the run in ``out`` (same config and seed, else a :class:`RunFileError`) is continued from its
@@ -160,8 +161,9 @@ def run_seed(
         wall = time.perf_counter() - t0
     champion = RunDir(out).read_best(config, {"seed": seed})
     fresh = eval_seed(seed, eval_seed_base)
-    final = assess(config, champion, eval_trials, seed=fresh)
-    step = step_check(config, champion, seed=fresh, base=final) if dt_check else None
+    final = tasks.assess(config, champion, eval_trials, seed=fresh)
+    step = (step_check(lambda c: tasks.assess(c, champion, final.trials, seed=fresh), config, base=final)
+            if dt_check else None)
     generations = result.history["generation"]
     return SeedResult(
         seed=seed, best_fitness=float(result.best_fitness), best_generation=int(result.best_generation),

@@ -1,2 +1,11 @@
-"""The tasks, one module each, as the paper names them: sequence learning (:mod:`.sequence`),
-one-dimensional navigation (:mod:`.nav1d`) and landmark recognition (:mod:`.landmark`)."""
+"""The tasks, one module each and each its only Python home: sequence learning
+(:mod:`.sequence`), one-dimensional navigation (:mod:`.nav1d`) and landmark recognition
+(:mod:`.landmark`). Every module implements :class:`~dnnevo.tasks.protocol.Task`;
+:mod:`.registry` finds one by name and judges a network by its rule."""
+
+from dnnevo.tasks import landmark, nav1d, sequence
+from dnnevo.tasks.protocol import Task
+from dnnevo.tasks.registry import DEFAULT_TRIALS, THRESHOLDS, UNITS, assess, find, get, names
+
+__all__ = ["DEFAULT_TRIALS", "THRESHOLDS", "UNITS", "Task", "assess", "find", "get", "landmark",
+           "nav1d", "names", "sequence"]

@@ -24,33 +24,74 @@ reached, or the environment classified right: ``f(v_C) >= 0.5`` means landmark-n
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo import _core
-from dnnevo.tasks._checks import bounded_count, nonnegative, task_params
+from dnnevo import _core, plot
+from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
+from dnnevo.evaluation import assessment
+from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, Rate, combine
+from dnnevo.runs.rundir import RunDir, save_figure
+
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = [
+    "DEFAULT_TRIALS",
+    "NAME",
+    "ROBOT_LIKE",
+    "THRESHOLD",
+    "UNIT",
     "Condition",
     "Part",
     "Record",
     "assess",
     "cases",
     "chains",
+    "draw",
+    "draw_system",
+    "evaluate_extra",
+    "extra_lines",
     "fresh_chains",
+    "goal_rate_table",
     "goal_rates",
+    "judge",
     "load_part",
+    "overall",
+    "preface",
+    "rate_column",
     "record",
+    "recorded_trials",
+    "scored_trials",
     "system_assess",
     "system_record",
 ]
+
+NAME = "nav1d"
+"""The task's name in a config."""
+
+THRESHOLD = 0.95
+"""The fraction of scored trials that must be right (``SUCCESS_RATE`` in
+``crates/tasks/src/nav1d/task.rs``)."""
+
+DEFAULT_TRIALS = 1000
+"""``dnnevo evaluate``'s default: chains of trials (the slowest objective's take 0.2 s on one
+core)."""
+
+UNIT = "chains"
+"""What a trial count counts."""
+
+ROBOT_LIKE = False
+"""One-dimensional navigation has no robot-like test."""
 
 CASES = (("far", "left"), ("far", "right"), ("near", "left"), ("near", "right"))
 """The paper's Fig. 2 environments A, B, C and D, in that order."""
@@ -191,8 +232,6 @@ def _by_environment(episodes: Sequence[dict[str, Any]],
 def load_part(run_dir: str | Path, role: str | None = None) -> Part:
     """The config and champion of a ``nav1d`` run folder; ``role`` (e.g. ``"--far"``) names the
     folder in errors."""
-    from dnnevo.runs.rundir import RunDir
-
     where = f"{role} {run_dir}" if role else str(run_dir)
     run = RunDir(Path(run_dir))
     config, table = run.read_config()
@@ -230,3 +269,262 @@ def system_record(
     c, f, n = _parts(classifier, far, near)
     d = json.loads(_core.nav1d_system_record(c, f, n, _to_json(conditions), persist_state))
     return _record(d["first"]), _record(d["rest"]), d["chosen"]
+
+
+def scored_trials(objective: str, episode: dict[str, Any]) -> list[bool]:
+    """Whether each scored trial of a nav1d chain was done right, as the task judges it: the
+    goal reached (``goal``; trials 2.. with ``single``) or the environment classified right
+    (``classify``: ``f(v_C) >= 0.5`` exactly in landmark-near environments)."""
+    out = []
+    for t, (condition, reached, f) in enumerate(
+        zip(episode["conditions"], episode["reached"], episode["classification"], strict=True)
+    ):
+        if objective == "single" and t == 0:
+            continue
+        if objective == "classify":
+            f = math.nan if f is None else f
+            out.append(f >= 0.5 if condition["environment"] == "near" else f < 0.5)
+        else:
+            out.append(bool(reached))
+    return out
+
+
+
+
+def judge(config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *,
+          robot_like: bool = False) -> Assessment:
+    """``net`` judged on ``trials`` fresh chains drawn from ``seed``: the rate of scored trials
+    done right, against :data:`THRESHOLD`. Trials within one chain share the network's state, so
+    with several scored trials per chain the interval counts each chain as one observation (the
+    worst case; never too narrow)."""
+    report = assess(config, net, trials, seed)
+    objective = report["objective"]
+    scored = [(e["environment"], scored_trials(objective, e)) for e in report["episodes"]]
+    per_chain = max(len(s) for _, s in scored)
+    if any(len(s) != per_chain for _, s in scored) or per_chain == 0:
+        raise ConfigError(f"the nav1d chains score {sorted({len(s) for _, s in scored})} trials each; "
+                          "judging needs the same number >= 1 in every chain")
+    clustered = per_chain > 1
+
+    def chain_rate(name: str, chains: list[list[bool]], threshold: float | None = None) -> Rate:
+        k, n = sum(map(sum, chains)), per_chain * len(chains)
+        return assessment.rate(name, k, n, threshold=threshold, effective_n=len(chains) if clustered else n)
+
+    rates = [chain_rate(env, [s for e, s in scored if e == env]) for env in ("far", "near")
+             if any(e == env for e, _ in scored)]
+    overall_rate = chain_rate("overall", [s for _, s in scored], THRESHOLD)
+    if abs(overall_rate.rate - report["rate"]) > 1e-12:
+        raise RuntimeError(f"nav1d: the scored trials give {overall_rate.rate} but the task's rate is "
+                          f"{report['rate']}; dnnevo.evaluation.assessment and the task disagree on what is scored")
+    method = (f"Wilson score interval, 95%, clustered by chain: the {per_chain} scored trials of a "
+              "chain share the network's state, so each chain counts as one observation (the "
+              "worst case; never too narrow)" if clustered
+              else INDEPENDENT + " (one scored trial per chain, each from a reset state)")
+    return Assessment(
+        task="nav1d", trials=trials, unit=UNIT, seed=seed, rates=[*rates, overall_rate],
+        verdict=combine([r.verdict for r in [overall_rate] if r.verdict is not None]), method=method,
+        details={"objective": objective, "scored_per_chain": per_chain,
+                 "classify_weight": float(config.task_json().get("classify_weight", 0.0))}, report=report,
+    )
+
+
+def goal_rate_table(episodes: Sequence[dict[str, Any]], first_scored: int) -> list[str]:
+    """Goal rate by environment type and trial index, one line per environment type."""
+    return _by_trial(goal_rates(episodes), episodes, first_scored)
+
+
+def _by_trial(rates: dict[str, Any], episodes: Sequence[dict[str, Any]], first_scored: int) -> list[str]:
+    """A table of ``rates`` by environment type and trial index, one line per environment type."""
+    k = len(rates["all"])
+    lines = [f"{'environment':>12} {'chains':>6}  " + " ".join(f"{'trial ' + str(t + 1):>8}" for t in range(k))]
+    for env in ("far", "near", "all"):
+        count = sum(1 for e in episodes if env in ("all", e["environment"]))
+        if count:
+            cells = " ".join(f"{r:>8.1%}" for r in rates[env])
+            lines.append(f"{env:>12} {count:>6}  {cells}")
+    if first_scored:
+        lines.append(f"(trial 1 is for learning; trials {first_scored + 1}.. are scored)")
+    return lines
+
+
+def preface(where: Path, a: Assessment) -> list[str]:
+    """What ``evaluate`` ran on a ``nav1d`` run, and the rates by case (``classify``) or by
+    environment type and trial index."""
+    objective = a.details["objective"]
+    episodes = a.report["episodes"]
+    lines = [f"{where}: champion ({objective}) on {a.trials} fresh chains (seed {a.seed})."]
+    if objective == "classify":
+        lines.append("A trial is right when f(v_C) >= 0.5 exactly in landmark-near environments.")
+        lines.append(f"{'environment':>12} {'goal':>6} {'trials':>6} {'right':>7} {'mean f(v_C)':>12}")
+        for env, goal in CASES:
+            picked = [e for e in episodes if e["environment"] == env
+                      and e["conditions"][0]["goal"] == goal]
+            if picked:
+                f = np.array([np.nan if e["classification"][0] is None else e["classification"][0]
+                              for e in picked])
+                right = (f >= 0.5) if env == "near" else (f < 0.5)
+                lines.append(f"{env:>12} {goal:>6} {len(picked):>6} {right.mean():>7.1%} {f.mean():>12.3f}")
+    else:
+        lines += goal_rate_table(episodes, 1 if objective == "single" else 0)
+    if objective == "single" and a.details.get("classify_weight", 0.0) > 0:
+        lines.append("The classifier (shaped by classify_weight): trials after which it names the "
+                     "environment right (f(v_C) >= 0.5 exactly in landmark-near chains).")
+        lines += _by_trial(classifier_rates(episodes), episodes, 0)
+    return lines
+
+
+def draw(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = False) -> list[str]:
+    """``dnnevo plot`` for a ``nav1d`` run: Fig. 2 (x(t) in the four cases) and, for a network with
+    a classifier, Fig. 3 (its traces in a landmark-near and a landmark-far trial)."""
+
+    champion = run.read_best(config, run.read_config()[1])
+    params = config.task_json()
+    k = params.get("trials_per_environment", 5) if params.get("objective") == "single" else 1
+    records = [record(config, champion, [c] * k) for c in cases(config)]
+    _fig2(records, params, f"{run.path.name}: the champion in environments A-D", run.path / "fig2-paths.png")
+    written = ["fig2-paths.png"]
+    if params.get("objective") in ("classify", "single"):
+        classifier = int(params.get("classifier", 2))
+        motors = (int(params.get("left_motor", 0)), int(params.get("right_motor", 1)))
+        fig, axes = plot.subplots(1, 2, figsize=(12, 4.5), layout="constrained")
+        for ax, (env, goal) in zip(axes, [("near", "left"), ("far", "right")], strict=True):
+            cond = next(c for c in cases(config) if (c.environment, c.goal) == (env, goal))
+            rec = record(config, champion, [cond])
+            plot_trial_traces(rec, ax, classifier=classifier, motors=motors, title=(
+                f"landmark-{env}, goal {goal}: "
+                f"{'reached' if rec.reached[0] else 'missed'}, f(v_C) = {rec.classification[0]:.2f}"))
+        save_figure(fig, run.path / "fig3-classifier.png")
+        plot.close(fig)
+        written.append("fig3-classifier.png")
+    return written
+
+
+def _fig2(records: Sequence[Record], params: dict[str, Any], title: str, path: Path) -> None:
+
+    fig, axes = plot.subplots(2, 2, figsize=(11, 6.5), layout="constrained", sharey=True)
+    for ax, rec, letter in zip(axes.T.flat, records, "ABCD", strict=True):
+        c = rec.conditions[0]
+        plot_path(rec, ax, half_length=float(params.get("half_length", 20.0)),
+                        landmark_width=float(params.get("landmark_width", 4.0)),
+                        title=f"{letter}: landmark-{c.environment}, goal {c.goal}")
+    fig.suptitle(title)
+    save_figure(fig, path)
+    plot.close(fig)
+
+
+def draw_system(parts: Sequence[Part], trials: int, path: Path, *, persist_state: bool = True) -> None:
+    """Fig. 2 of the integrated system of ``parts`` (classifier, far, near): one environment per
+    case, ``trials`` trials each, the goal on the same side, written to ``path``."""
+    records = []
+    for c in cases(parts[0].config):
+        first, rest, _ = system_record(parts[0], parts[1], parts[2], [c] * trials,
+                                             persist_state=persist_state)
+        records.append(_join(first, rest))
+    _fig2(records, parts[0].config.task_json(), "integrated system, one environment per case "
+          f"({trials} trials, goal on the same side)", path)
+
+
+def _join(first: Record, rest: Record) -> Record:
+    """The classifier's trial followed by the picked network's, as one record for plotting
+    (outputs are left out: the two networks' neurons differ)."""
+    return Record(
+        conditions=first.conditions + rest.conditions,
+        x=np.concatenate([first.x, rest.x]),
+        landmark=np.concatenate([first.landmark, rest.landmark]),
+        reinforcement=np.concatenate([first.reinforcement, rest.reinforcement]),
+        outputs=np.zeros((len(first.x) + len(rest.x), 0)),
+        trial=np.concatenate([first.trial, rest.trial + 1]),
+        moving=np.concatenate([first.moving, rest.moving]),
+        reached=first.reached + rest.reached,
+        classification=first.classification + rest.classification,
+        final_state=rest.final_state,
+    )
+
+
+def rate_column(a: Assessment) -> tuple[str, dict[str, str]] | None:
+    """No extra column."""
+    return None
+
+
+def overall(a: Assessment) -> str:
+    """The verdict line of the overall rate."""
+    return assessment.verdict_line(a)
+
+
+def evaluate_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
+    """No further test."""
+    return {}
+
+
+def extra_lines(extra: dict[str, Any]) -> list[str]:
+    """No further test."""
+    return []
+
+
+def recorded_trials(config: EvolutionConfig, net: _core.Network, *,
+                    seed: int) -> list[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
+    """One fresh chain drawn from ``seed`` of the task's chain length (:func:`chain_len`: 5
+    trials for nav1d-single, whose network learns its environment in trial 1), at least 2, as
+    (firing rates (T, N), inputs (T, M): landmark and reinforcement), for the dynamical
+    analysis."""
+    chain = fresh_chains(config, 1, max(2, chain_len(config)), seed)[0]
+    r = record(config, net, chain)
+    return [(r.outputs, np.column_stack([r.landmark, r.reinforcement][: net.n_inputs]))]
+
+
+def plot_path(
+    record: Record,
+    ax: Axes | None = None,
+    *,
+    half_length: float = 20.0,
+    landmark_width: float = 4.0,
+    title: str | None = None,
+) -> Axes:
+    """The paper's Fig. 2: the agent's position over time in a chain of trials, with each
+    trial's landmark (shaded) and goal (a star at its end) marked, and trial boundaries dashed."""
+    ax = plot.axes(ax)
+    t = np.arange(1, len(record.x) + 1)
+    x = np.where(record.moving, record.x, np.nan)
+    ax.plot(t, x, color="tab:blue", lw=1.4, label="agent x(t)")
+    bounds = np.flatnonzero(np.diff(record.trial)) + 1
+    edges = np.concatenate([[0], bounds, [len(t)]])
+    for k, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+        if k >= len(record.conditions):
+            break
+        c = record.conditions[k]
+        ax.fill_between([a, b], c.landmark - landmark_width / 2, c.landmark + landmark_width / 2,
+                        color="tab:orange", alpha=0.3, lw=0, label="landmark" if k == 0 else None)
+        goal = half_length if c.goal == "right" else -half_length
+        reached = k < len(record.reached) and record.reached[k]
+        ax.plot([b if reached else a], [goal], marker="*", ms=11, ls="none",
+                color="tab:green" if reached else "tab:red",
+                label=("goal" if k == 0 else None))
+        if k:
+            ax.axvline(a, color="k", lw=0.6, ls="--")
+    ax.axhline(half_length, color="0.4", lw=0.8)
+    ax.axhline(-half_length, color="0.4", lw=0.8)
+    ax.set_ylim(-1.1 * half_length, 1.1 * half_length)
+    ax.set_xlim(0, len(t))
+    ax.set_xlabel("time step")
+    ax.set_ylabel("position x")
+    ax.legend(loc="lower right", fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return ax
+
+
+def plot_trial_traces(
+    record: Record, ax: Axes | None = None, *, classifier: int = 2,
+    motors: tuple[int, int] = (0, 1), title: str | None = None,
+) -> Axes:
+    """The paper's Fig. 3: landmark and reinforcement inputs and every neuron's output over a
+    trial, with the classifier's 0.5 line."""
+    n = record.outputs.shape[1]
+    labels = [f"neuron {i}" for i in range(n)]
+    labels[motors[0]] = f"left motor ({motors[0]})"
+    labels[motors[1]] = f"right motor ({motors[1]})"
+    if classifier < n:
+        labels[classifier] = f"classifier ({classifier})"
+    return plot.plot_traces({"landmark": record.landmark, "reinforcement": record.reinforcement},
+                       record.outputs, ax, labels=labels, highlight=classifier if classifier < n else None,
+                       title=title)

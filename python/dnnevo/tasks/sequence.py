@@ -11,17 +11,43 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo import _core
-from dnnevo.tasks._checks import bounded_count, nonnegative, task_params
+from dnnevo import _core, plot
+from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
+from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, combine, rate
+from dnnevo.runs.rundir import RunDir, save_figure
 
-__all__ = ["SWITCH_AFTER", "SWITCH_HOLD", "Switch", "TrialRecord", "assess", "fresh_timings", "run_trial", "switch_table", "switch_trial",
-           "target_list", "timings", "trial_order"]
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+__all__ = ["DEFAULT_TRIALS", "NAME", "ROBOT_LIKE", "SWITCH_AFTER", "SWITCH_HOLD", "SWITCH_TRIALS",
+           "THRESHOLD", "UNIT", "Switch", "TrialRecord", "assess", "draw", "evaluate_extra",
+           "extra_lines", "fig5_pair", "fresh_timings", "judge", "overall", "preface",
+           "rate_column", "recorded_trials", "run_trial", "switch_lines", "switch_table", "switch_test",
+           "switch_trial", "target_list", "timings", "trial_order"]
+
+NAME = "sequence"
+"""The task's name in a config."""
+
+THRESHOLD = 0.9
+"""The fraction of fresh trials per target that must be right (``SUCCESS_FRACTION`` in
+``crates/tasks/src/sequence/scoring.rs``)."""
+
+DEFAULT_TRIALS = 1000
+"""``dnnevo evaluate``'s default: trials per target (4000 trials of the 2-bit task take under
+half a second on one core)."""
+
+UNIT = "trials per target"
+"""What a trial count counts."""
+
+ROBOT_LIKE = False
+"""Sequence learning has no robot-like test."""
 
 
 @dataclass(frozen=True)
@@ -187,3 +213,182 @@ def _rotate(pattern: str, shift: int) -> str:
     """``pattern`` continued from trigger ``shift``, so a switch keeps the sequence's phase."""
     s = shift % len(pattern)
     return pattern[s:] + pattern[:s]
+
+
+def judge(config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *,
+          robot_like: bool = False) -> Assessment:
+    """``net`` judged on ``trials`` fresh trials per target drawn from ``seed``: one rate per
+    target, each judged against :data:`THRESHOLD`; the run passes when every target passes."""
+    report = assess(config, net, trials, seed)
+    threshold = THRESHOLD
+    rates = [rate(f"{t['target']}*", round(t["success_fraction"] * trials), trials, threshold=threshold)
+             for t in report["targets"]]
+    return Assessment(
+        task="sequence", trials=trials, unit=UNIT, seed=seed, rates=rates,
+        verdict=combine([r.verdict for r in rates if r.verdict is not None]), method=INDEPENDENT,
+        details={"mean_performance": {t["target"]: t["mean_performance"] for t in report["targets"]}},
+        report=report,
+    )
+
+
+SWITCH_TRIALS = 20
+"""Fresh trials per ordered pair of targets in ``evaluate``'s switch test."""
+
+
+def preface(where: Path, a: Assessment) -> list[str]:
+    """What ``evaluate`` ran, and the rule it judges by."""
+    return [
+        f"{where}: champion on {a.trials} fresh {a.unit} (seed {a.seed}).",
+        "A trial is correct when every trigger from index 2 x len(target) on is. A target passes "
+        "when the 95% interval of its rate of correct trials lies at or above 90%, and fails when "
+        "it lies below.",
+    ]
+
+
+def switch_test(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
+    """The paper's Fig. 5 test for every ordered pair of targets, on :data:`SWITCH_TRIALS` fresh
+    trials of ``seed`` each: the first target for ``SWITCH_AFTER`` triggers, then the
+    second without a reset. ``{"switch_test": {...}}``, or ``{}`` with one target."""
+    if len(target_list(config)) < 2:
+        return {}
+    table = switch_table(config, champion, SWITCH_TRIALS, seed)
+    return {"switch_test": {"switch_after": SWITCH_AFTER, "trials": SWITCH_TRIALS, "pairs": [
+        {"first": s.first, "second": s.second, "settled": s.settled,
+         "median_triggers": s.median_triggers, "settled_after": list(s.settled_after)}
+        for s in table]}}
+
+
+def switch_lines(test: dict[str, Any]) -> list[str]:
+    """The switch test as a table: for each pair, the trials that settled on the second target,
+    and the median triggers after the switch they needed."""
+    pairs = test["pairs"]
+    names = list(dict.fromkeys(p["first"] for p in pairs))
+    cell = {(p["first"], p["second"]): p for p in pairs}
+
+    def text(p: dict[str, Any]) -> str:
+        median = "-" if p["median_triggers"] is None else f"{p['median_triggers']:g}"
+        return f"{p['settled']}/{test['trials']} ({median})"
+
+    corner = "from \\ to"
+    width = 2 + max(len(corner), *(len(text(p)) for p in pairs), *(len(n) + 1 for n in names))
+    lines = [f"switch test: {test['switch_after']} triggers of one target, then another without a "
+             f"reset; trials that settled on the new target, right from then on for at least "
+             f"{SWITCH_HOLD} triggers (median triggers needed), {test['trials']} fresh "
+             "trials each",
+             f"{corner:>{width}}" + "".join(f"{n + '*':>{width}}" for n in names)]
+    for a in names:
+        lines.append(f"{a + '*':>{width}}" + "".join(
+            f"{'-' if a == b else text(cell[(a, b)]):>{width}}" for b in names))
+    return lines
+
+
+def fig5_pair(targets: list[str]) -> tuple[str, str]:
+    """The two targets of Fig. 5: the paper's (01)* then 0* when the task has both, otherwise the
+    last target then the first.
+
+    >>> fig5_pair(["0", "1", "01", "10"])
+    ('01', '0')
+    >>> fig5_pair(["0", "1"])
+    ('1', '0')
+    """
+    if "01" in targets and "0" in targets:
+        return "01", "0"
+    return targets[-1], targets[0]
+
+
+def draw(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = False) -> list[str]:
+    """``dnnevo plot`` for a ``sequence`` run: Fig. 4 (a trial of each target) and, with two or
+    more targets, Fig. 5 (the switch test, on :func:`fig5_pair`)."""
+
+    champion = run.read_best(config, run.read_config()[1])
+    targets = target_list(config)
+    fig, axes = plot.subplots(len(targets), 1, figsize=(9, 2.6 * len(targets)),
+                             layout="constrained", squeeze=False)
+    for k, (target, ax) in enumerate(zip(targets, axes[:, 0], strict=True)):
+        record = run_trial(config, champion, target, timings(config, seed, 0, k))
+        plot_trial(record, ax=ax, title=f"{target}* positive trial")
+    save_figure(fig, run.path / "fig4-trials.png")
+    plot.close(fig)
+    written = ["fig4-trials.png"]
+    if len(targets) >= 2:
+        first, second = fig5_pair(targets)
+        timing = timings(config, seed, 0, 0) + timings(config, seed, 0, 1)
+        a, b, needed = switch_trial(config, champion, first, second, timing)
+        fig, ax = plot.subplots(figsize=(11, 3), layout="constrained")
+        plot_trial(a, ax=ax, follow=b, title=(
+            f"{first}* for {SWITCH_AFTER} triggers, then {second}* without reset "
+            f"({'settled after ' + str(needed) + ' trigger(s)' if needed is not None else 'never settled'})"))
+        save_figure(fig, run.path / "fig5-switch.png")
+        plot.close(fig)
+        written.append("fig5-switch.png")
+    return written
+
+
+def rate_column(a: Assessment) -> tuple[str, dict[str, str]] | None:
+    """The mean trial performance P of each target, beside its rate."""
+    return "mean P", {f"{t}*": f"{p:.3f}" for t, p in a.details["mean_performance"].items()}
+
+
+def overall(a: Assessment) -> str:
+    """The verdict line: every target must pass."""
+    failing = [r.name for r in a.judged if r.verdict == "fail"]
+    open_ = [r.name for r in a.judged if r.verdict == "undecided"]
+    why = {"pass": "every target passes",
+           "fail": f"{', '.join(failing)} {'fails' if len(failing) == 1 else 'fail'}; every target must pass",
+           "undecided": f"no target fails, but {', '.join(open_)} {'is' if len(open_) == 1 else 'are'} undecided"}
+    return f"overall: {a.verdict} ({why[a.verdict]})"
+
+
+def evaluate_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
+    """The switch test (:func:`switch_test`)."""
+    return switch_test(config, champion, seed)
+
+
+def extra_lines(extra: dict[str, Any]) -> list[str]:
+    """The switch test's table, when it ran."""
+    return switch_lines(extra["switch_test"]) if "switch_test" in extra else []
+
+
+def recorded_trials(config: EvolutionConfig, net: _core.Network, *,
+                    seed: int) -> list[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
+    """One trial per target drawn from ``seed``, each as (firing rates (T, N), inputs (T, 2):
+    trigger and reinforcement), for the dynamical analysis."""
+    out = []
+    for k, target in enumerate(target_list(config)):
+        r = run_trial(config, net, target, timings(config, seed, 0, k))
+        out.append((r.outputs, np.column_stack([r.trigger, r.reinforcement])))
+    return out
+
+
+def plot_trial(
+    record: TrialRecord,
+    ax: Axes | None = None,
+    *,
+    follow: TrialRecord | None = None,
+    title: str | None = None,
+) -> Axes:
+    """The paper's Fig. 4/5: trigger and reinforcement inputs and the output neuron over time,
+    with each trigger's expected bit. ``follow`` appends a second trial run without a reset."""
+    ax = plot.axes(ax)
+    records = [record] if follow is None else [record, follow]
+    trigger = np.concatenate([r.trigger for r in records])
+    reinforcement = np.concatenate([r.reinforcement for r in records])
+    output = np.concatenate([r.output for r in records])
+    t = np.arange(len(output))
+    ax.fill_between(t, 0, trigger, step="pre", color="0.85", label="trigger")
+    ax.plot(t, reinforcement, drawstyle="steps-pre", color="tab:green", label="reinforcement")
+    ax.plot(t, output, color="tab:red", label="output f(v0)")
+    ax.axhline(0.5, color="0.5", lw=0.6, ls=":")
+    starts = np.flatnonzero(np.diff(np.concatenate([[0.0], trigger])) > 0)
+    bits = np.concatenate([r.targets for r in records])
+    for s, bit in zip(starts, bits, strict=False):
+        ax.text(float(s) + 5, 1.05, str(bit), ha="center", fontsize=8)
+    if follow is not None:
+        ax.axvline(len(record.output), color="k", lw=0.8, ls="--")
+    ax.set_ylim(-0.05, 1.15)
+    ax.set_xlim(0, len(t))
+    ax.set_xlabel("time step")
+    ax.legend(loc="center right", fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return ax

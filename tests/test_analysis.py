@@ -258,7 +258,7 @@ def test_a_cycle_branch_ends_at_the_closed_form_hopf_point(tmp_path: Path) -> No
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from dnnevo.plot import plot_bifurcation
+    from dnnevo.analysis import plot_bifurcation
 
     fig, ax = plt.subplots()
     assert plot_bifurcation(b, ax) is ax

@@ -73,7 +73,7 @@ def test_analyze_options_and_a_two_neuron_portrait(tmp_path: Path, runs: dict[st
     assert doc["bifurcation"]["index"] == 0 and doc["bifurcation"]["values"][-1] == 2.0
     assert len(doc["bifurcation"]["cycles"]) == 5
     # A 2-neuron oscillator: the portrait draws nullclines and the cycle.
-    from dnnevo.plot import plot_phase_portrait
+    from dnnevo.analysis import plot_phase_portrait
 
     net = dnnevo.Network(tau=[1.0, 1.0], theta=[3.75, 1.75], weights=[[5.5, 2.0], [-2.0, 5.5]],
                          sensor_weights=[[1.0], [0.0]])

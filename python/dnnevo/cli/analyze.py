@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from dnnevo import _core, analysis
+from dnnevo import _core, analysis, plot
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
@@ -163,27 +163,23 @@ def analyze(args: argparse.Namespace) -> int:
 
 def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifurcation,
              table: LesionTable | None, outputs: np.ndarray, neurons: tuple[int, int], label: str) -> list[str]:
-    import matplotlib.pyplot as plt
-
-    from dnnevo.plot import plot_bifurcation, plot_lesions, plot_phase_portrait
-
     written = []
     n_lesions = len(table.lesions) if table is not None else 0
     for name, size in (("analysis-phase.png", (7.0, 5.5)), ("analysis-bifurcation.png", (7.0, 4.0)),
                        ("analysis-lesions.png", (7.0, 1.5 + 0.22 * n_lesions))):
         if name == "analysis-lesions.png" and table is None:
             continue
-        fig, ax = plt.subplots(figsize=size, layout="constrained")
+        fig, ax = plot.subplots(figsize=size, layout="constrained")
         if name == "analysis-phase.png":
-            plot_phase_portrait(found, ax, net=net, neurons=neurons, trajectory=outputs,
+            analysis.plot_phase_portrait(found, ax, net=net, neurons=neurons, trajectory=outputs,
                                 title=f"{run.path.name}: attractors under each input, and a real trial")
         elif name == "analysis-bifurcation.png":
-            plot_bifurcation(bif, ax, neuron=_moving_neuron(bif), xlabel=label,
+            analysis.plot_bifurcation(bif, ax, neuron=_moving_neuron(bif), xlabel=label,
                              title=f"{run.path.name}: equilibria as {label} varies")
         elif table is not None:
-            plot_lesions(table, ax, title=f"{run.path.name}: lesions")
+            analysis.plot_lesions(table, ax, title=f"{run.path.name}: lesions")
         save_figure(fig, run.path / name)
-        plt.close(fig)
+        plot.close(fig)
         written.append(name)
     return written
 
@@ -217,10 +213,6 @@ def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.n
 
 def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.ndarray, np.ndarray]],
                   basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str) -> str:
-    import matplotlib.pyplot as plt
-
-    from dnnevo.plot import plot_basins
-
     every, which = basins
     outputs = np.vstack([o for o, _ in trials])[::every]
     inputs = np.vstack([i for _, i in trials])[::every]
@@ -229,14 +221,14 @@ def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.nd
     stable = [e for e in off.equilibria if e.stable]
     neuron = output_neuron(config)
     labels = [f"{chr(65 + k)} (neuron {neuron} at {e.outputs[neuron]:.2f})" for k, e in enumerate(stable)]
-    fig, ax = plt.subplots(figsize=(9.0, 3.6), layout="constrained")
-    plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,
+    fig, ax = plot.subplots(figsize=(9.0, 3.6), layout="constrained")
+    analysis.plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,
                 neuron=neuron, boundaries=list(starts), levels=[e.value for e in bif.events if e.kind == "fold"],
                 level_label=f"folds of the {name} sweep",
                 title=f"{run.path.name}: recorded trials; background: where the state would settle "
                       f"with input {off.label}")
     save_figure(fig, run.path / "analysis-basins.png")
-    plt.close(fig)
+    plot.close(fig)
     return "analysis-basins.png"
 
 

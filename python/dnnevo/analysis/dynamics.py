@@ -1,4 +1,4 @@
-"""Dynamical analysis of a network: how it works, not only what it does.
+"""The attractors of a network under a constant input, and how an input that changes moves them.
 
 With its sensors held at a constant input vector, a network is an autonomous dynamical system
 ``tau_i dv_i/dt = -v_i + sum_j w_ij f(v_j - theta_j) + c_i`` (``c = sensor_weights @ input``). Its
@@ -31,47 +31,24 @@ dataclasses. The analysis is of the continuous-time system; tasks integrate it w
 [('fold', -1.0657), ('fold', 1.0657)]
 """
 
+
 from __future__ import annotations
 
 import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal, cast
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo import _core, tasks
-from dnnevo._checks import nonnegative
-from dnnevo.config import EvolutionConfig
+from dnnevo import _core
 from dnnevo.errors import InvalidArgumentError
 
-__all__ = [
-    "STABILITIES",
-    "Attractors",
-    "Bifurcation",
-    "Cycle",
-    "CycleBranch",
-    "CycleEnd",
-    "Equilibrium",
-    "Event",
-    "Lesion",
-    "LesionTable",
-    "RETRY_STARTS",
-    "attractors",
-    "clamp",
-    "cut",
-    "bifurcation",
-    "equilibria",
-    "lesions",
-    "limit_cycles",
-    "recorded_trials",
-    "replay",
-    "settles_to",
-    "trial_outputs",
-    "vector_field",
-]
+__all__ = ["RETRY_STARTS", "STABILITIES", "Attractors", "Bifurcation", "Cycle", "CycleBranch", "CycleEnd",
+           "Equilibrium", "Event", "attractors", "bifurcation", "equilibria", "limit_cycles",
+           "settles_to", "vector_field"]
 
 STABILITIES = ("stable_node", "stable_focus", "saddle", "unstable_node", "unstable_focus", "non_hyperbolic")
 """The stability classes, from the eigenvalues of the Jacobian: every real part negative (a node
@@ -404,114 +381,6 @@ def vector_field(net: _core.Network, input: npt.ArrayLike | None, states: npt.Ar
     return np.asarray((-v + f @ net.weights.T + c) / net.tau)
 
 
-# --- lesions -------------------------------------------------------------------------------------
-
-CLAMP_LIMIT = 1e-9
-"""A clamped output is kept this far inside (0, 1), so that its threshold stays finite."""
-
-
-def clamp(net: _core.Network, neuron: int, output: float) -> _core.Network:
-    """``net`` with ``neuron``'s firing rate held at ``output`` for every trial.
-
-    This is exact for the tasks, which start every trial from ``v = 0``: the neuron's incoming
-    weights, self-weight and sensor weights become 0, so ``tau dv/dt = -v`` keeps ``v = 0``, and its
-    threshold becomes ``-logit(output)``, so ``f(0 - theta) = output``. Every other neuron then
-    receives ``w_ij * output`` from it, as the clamp means. ``output`` is moved
-    :data:`CLAMP_LIMIT` inside (0, 1) if it lies closer to 0 or 1."""
-    n = net.size
-    if not isinstance(neuron, int) or isinstance(neuron, bool) or not 0 <= neuron < n:
-        raise InvalidArgumentError(f"neuron is {neuron!r}; it must be an integer in 0..{n - 1}")
-    if not math.isfinite(output) or not 0.0 <= output <= 1.0:
-        raise InvalidArgumentError(f"output is {output!r}; a firing rate must be in [0, 1]")
-    o = min(max(output, CLAMP_LIMIT), 1.0 - CLAMP_LIMIT)
-    weights, sensors, theta = net.weights.copy(), net.sensor_weights.copy(), net.theta.copy()
-    weights[neuron, :] = 0.0
-    sensors[neuron, :] = 0.0
-    theta[neuron] = -math.log(o / (1.0 - o))
-    return _core.Network(net.tau, theta, weights, sensors)
-
-
-def cut(net: _core.Network, source: int, target: int) -> _core.Network:
-    """``net`` without the connection from neuron ``source`` to neuron ``target``."""
-    n = net.size
-    for name, k in (("source", source), ("target", target)):
-        if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k < n:
-            raise InvalidArgumentError(f"{name} is {k!r}; it must be an integer in 0..{n - 1}")
-    weights = net.weights.copy()
-    weights[target, source] = 0.0
-    return _core.Network(net.tau, net.theta, weights, net.sensor_weights)
-
-
-@dataclass(frozen=True)
-class Lesion:
-    """One lesion and the score it leaves."""
-
-    name: str
-    """E.g. ``"clamp 3 at 0.12"`` or ``"cut 2->0"``."""
-    kind: str
-    """``"clamp"`` or ``"cut"``."""
-    neurons: tuple[int, ...]
-    """The clamped neuron, or (source, target) of the cut."""
-    score: float
-    """The lesioned network's score (see :attr:`LesionTable.score`)."""
-    drop: float
-    """The intact score minus this one: how much the part matters."""
-    verdict: str
-
-
-@dataclass(frozen=True)
-class LesionTable:
-    """Scores after each lesion, on the same fresh trials as the intact network."""
-
-    task: str
-    trials: int
-    seed: int
-    score: float
-    """The intact network's score: its lowest judged success rate (the weakest target for
-    sequence, the overall rate for landmark and nav1d)."""
-    verdict: str
-    mean_outputs: _Array
-    """Each neuron's mean firing rate over the recorded trials; a clamp holds it there."""
-    lesions: list[Lesion] = field(default_factory=list)
-
-    def to_dict(self) -> dict[str, Any]:
-        """As plain JSON types."""
-        return {"task": self.task, "trials": self.trials, "seed": self.seed, "score": self.score,
-                "verdict": self.verdict, "mean_outputs": self.mean_outputs.tolist(),
-                "lesions": [{"name": x.name, "kind": x.kind, "neurons": list(x.neurons), "score": x.score,
-                             "drop": x.drop, "verdict": x.verdict} for x in self.lesions]}
-
-
-def recorded_trials(config: EvolutionConfig, net: _core.Network, *, seed: int) -> list[tuple[_Array, _Array]]:
-    """Real trials of ``config``'s task drawn from ``seed``, each as (firing rates (T, N), inputs
-    (T, M)): one trial per target (sequence), one per landmark (landmark), one fresh chain
-    (nav1d) of the task's chain length (:func:`dnnevo.tasks.nav1d.chain_len`: 5 trials for nav1d-single,
-    whose network learns its environment in trial 1), at least 2."""
-    nonnegative("seed", seed)
-    task = tasks.find(config.task)
-    if task is None:
-        raise InvalidArgumentError(f"task {config.task!r} has no recorded trials to analyse")
-    return task.recorded_trials(config, net, seed=seed)
-
-
-def trial_outputs(config: EvolutionConfig, net: _core.Network, *, seed: int) -> tuple[_Array, _Array]:
-    """The :func:`recorded_trials` of ``seed`` stacked: firing rates (T, N) and inputs (T, M)."""
-    trials = recorded_trials(config, net, seed=seed)
-    return np.vstack([o for o, _ in trials]), np.vstack([i for _, i in trials])
-
-
-def replay(config: EvolutionConfig, net: _core.Network, inputs: npt.ArrayLike) -> _Array:
-    """The states (T, N) of ``net`` from ``v = 0`` driven by recorded ``inputs`` (T, M), one row
-    per time step, with the config's integrator: a recorded sequence or landmark trial exactly;
-    a nav1d trial to within the recording's time step (its landmark input is the fraction of a
-    time step spent on the landmark)."""
-    n = net.copy()
-    n.reset()
-    i = config.integrator
-    method = cast(Literal["euler", "rk4"], i.method)
-    return np.asarray(n.run(np.asarray(inputs, dtype=float), dt=i.dt, substeps=i.substeps, method=method).states)
-
-
 def settles_to(
     net: _core.Network, states: npt.ArrayLike, targets: Sequence[Equilibrium], input: npt.ArrayLike | None = None,
     *, duration: float | None = None, tolerance: float = 1e-2,
@@ -536,41 +405,3 @@ def settles_to(
             if d.min() <= tolerance:
                 out[k] = int(np.argmin(d))
     return out
-
-
-def _score(a: Any) -> float:
-    return float(min(r.rate for r in a.judged))
-
-
-def lesions(
-    config: EvolutionConfig, net: _core.Network, trials: int, *, seed: int, cuts: int | None = None,
-    mean_outputs: npt.ArrayLike | None = None,
-) -> LesionTable:
-    """Re-scores ``net`` with each neuron clamped at its mean output, and with each of its
-    ``cuts`` strongest connections (by ``|w|``; default N, 0 for none) cut, on ``trials`` fresh
-    trials from ``seed`` (the trials :func:`dnnevo.tasks.assess` draws, the same for every
-    lesion). ``mean_outputs`` defaults to the mean over :func:`trial_outputs` of ``seed``."""
-
-    base = tasks.assess(config, net, trials, seed=seed)
-    if mean_outputs is None:
-        mean = trial_outputs(config, net, seed=seed)[0].mean(axis=0)
-    else:
-        mean = np.asarray(mean_outputs, dtype=float).reshape(-1)
-        if mean.shape != (net.size,):
-            raise InvalidArgumentError(f"mean_outputs has {mean.size} values; expected N = {net.size}")
-    score = _score(base)
-    out: list[Lesion] = []
-
-    def add(name: str, kind: str, neurons: tuple[int, ...], lesioned: _core.Network) -> None:
-        a = tasks.assess(config, lesioned, trials, seed=seed)
-        out.append(Lesion(name, kind, neurons, _score(a), score - _score(a), a.verdict))
-
-    for i in range(net.size):
-        add(f"clamp {i} at {mean[i]:.3g}", "clamp", (i,), clamp(net, i, float(mean[i])))
-    w = net.weights
-    count = net.size if cuts is None else nonnegative("cuts", cuts)
-    order = sorted(((abs(w[t, s]), s, t) for t in range(net.size) for s in range(net.size) if w[t, s] != 0.0),
-                   reverse=True)[:count]
-    for _, s, t in order:
-        add(f"cut {s}->{t}", "cut", (s, t), cut(net, s, t))
-    return LesionTable(config.task, trials, seed, score, base.verdict, mean, out)

@@ -34,7 +34,7 @@ sys.path = [p for p in sys.path if Path(p or ".").resolve() != HERE] + [str(HERE
 
 from _common import describe_machine  # noqa: E402
 
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.experiments import scheduler
 from dnnevo.experiments import sweep# noqa: E402
 from dnnevo.experiments.runsview import RunsView  # noqa: E402

@@ -172,7 +172,7 @@ def part_c(args):
     rows = []
     for preset, overrides, generations in VALIDATION_RUNS:
         generations = max(2, generations // 4) if args.quick else generations
-        cfg = dnnevo.experiments.presets.get(preset, overrides=[*overrides, f"generations={generations}"])
+        cfg = dnnevo.presets.get(preset, overrides=[*overrides, f"generations={generations}"])
         runs = {"on": cfg, "off": dataclasses.replace(cfg, validation_candidates=0),
                 "checked": dataclasses.replace(cfg, champion_step_check=True)}
         times: dict[str, list[float]] = {key: [] for key in runs}
@@ -211,7 +211,7 @@ def main(argv=None) -> int:
     if min(args.generations, args.py_generations, args.repeats, args.validation_repeats) < 1:
         ap.error("--generations, --py-generations, --repeats and --validation-repeats must be >= 1")
 
-    cfg = dnnevo.experiments.presets.get("sequence-1bit")
+    cfg = dnnevo.presets.get("sequence-1bit")
     describe_machine()
     print(f"workload: preset sequence-1bit, P = {cfg.population}, N = {cfg.size}, crossover "
           f"{cfg.crossover_rate}, mutation {cfg.mutation_rate}{' [quick]' if args.quick else ''}")

@@ -68,7 +68,7 @@ def main(argv=None) -> int:
     if args.repeats < 1 or args.numpy_repeats < 1:
         ap.error("--repeats and --numpy-repeats must be >= 1")
 
-    cfg = dnnevo.experiments.presets.get("sequence-1bit")
+    cfg = dnnevo.presets.get("sequence-1bit")
     seed = 0
     ga = dnnevo.GeneticAlgorithm(cfg, seed=seed)
     genomes = ga.ask().genomes

@@ -46,7 +46,7 @@ import numpy as np
 
 import dnnevo
 from dnnevo.tasks import landmark
-from dnnevo.experiments import presets
+from dnnevo import presets
 from _common import describe_machine, median_time, threads
 
 MAX_DISTANCE = 6.5  # the sonar's range, m

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import dnnevo
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.tasks import sequence
 
 TARGETS = ("0", "1", "01", "10")

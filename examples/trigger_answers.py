@@ -16,7 +16,7 @@ import dataclasses
 from pathlib import Path
 
 import dnnevo
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.tasks import sequence
 from dnnevo.runs.rundir import RunDir
 

@@ -14,7 +14,7 @@ from dnnevo import tasks
 import dnnevo
 from dnnevo import _core, analysis
 from dnnevo.evaluation import assessment as assess
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.errors import InvalidArgumentError
 
 
@@ -308,3 +308,39 @@ def test_folds_at_one_value_are_told_apart_in_the_report() -> None:
     assert len(set(texts)) == len(texts), texts
     near = [t for t in texts if t.startswith(("fold at 0.43735 ", "fold at 0.43743 "))]
     assert len(near) == 2 and all("neuron" in t for t in near), near
+
+
+def test_the_report_names_the_stable_equilibria_its_basins_count_in() -> None:
+    """``dnnevo analyze`` calls the first condition's stable equilibria A, B, ...: it marks them
+    where it prints them and says what they are on the line that counts the trials' basins."""
+    from dnnevo.cli.analyze import summary
+
+    net = dnnevo.Network(tau=[1.0], theta=[4.0], weights=[[8.0]], sensor_weights=[[1.0]])
+    found = [analysis.attractors(net, [0.0], "off"), analysis.attractors(net, [3.0], "on")]
+    sweep = analysis.bifurcation(net, 0, -4.0, 4.0, steps=41)
+    lines = summary(found, sweep, None, "input 0", (1, np.array([0, 0, 0, 1, -1])), output=0)
+    assert lines[:6] == [
+        "input off [0]: 3 equilibria (2 stable: A, B), 0 attracting cycles",
+        "  A stable node     outputs [0.02], time scale 1.2",
+        "    unstable node   outputs [0.50], time scale 1",
+        "  B stable node     outputs [0.98], time scale 1.2",
+        "input on [3]: 1 equilibria (1 stable), 0 attracting cycles",  # only the first is lettered
+        "    stable node     outputs [1.00], time scale 1.01",
+    ]
+    assert lines[-2:] == [
+        "recorded trials: with input off held from each step on, the state would settle in A 60%, B 20%, none 20%",
+        "    A, B: the stable equilibria of input off, marked above (output neuron 0 at 0.02 in A, 0.98 in B); "
+        "none: no stable equilibrium reached (a cycle, or one not found)",
+    ]
+
+
+def test_dir_lists_only_the_public_names() -> None:
+    """``dir(dnnevo.analysis)`` is its public API: ``__all__``, which lists every public name of
+    its modules, and nothing else (no dunders, submodules or imported helpers)."""
+    import importlib
+
+    assert dir(analysis) == sorted(analysis.__all__)
+    assert all(hasattr(analysis, name) and not name.startswith("_") for name in analysis.__all__)
+    for module in ("dynamics", "lesions", "trials", "figures"):
+        names = importlib.import_module(f"dnnevo.analysis.{module}").__all__
+        assert set(names) <= set(analysis.__all__), (module, set(names) - set(analysis.__all__))

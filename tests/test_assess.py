@@ -14,7 +14,7 @@ from dnnevo.cli import evaluate as _cli_evaluate
 from dnnevo.tasks import nav1d
 import dnnevo
 from dnnevo.evaluation import assessment as assess
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.evaluation import stats
 from dnnevo.errors import ConfigError, InvalidArgumentError
 

@@ -18,13 +18,15 @@ def dnnevo(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[s
 def test_help_shows_a_working_example() -> None:
     r = dnnevo("--help")
     assert r.returncode == 0 and "dnnevo run sequence-1bit --quick" in r.stdout
+    # --quick takes well under a second, not ten.
+    assert "10-second" not in r.stdout and "a tiny demo run (under a second)" in r.stdout
 
 
 def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
     out = tmp_path / "demo"
     r = dnnevo("run", "sequence-1bit", "--quick", "--out", str(out), "--seed", "1")
     assert r.returncode == 0, r.stderr
-    assert "best fitness" in r.stdout
+    assert r.stdout.splitlines()[-1].startswith(f"next: dnnevo evaluate {out}")
     r = dnnevo("show", str(out))
     assert r.returncode == 0 and (out / "fitness.png").stat().st_size > 1000
     r = dnnevo("evaluate", str(out), "--trials", "5", "--seed", "1")
@@ -37,6 +39,11 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
         assert (out / name).stat().st_size > 1000
     r = dnnevo("resume", str(out))  # already finished: nothing to do, still a clean exit
     assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith(f"nothing to resume: {out} has run all its 8 generations; to run it "
+                               f"longer: dnnevo resume {out} --generations N (N > 8)\n"), r.stdout
+    r = dnnevo("resume", str(out), "--generations", "9")
+    assert r.returncode == 0 and "nothing to resume" not in r.stdout, r.stdout
+    assert r.stdout.startswith("9 generations in "), r.stdout
     r = dnnevo("presets")
     assert r.returncode == 0 and "sequence-1bit" in r.stdout
 
@@ -44,9 +51,19 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "fragment"),
     [
-        (["run", "no-such-preset"], "unknown preset 'no-such-preset'"),
-        (["run", "sequence-1bit", "--quick", "--set", "populaton=3"], "unknown setting 'populaton'"),
-        (["run", "sequence-1bit", "--quick", "--set", "population=1"], "population is 1"),
+        (["run", "no-such-preset"], "unknown preset 'no-such-preset'; presets: landmark, "),
+        (["run", "sequence-1bti"], "unknown preset 'sequence-1bti' (did you mean 'sequence-1bit'?)"),
+        (["run", "nav1d-clasifier"], "(did you mean 'nav1d-classifier'?)"),
+        (["run", "sequence-1bit", "--set", "task=sequnce"], "unknown task 'sequnce' (did you mean 'sequence'?)"),
+        (["run", "sequence-1bit", "--quick", "--set", "populaton=3"],
+         "unknown setting 'populaton' (did you mean 'population'?)"),
+        (["run", "sequence-1bit", "--quick", "--set", "integrator.td=3"],
+         "unknown setting 'integrator.td' (did you mean 'integrator.dt'?)"),
+        (["run", "sequence-1bit", "--quick", "--set", "population=1"], "population is 1; it must be at least 2"),
+        # A negative count reads as 0 does, not as a type error.
+        (["run", "sequence-1bit", "--quick", "--set", "population=0"], "population is 0; it must be at least 2"),
+        (["run", "sequence-1bit", "--quick", "--set", "population=-5"], "population is -5; it must be at least 2"),
+        (["run", "sequence-1bit", "--quick", "--set", "generations=-3"], "generations is -3; it must be at least 1"),
         (["run", "sequence-1bit", "--quick", "--set", "nonsense"], "is not key=value"),
         (["run", "sequence-1bit", "--seed", "-1"], "-1 is negative"),
         (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
@@ -68,6 +85,54 @@ def test_errors_are_one_line(args: list[str], fragment: str, tmp_path: Path) -> 
     assert fragment in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_run_show_and_the_progress_bar_name_the_same_champion(tmp_path: Path) -> None:
+    """``run`` ends with the champion best.json holds, the success rule and the next command;
+    ``show`` says the same; the progress bar tells the champion from the generation's best."""
+    import dnnevo as dn
+
+    out = tmp_path / "full"
+    # Seed 0 at the paper's population meets the success rule in generation 0.
+    r = dnnevo("run", "sequence-1bit", "--set", "generations=2", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    meta = dn.Network.load(out / "best.json").meta
+    champion = (f"champion (best.json): fitness {meta['fitness']:.4f} (generation {meta['generation']}); "
+                f"validation rate {meta['validation_rate']:.3f}, score {meta['validation_score']:.4f}")
+    success = "success rule: met at generation 0 (the champion passed it on fresh trials)"
+    after = f"next: dnnevo evaluate {out}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
+    assert r.stdout.splitlines() == [r.stdout.splitlines()[0], champion, success, after], r.stdout
+    assert r.stdout.startswith("2 generations in "), r.stdout
+    bar = r.stderr.strip().splitlines()[-1]  # not a terminal: one line at the end
+    assert f"gen 2/2  champion {meta['fitness']:.4f}  gen best " in bar and " gen mean " in bar, bar
+    assert " best " not in bar.replace("gen best", ""), bar
+    r = dnnevo("show", str(out))
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[1:3] == [champion, success] and lines[-1] == after, r.stdout
+    from dnnevo.runs.rundir import RunDir
+
+    row = RunDir(out).read_log()[-1]
+    assert lines[3] == f"last generation (1): gen best {row['best']:.4f}, gen mean {row['mean']:.4f}"
+    # The quick run does not meet the rule.
+    r = dnnevo("run", "sequence-1bit", "--quick", "--out", str(tmp_path / "quick"))
+    assert "success rule: not met in 8 generations (the champion failed it on fresh trials)" in r.stdout
+
+
+def test_show_says_a_python_fitness_has_no_success_rule(tmp_path: Path) -> None:
+    import dnnevo as dn
+    from dnnevo.cli.show import success_line
+
+    out = tmp_path / "py"
+    config = dn.EvolutionConfig(population=10, generations=2, size=2, n_inputs=1)
+    dn.evolve(lambda nets: np.array([n.tau[0] for n in nets]), config, out=out, progress=False)
+    r = dnnevo("show", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "success rule: none (a Python fitness function has no success rule)" in r.stdout
+    assert "next:" not in r.stdout  # the command line can neither resume nor judge it
+    assert success_line("sequence", [0.0, 1.0, 0.0]).startswith(
+        "success rule: met at generation 1, but the final champion fails it")
+    assert success_line("sequence", [float("nan")]).startswith("success rule: not checked")
 
 
 def test_non_empty_out_is_refused(tmp_path: Path) -> None:

@@ -56,6 +56,10 @@ def test_analyze_writes_json_and_figures(runs: dict[str, Path], preset: str) -> 
     assert i != j
     basins = doc["trial_basins"]
     assert len(basins["basins"]) > 10 and set(basins["basins"]) <= {-1, *range(len(basins["attractors"]))}
+    # The letters of the basins' line are explained: the first condition's stable equilibria.
+    letters = ", ".join(chr(65 + k) for k in range(len(basins["attractors"])))
+    if letters:
+        assert f"stable: {letters})" in r.stdout and f"    {letters}: the stable equilibri" in r.stdout, r.stdout
     for name in ("analysis-phase.png", "analysis-bifurcation.png", "analysis-lesions.png", "analysis-basins.png"):
         assert_png(run / name)
     hidden = [p for p in run.iterdir() if p.name.startswith(".") and p.name != rundir.LOCK_NAME]

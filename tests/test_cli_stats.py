@@ -19,7 +19,7 @@ import dnnevo
 from dnnevo.cli import evaluate as _cli_evaluate
 from dnnevo.evaluation import assessment as assess
 from dnnevo.cli import command as cli
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.tasks import sequence
 from dnnevo.evaluation import stats
 from dnnevo.config import EvolutionConfig

@@ -88,7 +88,7 @@ def test_seeding_puts_networks_first() -> None:
 
 
 def test_builtin_run_is_identical_with_one_and_two_threads(tmp_path: Path) -> None:
-    config = dnnevo.experiments.presets.get("sequence-1bit", quick=True)
+    config = dnnevo.presets.get("sequence-1bit", quick=True)
     one = dnnevo.evolve("sequence", config, seed=5, threads=1, out=tmp_path / "1", progress=False)
     two = dnnevo.evolve("sequence", config, seed=5, threads=2, out=tmp_path / "2", progress=False)
     for key in ("best", "mean", "std", "min"):
@@ -98,7 +98,7 @@ def test_builtin_run_is_identical_with_one_and_two_threads(tmp_path: Path) -> No
 
 
 def test_evaluate_matches_in_run_scores() -> None:
-    config = dnnevo.experiments.presets.get("sequence-1bit", quick=True)
+    config = dnnevo.presets.get("sequence-1bit", quick=True)
     ga = dnnevo.GeneticAlgorithm(config, seed=11)
     genomes, networks = ga.ask()
     from_genomes = dnnevo.evaluate("sequence", genomes, generation=0, seed=11, config=config)
@@ -117,7 +117,11 @@ def test_run_folder_contents(tmp_path: Path) -> None:
     assert saved.task == "python:test_evolve.follow_square"
     assert dataclasses.replace(saved, task=SMALL.task) == SMALL
     assert "seed = 2" in (out / "config.toml").read_text()
-    assert len((out / "log.csv").read_text().splitlines()) == 1 + SMALL.generations
+    header, *rows = (out / "log.csv").read_text().splitlines()
+    assert len(rows) == SMALL.generations
+    # The generation is written as an integer; a Python fitness has no success rule (nan).
+    assert header.startswith("generation,") and [row.split(",")[0] for row in rows] == ["0", "1", "2", "3", "4", "5"]
+    assert {row.split(",")[header.split(",").index("champion_success")] for row in rows} == {"nan"}
     best = dnnevo.Network.load(out / "best.json")
     assert best == result.best
     assert best.meta["fitness"] == result.best_fitness
@@ -203,8 +207,17 @@ def test_config_validation_messages() -> None:
         ({"generations": 0}, "generations is 0"),
         ({"size": 0}, "size is 0"),
         ({"task": ""}, "task is empty"),
-        ({"population": -1}, "population is -1; expected an integer >= 0"),
+        # A negative count reads as 0 does, the rule coming from the Rust core's check.
+        ({"population": 0}, "population is 0; it must be at least 2"),
+        ({"population": -1}, "population is -1; it must be at least 2"),
+        ({"population": -5}, "population is -5; it must be at least 2"),
+        ({"generations": -2}, "generations is -2; it must be at least 1"),
+        ({"size": -1}, "size is -1; it must be at least 1"),
+        ({"elitism": -1}, "elitism is -1; it must be at least 0"),
+        ({"validation_candidates": -3}, "validation_candidates is -3; it must be at least 0"),
+        ({"integrator": {"substeps": -2}}, "integrator.substeps is -2; it must be >= 1"),
         ({"population": 2.5}, "population is 2.5; expected an integer"),
+        ({"population": True}, "population is True; expected an integer"),
         ({"crossover_rate": "high"}, "crossover_rate is 'high'; expected a number"),
         ({"integrator": {"dt": 0}}, "integrator.dt is 0"),
         ({"integrator": {"dt": float("inf")}}, "integrator.dt is inf; every number must be finite"),
@@ -262,7 +275,7 @@ def test_env_thread_count_does_not_change_results(tmp_path: Path) -> None:
 
 
 def test_a_preset_name_with_its_config_runs_the_presets_task() -> None:
-    config = dnnevo.experiments.presets.get("nav1d-far", quick=True, overrides=["generations=2"])
+    config = dnnevo.presets.get("nav1d-far", quick=True, overrides=["generations=2"])
     by_name = dnnevo.evolve("nav1d-far", config, seed=1, progress=False)
     by_task = dnnevo.evolve("nav1d", config, seed=1, progress=False)
     assert by_name.best_fitness == by_task.best_fitness

@@ -308,6 +308,37 @@ def test_generations_extends_a_run_keeping_files_in_agreement(pristine: Path, tm
         assert a == b, name
 
 
+def test_a_log_written_with_float_generations_reads_shows_and_resumes(pristine: Path, tmp_path: Path) -> None:
+    """log.csv files written before the generation and champion_success were integers (``0.0``,
+    ``1.0``) read the same, ``show`` takes them, and the folder extends bit for bit."""
+    run = copy(pristine, tmp_path / "run")
+    header, *lines = (run / "log.csv").read_text().splitlines()
+    assert [line.split(",")[0] for line in lines] == [str(g) for g in range(len(lines))]
+    rows = RunDir(run).read_log()
+    # The old writer: repr(float(value)) for every column.
+    old = [header, *(",".join(repr(float(cell)) for cell in line.split(",")) for line in lines)]
+    assert old[1].startswith("0.0,")
+    (run / "log.csv").write_text("\n".join(old) + "\n")
+    assert json.dumps(RunDir(run).read_log()) == json.dumps(rows)
+    r = run_cli("show", run)
+    assert r.returncode == 0 and "last generation (5): gen best" in r.stdout, (r.stdout, r.stderr)
+    longer = tmp_path / "longer"
+    r = run_cli("run", "sequence-1bit", "--quick", "--set", "population=12", "--set", "generations=9",
+                "--seed", "3", "--out", longer)
+    assert r.returncode == 0, r.stderr
+    r = run_cli("resume", run, "--generations", "9")
+    assert r.returncode == 0, r.stderr
+    assert_consistent(run)
+
+    def without_timing(path: Path) -> list[list[str]]:
+        table = [line.split(",") for line in path.read_text().splitlines()]
+        return [row[:-2] for row in table]
+
+    assert without_timing(run / "log.csv") == without_timing(longer / "log.csv")
+    assert [row[0] for row in without_timing(run / "log.csv")[1:]] == [str(g) for g in range(9)]
+    assert (run / "best.json").read_text() == (longer / "best.json").read_text()
+
+
 KILLS = 30 if FULL else 8
 KILL_GENERATIONS = 100
 KILL_RUN = ["sequence-1bit", "--quick", "--set", "population=40", "--set", f"generations={KILL_GENERATIONS}"]
@@ -430,7 +461,7 @@ refused(lambda: dnnevo.EvolutionConfig(task_params={"perf_base": float("nan")}),
 from dnnevo import analysis
 from dnnevo.tasks import landmark
 from dnnevo.tasks import nav1d
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.tasks import sequence
 refused(lambda: nets[0].run(np.zeros((3, 2)), substeps=2**64), InvalidArgumentError, "substeps is 18446744073709551616")
 refused(lambda: dnnevo.run_population(nets, np.zeros((3, 2)), substeps=2**70), InvalidArgumentError, "substeps is")

@@ -21,7 +21,7 @@ import pytest
 import dnnevo
 from dnnevo.tasks import landmark
 from dnnevo.tasks import nav1d
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.tasks import sequence
 
 DELAY = 0.5

@@ -20,7 +20,7 @@ from dnnevo.cli import evaluate as _cli_evaluate
 import dnnevo
 from dnnevo.evaluation import assessment as assess
 from dnnevo.tasks import landmark
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 
@@ -520,7 +520,7 @@ def run(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("landmark-run") / "lm"
     r = run_cli("run", "landmark", "--quick", "--out", out, "--seed", "0")
     assert r.returncode == 0, r.stderr
-    assert "best fitness" in r.stdout
+    assert "champion (best.json): fitness" in r.stdout
     return out
 
 

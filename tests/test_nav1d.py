@@ -24,7 +24,7 @@ import dnnevo
 from dnnevo.evaluation.stats import wilson
 from dnnevo.evaluation import assessment as assess
 from dnnevo.tasks import nav1d
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.config import apply_overrides
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 
@@ -448,7 +448,7 @@ def runs(tmp_path_factory) -> dict[str, Path]:
         out[name] = root / name
         r = run_cli("run", name, "--quick", "--out", out[name], "--seed", "0")
         assert r.returncode == 0, r.stderr
-        assert "best fitness" in r.stdout
+        assert "champion (best.json): fitness" in r.stdout
     return out
 
 

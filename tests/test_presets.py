@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import dnnevo
-from dnnevo.experiments import presets
+from dnnevo import presets
 
 
 @pytest.mark.parametrize("name", presets.names())
@@ -57,3 +57,26 @@ def test_the_incremental16_rows_made_before_the_preset_changed_still_name_their_
             for c in (earlier, made_as)]
     np.testing.assert_array_equal(runs[0].history["validation_score"], runs[1].history["validation_score"])
     assert runs[0].best == runs[1].best
+
+
+def test_a_misspelt_preset_or_task_gets_a_did_you_mean() -> None:
+    with pytest.raises(dnnevo.ConfigError, match=r"unknown preset 'sequence-1bti' \(did you mean 'sequence-1bit'\?\)"):
+        presets.get("sequence-1bti")
+    with pytest.raises(dnnevo.ConfigError, match=r"\(did you mean 'sequence-2bit-direct16' or 'sequence-2bit-direct'\?\)"):
+        presets.get("sequence-2bit-direct1")
+    with pytest.raises(dnnevo.ConfigError) as nothing_close:
+        presets.get("maze")
+    assert "did you mean" not in str(nothing_close.value) and "presets: landmark, " in str(nothing_close.value)
+    # A task name, given alone or with a config that names it: the same message.
+    for config in (None, dnnevo.EvolutionConfig(task="sequnce")):
+        with pytest.raises(dnnevo.ConfigError, match=r"unknown task 'sequnce' \(did you mean 'sequence'\?\)"):
+            dnnevo.evolve("sequnce", config, progress=False)
+    # A config.toml naming a misspelt task, as resume reads it.
+    from dnnevo.evolution.evolve import _check_layout
+
+    with pytest.raises(dnnevo.ConfigError, match=r"unknown task 'landmrk' \(did you mean 'landmark'\?\)"):
+        _check_layout(dnnevo.EvolutionConfig(task="landmrk"))
+    from dnnevo.experiments import plan
+
+    with pytest.raises(dnnevo.ConfigError, match=r"did you mean 'sequence-1bit'\?"):
+        plan.experiment("sequence-1bti")

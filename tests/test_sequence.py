@@ -22,7 +22,7 @@ TOL = 1e-9
 def config(**task_params):
     """The sequence-1bit preset, with ``size`` and the integrator as keyword arguments and
     anything else overriding its task_params."""
-    base = dnnevo.experiments.presets.get("sequence-1bit")
+    base = dnnevo.presets.get("sequence-1bit")
     d = base.to_dict()
     for key in ("size", "integrator"):
         if key in task_params:

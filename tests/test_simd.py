@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import dnnevo
-from dnnevo.experiments import presets
+from dnnevo import presets
 
 KERNELS = dnnevo.build_info()["kernels"]
 

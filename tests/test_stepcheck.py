@@ -65,7 +65,7 @@ def test_a_champion_that_depends_on_the_step_is_flagged() -> None:
     from pathlib import Path
 
     from dnnevo import _core
-    from dnnevo.experiments import presets
+    from dnnevo import presets
 
     net = _core.Network.load(Path(__file__).parent / "data" / "landmark-step-artefact.json")
     config = presets.get("landmark")

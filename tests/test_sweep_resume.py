@@ -11,7 +11,7 @@ import pytest
 from cli_helpers import assert_one_line_error, run_cli
 
 import dnnevo
-from dnnevo.experiments import presets
+from dnnevo import presets
 
 OVERRIDES = ["population=12", "generations=8"]
 ARGS = ["sequence-1bit", "--quick", *(a for o in OVERRIDES for a in ("--set", o)),

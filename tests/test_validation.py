@@ -25,7 +25,7 @@ RESULT_COLUMNS = (*FITNESS_COLUMNS, "champion_success", "validation_rate", "vali
 
 def config(task: str, *extra: str) -> EvolutionConfig:
     preset, overrides = CONFIGS[task]
-    return dnnevo.experiments.presets.get(preset, quick=True, overrides=[*overrides, *extra])
+    return dnnevo.presets.get(preset, quick=True, overrides=[*overrides, *extra])
 
 
 def same(a: np.ndarray, b: np.ndarray) -> bool:

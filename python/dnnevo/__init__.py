@@ -41,7 +41,7 @@ if _sys.excepthook is _sys.__excepthook__:
 from dnnevo.errors import DnnevoError  # noqa: E402
 
 from dnnevo import _core, plot
-from dnnevo.experiments import presets# noqa: E402
+from dnnevo import presets# noqa: E402
 from dnnevo._core import (
     LANES,
     Network,

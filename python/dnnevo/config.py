@@ -1,6 +1,6 @@
 """Evolution settings: a frozen dataclass that reads and writes TOML.
 
-Every field has one meaning and one default here; presets (``dnnevo.experiments.presets``) override fields by
+Every field has one meaning and one default here; presets (``dnnevo.presets``) override fields by
 name. A run folder's ``config.toml`` is this dataclass plus the run's seed and dnnevo's version,
 so a run can always be repeated from its folder.
 """
@@ -18,7 +18,7 @@ from typing import Any
 import tomli_w
 
 from dnnevo import _core
-from dnnevo.errors import ConfigError
+from dnnevo.errors import ConfigError, did_you_mean
 
 __all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides", "with_later_defaults"]
 
@@ -140,6 +140,7 @@ class EvolutionConfig:
         object.__setattr__(self, "task_params", dict(self.task_params))
         d = self.to_dict()
         _check_finite(d, "")
+        _check_negative(d)
         _core.check_config(json.dumps(d))
 
     # -- conversions -------------------------------------------------------------------------
@@ -194,8 +195,8 @@ _TYPES: dict[str, type] = {
 
 
 def _check_type(obj: Any, name: str, kind: type, prefix: str = "") -> None:
-    """``obj.name`` has the type ``kind``: a str; a bool; an int (not a bool) >= 0; or a float,
-    which an int may stand for."""
+    """``obj.name`` has the type ``kind``: a str; a bool; an int (not a bool; a negative one is
+    refused by :func:`_check_negative`); or a float, which an int may stand for."""
     value = getattr(obj, name)
     if kind is bool:
         ok = isinstance(value, bool)
@@ -204,13 +205,33 @@ def _check_type(obj: Any, name: str, kind: type, prefix: str = "") -> None:
         ok = isinstance(value, str)
         expected = "a string"
     elif kind is int:
-        ok = isinstance(value, int) and not isinstance(value, bool) and value >= 0
-        expected = "an integer >= 0"
+        ok = isinstance(value, int) and not isinstance(value, bool)
+        expected = "an integer"
     else:
         ok = isinstance(value, int | float) and not isinstance(value, bool)
         expected = "a number"
     if not ok:
         raise ConfigError(f"{prefix}{name} is {value!r}; expected {expected}")
+
+
+def _check_negative(d: dict[str, Any]) -> None:
+    """A negative count (which the Rust core cannot even parse) gets the message Rust gives for 0,
+    so that ``population = -5`` and ``population = 0`` read alike ("it must be at least 2")."""
+    counts: list[tuple[str, str | None]] = [(name, None) for name, kind in _TYPES.items() if kind is int]
+    for name, sub in [*counts, ("integrator", "substeps")]:
+        value = d[name] if sub is None else d[name][sub]
+        if value >= 0:
+            continue
+        key = name if sub is None else f"{name}.{sub}"
+        probe = {**d, name: 0 if sub is None else {**d[name], sub: 0}}
+        rule = "it must be at least 0"
+        try:
+            _core.check_config(json.dumps(probe))
+        except ConfigError as e:
+            said = str(e)
+            if said.startswith(f"{key} is 0; "):
+                rule = said[len(f"{key} is 0; "):]
+        raise ConfigError(f"{key} is {value}; {rule}")
 
 
 def _check_finite(value: Any, where: str) -> None:
@@ -262,13 +283,15 @@ def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> Evolutio
         value = _parse_value(raw.strip())
         head, _, sub = key.partition(".")
         if head not in d:
-            raise ConfigError(f"unknown setting {key!r}; known settings: {', '.join(sorted(d))}")
+            raise ConfigError(f"unknown setting {key!r}{did_you_mean(key, d)}; "
+                              f"known settings: {', '.join(sorted(d))}")
         if sub:
             if not isinstance(d[head], dict):
                 raise ConfigError(f"{head} is not a table, so {key!r} cannot be set")
             if head != "task_params" and sub not in d[head]:
+                hint = did_you_mean(key, [f"{head}.{k}" for k in d[head]])
                 raise ConfigError(
-                    f"unknown setting {key!r}; {head} has {', '.join(sorted(d[head]))}"
+                    f"unknown setting {key!r}{hint}; {head} has {', '.join(sorted(d[head]))}"
                 )
             d[head] = {**d[head], sub: value}
         else:

@@ -5,6 +5,9 @@ Errors about bad values also derive from :class:`ValueError`, so ``except ValueE
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 __all__ = [
     "DnnevoError",
     "InvalidNetworkError",
@@ -37,3 +40,21 @@ class ConfigError(DnnevoError, ValueError):
 
 class FitnessError(DnnevoError, ValueError):
     """A fitness value cannot be selected on (NaN, or negative under proportional selection)."""
+
+
+def did_you_mean(name: str, known: Iterable[str]) -> str:
+    """The hint an "unknown name" message carries: `` (did you mean 'x'?)`` naming the closest
+    of ``known`` (up to three when they are about as close), or ``""`` when none is close.
+
+    >>> did_you_mean("sequence-1bti", ["landmark", "sequence-1bit", "sequence-3bit"])
+    " (did you mean 'sequence-1bit'?)"
+    >>> did_you_mean("maze", ["landmark", "sequence"])
+    ''
+    """
+    matches = difflib.get_close_matches(name, list(known), n=3, cutoff=0.75)
+    if not matches:
+        return ""
+    best = difflib.SequenceMatcher(None, name, matches[0]).ratio()
+    close = [repr(k) for k in matches if difflib.SequenceMatcher(None, name, k).ratio() >= best - 0.03]
+    either = close[0] if len(close) == 1 else f"{', '.join(close[:-1])} or {close[-1]}"
+    return f" (did you mean {either}?)"

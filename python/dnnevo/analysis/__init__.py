@@ -83,3 +83,9 @@ __all__ = [
     "trial_outputs",
     "vector_field",
 ]
+
+
+def __dir__() -> list[str]:
+    """The public names only: ``dir(dnnevo.analysis)`` lists ``__all__``, not the dunders and
+    submodules a package shows (the submodules stay importable, e.g. ``dnnevo.analysis.dynamics``)."""
+    return sorted(__all__)

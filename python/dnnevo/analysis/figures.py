@@ -42,10 +42,8 @@ def plot_phase_portrait(
     marker shape per condition, coloured by stability, filled when stable) and attracting cycles,
     and, for a 2-neuron ``net``, the nullclines of the first condition (solid: neuron i's,
     dashed: neuron j's)."""
-    from matplotlib.lines import Line2D
-
-
     ax = plot.axes(ax)
+    Line2D = plot.pyplot().Line2D
     i, j = neurons
     theta = np.asarray(net.theta)
     if trajectory is not None:
@@ -189,10 +187,8 @@ def plot_basins(
         ax.axvline(x - 0.5, color="k", lw=0.8, ls="--")
     for k, y in enumerate(levels):
         ax.axhline(y, color="0.3", lw=0.7, ls=":", label=level_label if k == 0 else None)
-    from matplotlib.patches import Patch
-
     handles, _ = ax.get_legend_handles_labels()
-    handles += [Patch(color=_BASIN_COLORS[k % len(_BASIN_COLORS)], alpha=0.3, label=f"would settle in {name}")
+    handles += [plot.pyplot().Rectangle((0, 0), 1, 1, color=_BASIN_COLORS[k % len(_BASIN_COLORS)], alpha=0.3, label=f"would settle in {name}")
                 for k, name in enumerate(labels)]
     ax.legend(handles=handles, loc="center right", fontsize=7)
     ax.set_xlim(-0.5, len(b) - 0.5)

@@ -156,7 +156,7 @@ def analyze(args: argparse.Namespace) -> int:
     write_atomic(run.path / "analysis.json", json.dumps(doc, indent=1) + "\n")
     written = ["analysis.json", *_figures(run, net, found, bif, table, outputs, neurons, name)]
     written.append(_basin_figure(run, config, trials, basins, found[0], bif, name))
-    print("\n".join(summary(found, bif, table, name, basins)))
+    print("\n".join(summary(found, bif, table, name, basins, output=output_neuron(config))))
     print(f"analysed in {elapsed:.1f} s; wrote {', '.join(str(run.path / w) for w in written)}")
     return 0
 
@@ -276,23 +276,33 @@ def _end_text(end: analysis.CycleEnd | None, edge: str, events: list[analysis.Ev
             f"period {end.period:.3g} there{was})")
 
 
-def _eq_line(e: analysis.Equilibrium) -> str:
+def _eq_line(e: analysis.Equilibrium, letter: str = "") -> str:
     rates = " ".join(f"{o:.2f}" for o in e.outputs)
     scale = f", time scale {e.time_scale:.3g}" if e.time_scale is not None else ""
-    return f"    {e.stability.replace('_', ' '):<15} outputs [{rates}]{scale}"
+    return f"  {letter:<2}{e.stability.replace('_', ' '):<15} outputs [{rates}]{scale}"
+
+
+def letters(a: Attractors) -> dict[int, str]:
+    """The names A, B, C, ... of ``a``'s stable equilibria, in their order (the index of each in
+    ``a.equilibria``), as the basins' summary line and figure call them."""
+    stable = [k for k, e in enumerate(a.equilibria) if e.stable]
+    return {k: chr(65 + i) for i, k in enumerate(stable)}
 
 
 def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None, name: str,
-            basins: tuple[int, np.ndarray] | None = None) -> list[str]:
-    """The printed report."""
+            basins: tuple[int, np.ndarray] | None = None, *, output: int | None = None) -> list[str]:
+    """The printed report. The first condition's stable equilibria are named A, B, ... (as in
+    analysis-basins.png); ``output`` is the neuron whose firing rate is the task's answer."""
     lines = []
-    for a in found:
+    named = letters(found[0]) if found else {}
+    for i, a in enumerate(found):
         stable = sum(e.stable for e in a.equilibria)
+        names = f": {', '.join(named.values())}" if i == 0 and named else ""
         lines.append(f"input {a.label} [{', '.join(f'{x:g}' for x in a.input)}]: {len(a.equilibria)} equilibria "
-                     f"({stable} stable), {len(a.cycles)} attracting cycle{'s' * (len(a.cycles) != 1)}")
+                     f"({stable} stable{names}), {len(a.cycles)} attracting cycle{'s' * (len(a.cycles) != 1)}")
         if len(a.equilibria) % 2 == 0:
             lines.append("    (an even count: at least one equilibrium was missed, see docs/analysis.md)")
-        lines += [_eq_line(e) for e in a.equilibria[:12]]
+        lines += [_eq_line(e, named.get(k, "") if i == 0 else "") for k, e in enumerate(a.equilibria[:12])]
         if len(a.equilibria) > 12:
             lines.append(f"    ... {len(a.equilibria) - 12} more in analysis.json")
         for c in a.cycles:
@@ -315,9 +325,21 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
     if basins is not None:
         every, which = basins
         shares = ", ".join(f"{chr(65 + k)} {np.mean(which == k):.0%}" for k in range(int(which.max(initial=-1)) + 1))
-        lines.append(f"recorded trials: the state would settle in {shares}"
-                     + (f", none {np.mean(which < 0):.0%}" if (which < 0).any() else "")
-                     + f" (input {found[0].label} attractors, by stable equilibrium order)")
+        off = found[0].label
+        lines.append(f"recorded trials: with input {off} held from each step on, the state would settle in "
+                     + (shares or "no stable equilibrium")
+                     + (f", none {np.mean(which < 0):.0%}" if (which < 0).any() and shares else ""))
+        if named:
+            attractors = [e for e in found[0].equilibria if e.stable]
+            where = ""
+            if output is not None:
+                where = (f" (output neuron {output} at "
+                         + ", ".join(f"{e.outputs[output]:.2f} in {chr(65 + k)}" for k, e in enumerate(attractors))
+                         + ")")
+            kind = "equilibria" if len(named) > 1 else "equilibrium"
+            lines.append(f"    {', '.join(named.values())}: the stable {kind} of input {off}, marked above{where}"
+                         + ("; none: no stable equilibrium reached (a cycle, or one not found)"
+                            if (which < 0).any() else ""))
     if table is not None:
         lines.append(f"lesions ({table.trials} fresh trials, seed {table.seed}): intact score {table.score:.3f} "
                      f"({table.verdict})")

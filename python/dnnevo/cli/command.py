@@ -16,24 +16,23 @@ import os
 import traceback
 from pathlib import Path
 
-import numpy as np
-
 from dnnevo import _startup, figures
 from dnnevo.cli import analyze as _cli_analyze
 from dnnevo.cli import evaluate as _cli_evaluate
 from dnnevo.cli import nav1d_system as _cli_nav1d_system
 from dnnevo.cli import reproduce as _cli_reproduce
+from dnnevo.cli import show as _cli_show
 from dnnevo.cli import sweep as _cli_sweep
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
 from dnnevo.tasks import DEFAULT_TRIALS
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.runs.rundir import RunDir, save_figure
+from dnnevo.runs.rundir import RunDir
 
 EXAMPLES = """examples:
   dnnevo presets                                   list the experiments
-  dnnevo run sequence-1bit --quick --out runs/demo a 10-second demo run
+  dnnevo run sequence-1bit --quick --out runs/demo a tiny demo run (under a second)
   dnnevo run sequence-1bit --seed 3                the paper's 1-bit experiment (1000 x 500)
   dnnevo run sequence-1bit --set population=200 --set mutation_rate=0.02
   dnnevo resume runs/demo                          continue a stopped run
@@ -121,7 +120,8 @@ def build_parser() -> argparse.ArgumentParser:
     def run_options(p: argparse.ArgumentParser) -> None:
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a setting, e.g. population=200 or integrator.dt=0.05")
-        p.add_argument("--quick", action="store_true", help="small population, few generations")
+        p.add_argument("--quick", action="store_true",
+                       help="small population, few generations: a demo, not a result")
         p.add_argument("--threads", type=_positive, help="worker threads (default: all cores)")
 
     p = sub.add_parser("run", help="run a preset", epilog="example: dnnevo run sequence-1bit --quick --out runs/demo")
@@ -218,34 +218,39 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _report(result: dnnevo.EvolutionResult) -> int:
+    """Ends ``run`` and ``resume``: the time taken, the champion, the success rule and the next
+    command, in the words of ``dnnevo show`` (see :mod:`dnnevo.cli.show`)."""
     h = result.history
     wall = h["elapsed_s"][-1] if len(h.get("elapsed_s", [])) else 0.0
-    print(f"best fitness {result.best_fitness:.4f} (generation {result.best_generation}); "
-          f"{len(h['generation'])} generations in {wall:.1f} s; run folder {result.run_dir}")
+    print(f"{len(h['generation'])} generations in {wall:.1f} s; run folder {result.run_dir}")
+    champion: dict[str, float] = {"fitness": result.best_fitness, "generation": result.best_generation}
+    if result.best_validation is not None:
+        champion["validation_rate"], champion["validation_score"] = result.best_validation
+    assert result.run_dir is not None, "the command line always writes a run folder"
+    for line in _cli_show.outcome(result.run_dir, result.config, champion,
+                                  list(h.get("champion_success", [])), interrupted=result.interrupted):
+        print(line)
     return 130 if result.interrupted else 0
 
 
 def _cmd_resume(args: argparse.Namespace) -> int:
+    done = _finished(args.dir) if args.generations is None else None
+    if done is not None:
+        print(f"nothing to resume: {args.dir} has run all its {done} generations; to run it "
+              f"longer: dnnevo resume {args.dir} --generations N (N > {done})")
     return _report(dnnevo.resume(args.dir, threads=args.threads, generations=args.generations))
 
 
-def _cmd_show(args: argparse.Namespace) -> int:
-    run = RunDir(args.dir)
-    config, _ = run.read_config()
-    history = run.read_log(config)
-    last = history[-1]
-    best = max(history, key=lambda r: r["best"])
-    print(f"{args.dir}: task {config.task}, population {config.population}, "
-          f"{len(history)}/{config.generations} generations, {last['elapsed_s']:.1f} s")
-    print(f"best fitness {best['best']:.4f} at generation {int(best['generation'])}; "
-          f"last generation: best {last['best']:.4f}, mean {last['mean']:.4f}")
-    from dnnevo.plot import plot_fitness
-
-    arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
-    ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
-    save_figure(ax.figure, run.path / "fitness.png")
-    print(f"wrote {run.path / 'fitness.png'}")
-    return 0
+def _finished(path: Path) -> int | None:
+    """The generations of the run at ``path`` when its log says it has run them all, else None
+    (also when a file is unreadable: ``resume`` then says what is wrong, or repairs it)."""
+    try:
+        run = RunDir(path)
+        config, _ = run.read_config()
+        done = len(run.read_log(config))
+    except (DnnevoError, OSError):
+        return None
+    return done if done >= config.generations else None
 
 
 def _cmd_presets(args: argparse.Namespace) -> int:
@@ -264,7 +269,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 COMMANDS = {
     "run": _cmd_run,
     "resume": _cmd_resume,
-    "show": _cmd_show,
+    "show": _cli_show.show,
     "presets": _cmd_presets,
     "sweep": _cli_sweep.sweep_command,
     "evaluate": _cli_evaluate.evaluate,

@@ -48,11 +48,11 @@ def evaluate(args: argparse.Namespace) -> int:
     config, table = run.read_config()
     champion = run.read_best(config, table)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
-    if args.robot_like and config.task != "landmark":
+    task = tasks.get(config.task)
+    if args.robot_like and not task.ROBOT_LIKE:
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
     if args.dt is not None:
         config = with_dt(config, args.dt, "--dt")
-    task = tasks.get(config.task)
     a = tasks.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
     extra = task.evaluate_extra(config, champion, seed)
     if args.dt is not None:

@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.experiments import scheduler
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep

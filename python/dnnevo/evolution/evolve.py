@@ -23,10 +23,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo import _core
+from dnnevo import _core, presets
 from dnnevo._checks import nonnegative
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError, DnnevoError, FitnessError
+from dnnevo.errors import ConfigError, DnnevoError, FitnessError, did_you_mean
 from dnnevo.evolution.ga import GeneticAlgorithm
 from dnnevo.evolution.progress import Progress
 from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short
@@ -98,8 +98,12 @@ def evaluate(
 
 def _task_config(task: str, config: EvolutionConfig | None) -> EvolutionConfig:
     """The config for a built-in task name or preset name."""
-    from dnnevo.experiments import presets
-
+    if task not in presets.names() and task not in _core.task_names():
+        known = [*_core.task_names(), *presets.names()]
+        raise ConfigError(
+            f"unknown task {task!r}{did_you_mean(task, known)}; built-in tasks: "
+            f"{', '.join(_core.task_names())}; presets: {', '.join(presets.names())}"
+        )
     if config is not None:
         named = presets.get(task).task if task in presets.names() else task
         if named != config.task:
@@ -107,12 +111,7 @@ def _task_config(task: str, config: EvolutionConfig | None) -> EvolutionConfig:
         return config
     if task in presets.names():
         return presets.get(task)
-    if task in _core.task_names():
-        return EvolutionConfig(task=task)
-    raise ConfigError(
-        f"unknown task {task!r}; built-in tasks: {', '.join(_core.task_names())}; "
-        f"presets: {', '.join(presets.names())}"
-    )
+    return EvolutionConfig(task=task)
 
 
 def evolve(
@@ -302,6 +301,10 @@ def _run_table(seed: int) -> dict[str, Any]:
 
 
 def _check_layout(config: EvolutionConfig) -> None:
+    names = _core.task_names()
+    if config.task not in names:
+        raise ConfigError(f"unknown task {config.task!r}{did_you_mean(config.task, names)}; "
+                          f"built-in tasks: {', '.join(names)}")
     size, n_inputs = _core.task_layout(config.to_json())
     if (size, n_inputs) != (config.size, config.n_inputs):
         raise ConfigError(
@@ -405,7 +408,8 @@ def _loop(
                     last_log = now
                 if bar is not None:
                     row = history[-1]
-                    bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"])
+                    bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"],
+                               champion=ga.best_fitness)
                 if callback is not None and callback(stats, ga) is True:
                     break
             interrupted = stop.requested

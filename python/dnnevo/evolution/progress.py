@@ -1,7 +1,16 @@
-"""A one-line progress bar on stderr: generation, best, mean, evaluations per second, ETA."""
+"""A one-line progress bar on stderr: the generation, the champion's fitness, the generation's
+best and mean fitness, evaluations per second and the ETA.
+
+The words are those of ``dnnevo run`` and ``dnnevo show``: the *champion* is the run's best
+network so far, the one best.json holds (chosen on the task's validation trials when it has them,
+so its training fitness is shown); *gen best* and *gen mean* are the training fitness of the
+generation just scored. Without elitism (the paper's GA) the best network is not kept, so gen
+best may drop while the champion stays.
+"""
 
 from __future__ import annotations
 
+import shutil
 import sys
 import time
 from typing import TextIO
@@ -19,21 +28,26 @@ class Progress:
         self.every = every
         self.t0 = time.perf_counter()
 
-    def update(self, generation: int, best: float, mean: float, evals_per_s: float) -> None:
-        """Shows that ``generation`` (0-based) has been scored."""
+    def update(self, generation: int, best: float, mean: float, evals_per_s: float,
+               champion: float | None = None) -> None:
+        """Shows that ``generation`` (0-based) has been scored: its ``best`` and ``mean`` fitness,
+        and the ``champion``'s fitness."""
         done = generation + 1
         elapsed = time.perf_counter() - self.t0
         rate = (done - self.start) / elapsed if elapsed > 0 else 0.0
         eta = (self.total - done) / rate if rate > 0 else 0.0
-        width = 24
+        width = 10
         filled = int(width * done / self.total)
         bar = "#" * filled + "-" * (width - filled)
+        held = f"  champion {champion:.4f}" if champion is not None else ""
         line = (
-            f"[{bar}] gen {done}/{self.total}  best {best:.4f}  mean {mean:.4f}  "
+            f"[{bar}] gen {done}/{self.total}{held}  gen best {best:.4f}  gen mean {mean:.4f}  "
             f"{evals_per_s:,.0f} evals/s  ETA {clock(eta)}"
         )
         if self.tty:
-            self.stream.write("\r" + line + "\x1b[K")
+            # Cut to the terminal's width: a line that wraps cannot be redrawn in place.
+            columns = shutil.get_terminal_size().columns
+            self.stream.write("\r" + line[:max(columns - 1, 20)] + "\x1b[K")
             self.stream.flush()
         elif done % self.every == 0 or done == self.total:
             self.stream.write(line + "\n")

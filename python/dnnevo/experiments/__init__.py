@@ -1,3 +1,2 @@
-"""Above the tasks: named presets (:mod:`.presets`), sweeps over seeds (:mod:`.sweep`), and the
-reproduction of the whole paper (:mod:`.plan`, :mod:`.jobs`, :mod:`.scheduler`, :mod:`.runsview`,
-:mod:`.report`)."""
+"""Above the tasks: sweeps over seeds (:mod:`.sweep`) and the reproduction of the whole paper
+(:mod:`.plan`, :mod:`.jobs`, :mod:`.scheduler`, :mod:`.runsview`, :mod:`.report`)."""

@@ -26,7 +26,7 @@ from typing import Any
 from dnnevo import tasks
 from dnnevo.tasks import nav1d
 from dnnevo.experiments import plan
-from dnnevo.experiments import presets
+from dnnevo import presets
 from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
 from dnnevo.evaluation.assessment import Assessment

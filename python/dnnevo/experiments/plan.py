@@ -18,7 +18,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-from dnnevo.errors import ConfigError
+from dnnevo.errors import ConfigError, did_you_mean
 
 __all__ = ["FAMILIES", "EXPERIMENTS", "Experiment", "Job", "jobs", "experiment"]
 
@@ -135,7 +135,8 @@ def experiment(name: str) -> Experiment:
     for e in EXPERIMENTS:
         if e.name == name:
             return e
-    raise ConfigError(f"unknown experiment {name!r}; experiments: {', '.join(e.name for e in EXPERIMENTS)}")
+    known = [e.name for e in EXPERIMENTS]
+    raise ConfigError(f"unknown experiment {name!r}{did_you_mean(name, known)}; experiments: {', '.join(known)}")
 
 
 @dataclass(frozen=True)

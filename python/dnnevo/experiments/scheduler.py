@@ -31,12 +31,10 @@ import os
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from dnnevo.errors import ConfigError, DnnevoError
-
-if TYPE_CHECKING:
-    from dnnevo.experiments.runsview import RunsView
+from dnnevo.experiments.runsview import RunsView
 
 __all__ = ["CLUSTER_EXTRA", "Outcome", "Task", "check_options", "dask_client", "describe", "run_in_process", "run_on_dask"]
 

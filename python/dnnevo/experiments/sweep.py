@@ -37,6 +37,8 @@ from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.evolution.evolve import evolve
+from dnnevo.evolution.evolve import resume as resume_run
 from dnnevo.evolution.seeding import Seeding
 from dnnevo.evaluation.stats import Verdict
 from dnnevo.evaluation.stepcheck import StepCheck, step_check
@@ -134,9 +136,6 @@ def run_seed(
     run made with fewer generations than ``config`` and otherwise the same config is extended to
     ``config.generations`` (as ``dnnevo resume --generations``). ``progress`` shows the run's
     progress bar."""
-    from dnnevo.evolution.evolve import evolve
-    from dnnevo.evolution.evolve import resume as resume_run
-
     t0 = time.perf_counter()
     if resume:
         found, table = RunDir(out).read_config()

@@ -5,10 +5,11 @@ A run folder holds:
 
 - ``config.toml``: the complete, resolved config, with the seed and the dnnevo version;
 - ``log.csv``: one row per generation (rewritten at most every second, and at every
-  checkpoint, so it may trail the run by a second): best, mean, std and min fitness; whether the
-  champion so far meets the task's success criterion on fresh conditions (1 or 0, ``nan`` when
-  the task has none); the champion's validation rate and score (``nan`` when it was chosen by
-  training fitness); evaluations per second and elapsed seconds;
+  checkpoint, so it may trail the run by a second): the generation (an integer), the generation's
+  best, mean, std and min fitness; whether the champion so far meets the task's success
+  criterion on fresh conditions (1 or 0, ``nan`` when the task has none); the champion's
+  validation rate and score (``nan`` when it was chosen by training fitness); evaluations per
+  second and elapsed seconds;
 - ``best.json``: the champion in the ``dnnevo-network`` format, with meta;
 - ``checkpoint.json``: the GA state, the history and a digest of the complete run config, enough
   to continue bit for bit (written at generation 0, before anything else, so a folder is
@@ -37,13 +38,12 @@ import tempfile
 import tomllib
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from dnnevo._core import Network
 from dnnevo.config import LATER_SETTINGS, EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError, FormatError
 
-if TYPE_CHECKING:
-    from dnnevo._core import Network
 
 __all__ = [
     "LOG_COLUMNS",
@@ -70,6 +70,9 @@ LOG_COLUMNS = (
 )
 #: Columns a history from before they existed may lack (those generations have no value).
 OPTIONAL_COLUMNS = ("champion_success", "validation_rate", "validation_score")
+#: Columns log.csv writes as integers (``7``, not ``7.0``; ``nan`` stays ``nan``). Files written
+#: before, with ``7.0``, read the same.
+INTEGER_COLUMNS = ("generation", "champion_success")
 CHECKPOINT_FORMAT = "dnnevo-checkpoint"
 #: Version 2 added the run table and the config digest; version 1 is still read.
 CHECKPOINT_VERSION = 2
@@ -300,6 +303,14 @@ def _history_rows(path: Path, history: Any) -> list[dict[str, float]]:
     return rows
 
 
+def _cell(column: str, value: float) -> str:
+    """One value of log.csv: an integer column's whole numbers as integers, any other number as
+    ``repr`` writes it (which reads back to the same bits)."""
+    if column in INTEGER_COLUMNS and value.is_integer():
+        return str(int(value))
+    return repr(value)
+
+
 class Checkpoint:
     """A validated checkpoint: the GA state, the history and the run table."""
 
@@ -409,7 +420,7 @@ class RunDir:
     def write_log(self, history: list[dict[str, float]]) -> None:
         """Rewrites ``log.csv`` from the whole history (atomic, so never torn)."""
         lines = [",".join(LOG_COLUMNS)]
-        lines += [",".join(repr(float(row.get(k, "nan"))) for k in LOG_COLUMNS) for row in history]
+        lines += [",".join(_cell(k, float(row.get(k, "nan"))) for k in LOG_COLUMNS) for row in history]
         write_atomic(self.log, "\n".join(lines) + "\n")
 
     def write_checkpoint(self, state: dict[str, Any], history: list[dict[str, float]],
@@ -529,8 +540,6 @@ class RunDir:
     def read_best(self, config: EvolutionConfig, run: Mapping[str, Any] | None = None) -> Network:
         """``best.json``, which must be a network of the run's size and inputs, and, when its
         meta says, of the run's task and seed."""
-        from dnnevo._core import Network
-
         path = self.best
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")

@@ -205,7 +205,7 @@ def _animate(rec: Record, classifier: int, path: Any) -> None:
     The figure is drawn once; each frame redraws only the three moving artists over a copy of
     it, as matplotlib's blitting does, which is many times quicker than drawing every frame whole.
     """
-    from PIL import Image
+    from PIL import Image  # here, not at the top: only a GIF needs Pillow (matplotlib's own dependency)
 
 
     fig, (top, trace) = plot.subplots(2, 1, figsize=(6, 6.5), height_ratios=[3, 1],
@@ -278,9 +278,8 @@ def plot_world(
 ) -> Axes:
     """A top-down view of a landmark trial: the room's walls, the boxes, the robot's path (start
     marked) and where the sonar's echoes landed."""
-    from matplotlib.patches import Rectangle
-
     ax = plot.axes(ax)
+    Rectangle = plot.pyplot().Rectangle
     w, h = record.world["room"]
     ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2.5, color="0.2"))
     for box in record.world["boxes"]:

@@ -14,7 +14,7 @@ reached, or the environment classified right: ``f(v_C) >= 0.5`` means landmark-n
 
 >>> import dnnevo
 >>> from dnnevo.tasks import nav1d
->>> from dnnevo.experiments import presets
+>>> from dnnevo import presets
 >>> config = presets.get("nav1d-far")
 >>> a, b = nav1d.cases(config)[:2]
 >>> (a.environment, a.goal, a.landmark, b.goal, b.landmark)

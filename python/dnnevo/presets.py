@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from dnnevo.config import EvolutionConfig, apply_overrides
-from dnnevo.errors import ConfigError
+from dnnevo.errors import ConfigError, did_you_mean
 
 __all__ = ["Preset", "get", "names", "PRESETS"]
 
@@ -214,7 +214,8 @@ def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -
     try:
         preset = PRESETS[name]
     except KeyError:
-        raise ConfigError(f"unknown preset {name!r}; presets: {', '.join(names())}") from None
+        raise ConfigError(f"unknown preset {name!r}{did_you_mean(name, names())}; "
+                          f"presets: {', '.join(names())}") from None
     config = preset.config
     if quick:
         config = EvolutionConfig.from_dict({**config.to_dict(), **preset.quick})

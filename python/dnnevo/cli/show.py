@@ -1,0 +1,113 @@
+"""The ``dnnevo show`` command, and the outcome of a run that ``run``, ``resume`` and ``show`` all
+print, in the same words:
+
+- the **champion**: the run's best network so far, the one ``best.json`` holds, with its training
+  fitness and the generation it was scored in, and, when the task has validation trials, its
+  validation rate and score (log.csv's ``validation_rate`` and ``validation_score``), by which it
+  was chosen;
+- the **success rule**: whether, and from which generation, the champion met the task's success
+  rule on fresh trials during the run (log.csv's ``champion_success``);
+- **gen best** and **gen mean**: the training fitness of one generation (log.csv's ``best`` and
+  ``mean``); without elitism the best network is not kept, so gen best may drop while the
+  champion stays;
+- the **next** command.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dnnevo.config import EvolutionConfig
+from dnnevo.evolution.evolve import PYTHON_TASK
+from dnnevo.runs.rundir import RunDir, save_figure
+
+__all__ = ["champion_line", "next_line", "outcome", "show", "success_line"]
+
+
+def champion_line(fitness: float | None, generation: int | None,
+                  validation: tuple[float, float] | None) -> str:
+    """``champion (best.json): fitness 0.8621 (generation 0); validation rate 1.000, score 0.8554``."""
+    if fitness is None or generation is None:
+        return "champion (best.json): no fitness recorded in its meta"
+    text = f"champion (best.json): fitness {fitness:.4f} (generation {generation})"
+    if validation is not None:
+        text += f"; validation rate {validation[0]:.3f}, score {validation[1]:.4f}"
+    return text
+
+
+def success_line(task: str, success: Sequence[float]) -> str:
+    """Whether the champion met the task's success rule during the run, from log.csv's
+    ``champion_success`` column (one value per generation: 1, 0 or nan)."""
+    if task.startswith(PYTHON_TASK):
+        return "success rule: none (a Python fitness function has no success rule)"
+    judged = [s for s in success if not math.isnan(s)]
+    if not judged:
+        return "success rule: not checked in this run (champion_success is nan in log.csv)"
+    met = [g for g, s in enumerate(success) if s == 1.0]
+    if not met:
+        n = len(success)
+        return (f"success rule: not met in {n} generation{'s' * (n != 1)} (the champion failed it "
+                "on fresh trials)")
+    if success[-1] == 1.0:
+        return f"success rule: met at generation {met[0]} (the champion passed it on fresh trials)"
+    return (f"success rule: met at generation {met[0]}, but the final champion fails it on fresh "
+            "trials")
+
+
+def next_line(path: Path, config: EvolutionConfig, done: int, *, interrupted: bool = False) -> str | None:
+    """The command to run next on the run folder ``path`` after ``done`` generations, or None
+    for a Python fitness function's run, which the command line can neither resume nor judge."""
+    if config.task.startswith(PYTHON_TASK):
+        return None
+    judge = f"dnnevo evaluate {path}"
+    if interrupted or done < config.generations:
+        return (f"next: dnnevo resume {path} to run the rest of its {config.generations} generations, "
+                f"or {judge} to judge the champion so far")
+    return f"next: {judge}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
+
+
+def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
+            success: Sequence[float], *, interrupted: bool = False) -> list[str]:
+    """The champion, the success rule and the next command, as ``run``, ``resume`` and ``show``
+    end. ``champion`` is best.json's meta (``fitness``, ``generation`` and, when validated,
+    ``validation_rate`` and ``validation_score``)."""
+    validation = None
+    if "validation_rate" in champion and "validation_score" in champion:
+        validation = (float(champion["validation_rate"]), float(champion["validation_score"]))
+    fitness, generation = champion.get("fitness"), champion.get("generation")
+    lines = [champion_line(None if fitness is None else float(fitness),
+                           None if generation is None else int(generation), validation),
+             success_line(config.task, success)]
+    step = next_line(path, config, len(success), interrupted=interrupted)
+    return lines if step is None else [*lines, step]
+
+
+def show(args: argparse.Namespace) -> int:
+    """``dnnevo show``: the run's size and time, its champion, the success rule, the last
+    generation, and fitness.png."""
+    run = RunDir(args.dir)
+    config, table = run.read_config()
+    history = run.read_log(config)
+    champion = run.read_best(config, table)
+    last = history[-1]
+    print(f"{args.dir}: task {config.task}, population {config.population}, "
+          f"{len(history)}/{config.generations} generations, {last['elapsed_s']:.1f} s")
+    lines = outcome(args.dir, config, champion.meta, [r["champion_success"] for r in history])
+    print("\n".join(lines[:2]))
+    print(f"last generation ({int(last['generation'])}): gen best {last['best']:.4f}, "
+          f"gen mean {last['mean']:.4f}")
+    from dnnevo.plot import plot_fitness
+
+    arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
+    ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
+    save_figure(ax.figure, run.path / "fitness.png")
+    print(f"wrote {run.path / 'fitness.png'}")
+    for line in lines[2:]:
+        print(line)
+    return 0

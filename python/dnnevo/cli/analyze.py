@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from dnnevo import _core, analysis, plot
+from dnnevo import _core, analysis, plot, tasks
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
@@ -36,17 +36,6 @@ and nullclines for 2 neurons), analysis-bifurcation.png (the firing rate of the 
 equilibria move most), analysis-basins.png (the recorded trials over time, on a background that
 says which attractor of the first --input the state would settle in if that input were held
 from then on) and analysis-lesions.png."""
-
-TASK_INPUTS: dict[str, dict[str, list[float]]] = {
-    "sequence": {"off": [0.0, 0.0], "trigger": [1.0, 0.0], "reinforcement": [0.0, 1.0]},
-    "landmark": {"off": [0.0], "sonar 1": [1.0]},
-    "nav1d": {"off": [0.0, 0.0], "landmark": [1.0, 0.0], "reinforcement": [0.0, 1.0]},
-}
-"""The default input conditions per task (nav1d networks without a reinforcement input use the
-first value of each)."""
-
-MAIN_INPUT = {"sequence": (1, "reinforcement"), "landmark": (0, "sonar input"), "nav1d": (0, "landmark")}
-"""The input a sweep varies by default, per task: the one the task's behaviour turns on."""
 
 DEFAULT_LESION_TRIALS = 200
 
@@ -105,8 +94,9 @@ def analyze(args: argparse.Namespace) -> int:
     config, raw = run.read_config()
     net = run.read_best(config, raw)
     m = net.n_inputs
-    if config.task not in TASK_INPUTS:
-        raise ConfigError(f"task {config.task!r} has no analysis defaults; tasks with one: {', '.join(TASK_INPUTS)}")
+    task = tasks.find(config.task)
+    if task is None:
+        raise ConfigError(f"task {config.task!r} has no analysis defaults; tasks with one: {', '.join(tasks.names())}")
     if args.steps < 2:
         raise InvalidArgumentError(f"--steps is {args.steps}; a sweep needs at least 2 input values")
     if args.trials < 1:
@@ -116,7 +106,7 @@ def analyze(args: argparse.Namespace) -> int:
     if args.input:
         conditions = {text: _vector(text, "--input") for text in args.input}
     else:
-        conditions = {name: v[:m] for name, v in TASK_INPUTS[config.task].items()}
+        conditions = {name: v[:m] for name, v in task.ANALYSIS_CONDITIONS.items()}
     for name, v in conditions.items():
         if len(v) != m:
             raise InvalidArgumentError(f"--input {name} has {len(v)} values; this network has {m} sensors")
@@ -131,7 +121,7 @@ def analyze(args: argparse.Namespace) -> int:
         order = np.argsort(-outputs.var(axis=0), kind="stable")
         neurons = (int(order[0]), int(order[1])) if net.size > 1 else (0, 0)
 
-    index, name = MAIN_INPUT[config.task]
+    index, name = task.MAIN_INPUT, task.INPUT_NAMES[task.MAIN_INPUT]
     if args.sweep_input is not None:
         if not 0 <= args.sweep_input < m:
             raise InvalidArgumentError(f"--sweep-input is {args.sweep_input}; this network's inputs are 0..{m - 1}")
@@ -184,21 +174,13 @@ def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifu
     return written
 
 
-OUTPUT_NEURON = {"sequence": 0, "landmark": 0, "nav1d": 2}
-"""The neuron whose firing rate is the task's answer, by default (``task_params.classifier``
-overrides it for landmark and nav1d, as in ``crates/tasks``)."""
-
-
 def output_neuron(config: EvolutionConfig) -> int:
     """The neuron whose firing rate is ``config``'s task's answer."""
-    return int(config.task_params.get("classifier", OUTPUT_NEURON[config.task]))
+    return int(config.task_params.get("classifier", tasks.get(config.task).OUTPUT_NEURON))
 
 
 BASIN_STATES = 1500
 """The most trial steps whose basin is computed; longer recordings are subsampled evenly."""
-
-INPUT_NAMES = {"sequence": ["trigger", "reinforcement"], "landmark": ["sonar input"],
-               "nav1d": ["landmark", "reinforcement"]}
 
 
 def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.ndarray, np.ndarray]],
@@ -216,7 +198,7 @@ def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.nd
     every, which = basins
     outputs = np.vstack([o for o, _ in trials])[::every]
     inputs = np.vstack([i for _, i in trials])[::every]
-    names = INPUT_NAMES[config.task]
+    names = tasks.get(config.task).INPUT_NAMES
     starts = np.cumsum([0] + [len(o) for o, _ in trials])[1:-1] // every
     stable = [e for e in off.equilibria if e.stable]
     neuron = output_neuron(config)

@@ -27,7 +27,7 @@ from dnnevo import presets
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
 from dnnevo.tasks import DEFAULT_TRIALS
-from dnnevo.errors import ConfigError, DnnevoError
+from dnnevo.errors import DnnevoError
 from dnnevo.runs.rundir import RunDir
 
 EXAMPLES = """examples:

@@ -38,7 +38,7 @@ from dnnevo.runs.rundir import RunDir, save_figure, write_atomic_with
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["DEFAULT_TRIALS", "FRAME_STEPS", "NAME", "ROBOT_LIKE", "THRESHOLD", "UNIT", "Record",
+__all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT", "OUTPUT_NEURON", "FRAME_STEPS", "NAME", "ROBOT_LIKE", "THRESHOLD", "UNIT", "Record",
            "assess", "cast_rays", "default_world", "draw", "evaluate_extra", "extra_lines", "judge",
            "overall", "preface", "rate_column", "record", "recorded_trials"]
 
@@ -58,6 +58,18 @@ UNIT = "trials per landmark"
 
 ROBOT_LIKE = True
 """Landmark recognition has a robot-like test: sonar noise, specular misses, a jittered room."""
+
+INPUT_NAMES = ["sonar input"]
+"""The network's inputs, in order, as the analysis names them."""
+
+ANALYSIS_CONDITIONS: dict[str, list[float]] = {"off": [0.0], "sonar 1": [1.0]}
+"""The constant input conditions ``dnnevo analyze`` finds the attractors of, by default."""
+
+MAIN_INPUT = 0
+"""The input a bifurcation sweep varies by default: the one the task's behaviour turns on."""
+
+OUTPUT_NEURON = 0
+"""The neuron whose firing rate is the task's answer (``task_params.classifier`` overrides it)."""
 
 
 @dataclass(frozen=True)

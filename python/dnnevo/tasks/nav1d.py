@@ -46,7 +46,11 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 __all__ = [
+    "ANALYSIS_CONDITIONS",
     "DEFAULT_TRIALS",
+    "INPUT_NAMES",
+    "MAIN_INPUT",
+    "OUTPUT_NEURON",
     "NAME",
     "ROBOT_LIKE",
     "THRESHOLD",
@@ -92,6 +96,19 @@ UNIT = "chains"
 
 ROBOT_LIKE = False
 """One-dimensional navigation has no robot-like test."""
+
+INPUT_NAMES = ["landmark", "reinforcement"]
+"""The network's inputs, in order, as the analysis names them."""
+
+ANALYSIS_CONDITIONS: dict[str, list[float]] = {"off": [0.0, 0.0], "landmark": [1.0, 0.0], "reinforcement": [0.0, 1.0]}
+"""The constant input conditions ``dnnevo analyze`` finds the attractors of, by default (a network
+    without the reinforcement input uses the first value of each)."""
+
+MAIN_INPUT = 0
+"""The input a bifurcation sweep varies by default: the one the task's behaviour turns on."""
+
+OUTPUT_NEURON = 2
+"""The neuron whose firing rate is the task's answer (``task_params.classifier`` overrides it)."""
 
 CASES = (("far", "left"), ("far", "right"), ("near", "left"), ("near", "right"))
 """The paper's Fig. 2 environments A, B, C and D, in that order."""

@@ -34,6 +34,14 @@ class Task(Protocol):
     """What a trial count counts (trials per target, trials per landmark, chains)."""
     ROBOT_LIKE: bool
     """Whether the task has a robot-like test (``dnnevo evaluate --robot-like``)."""
+    INPUT_NAMES: list[str]
+    """The network's inputs, in order."""
+    ANALYSIS_CONDITIONS: dict[str, list[float]]
+    """The constant input conditions ``dnnevo analyze`` looks at by default."""
+    MAIN_INPUT: int
+    """The input (index into :attr:`INPUT_NAMES`) a bifurcation sweep varies by default."""
+    OUTPUT_NEURON: int
+    """The neuron whose firing rate is the task's answer."""
 
     def judge(self, config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *,
               robot_like: bool = False) -> Assessment:

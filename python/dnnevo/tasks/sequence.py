@@ -26,7 +26,7 @@ from dnnevo.runs.rundir import RunDir, save_figure
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["DEFAULT_TRIALS", "NAME", "ROBOT_LIKE", "SWITCH_AFTER", "SWITCH_HOLD", "SWITCH_TRIALS",
+__all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT", "OUTPUT_NEURON", "NAME", "ROBOT_LIKE", "SWITCH_AFTER", "SWITCH_HOLD", "SWITCH_TRIALS",
            "THRESHOLD", "UNIT", "Switch", "TrialRecord", "assess", "draw", "evaluate_extra",
            "extra_lines", "fig5_pair", "fresh_timings", "judge", "overall", "preface",
            "rate_column", "recorded_trials", "run_trial", "switch_lines", "switch_table", "switch_test",
@@ -48,6 +48,18 @@ UNIT = "trials per target"
 
 ROBOT_LIKE = False
 """Sequence learning has no robot-like test."""
+
+INPUT_NAMES = ["trigger", "reinforcement"]
+"""The network's inputs, in order, as the analysis names them."""
+
+ANALYSIS_CONDITIONS: dict[str, list[float]] = {"off": [0.0, 0.0], "trigger": [1.0, 0.0], "reinforcement": [0.0, 1.0]}
+"""The constant input conditions ``dnnevo analyze`` finds the attractors of, by default."""
+
+MAIN_INPUT = 1
+"""The input a bifurcation sweep varies by default: the one the task's behaviour turns on."""
+
+OUTPUT_NEURON = 0
+"""The neuron whose firing rate is the task's answer (``task_params.classifier`` overrides it)."""
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ import numpy as np
 import dnnevo
 import dnnevo.tasks.sequence
 from dnnevo.evolution.evolve import CHECKPOINT_SECONDS, LOG_SECONDS
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 from _common import describe_machine, load_reference, median_time
 
 TARGET_SHARE = 0.01

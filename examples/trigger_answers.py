@@ -18,7 +18,7 @@ from pathlib import Path
 import dnnevo
 from dnnevo import presets
 from dnnevo.tasks import sequence
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 
 
 def load(run: str, preset: str) -> tuple[dnnevo.EvolutionConfig, dnnevo.Network]:

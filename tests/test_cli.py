@@ -110,7 +110,7 @@ def test_run_show_and_the_progress_bar_name_the_same_champion(tmp_path: Path) ->
     assert r.returncode == 0, r.stderr
     lines = r.stdout.splitlines()
     assert lines[1:3] == [champion, success] and lines[-1] == after, r.stdout
-    from dnnevo.runs.rundir import RunDir
+    from dnnevo.runs import RunDir
 
     row = RunDir(out).read_log()[-1]
     assert lines[3] == f"last generation (1): gen best {row['best']:.4f}, gen mean {row['mean']:.4f}"
@@ -180,7 +180,7 @@ def test_seed_from_composes_champions_and_records_them(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     assert tomllib.loads((tmp_path / "d" / "config.toml").read_text())["run"]["seeded_with"] == "populations"
     import dnnevo as dn
-    from dnnevo.runs.rundir import RunDir
+    from dnnevo.runs import RunDir
 
     def population(run: Path) -> list[dn.Network]:
         state = RunDir(run).read_checkpoint().state

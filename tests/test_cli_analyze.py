@@ -14,7 +14,7 @@ import dnnevo
 from dnnevo import analysis
 from dnnevo.runs import rundir
 from dnnevo.config import EvolutionConfig
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
 PRESETS = ("sequence-1bit", "nav1d-classifier", "nav1d-single", "landmark")

@@ -23,7 +23,7 @@ from dnnevo import presets
 from dnnevo.tasks import sequence
 from dnnevo.evaluation import stats
 from dnnevo.config import EvolutionConfig
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 
 TINY = ["--quick", "--set", "generations=1", "--set", "population=10"]
 

@@ -252,7 +252,7 @@ def test_creep_mutation_runs_deterministically_and_differs_from_uniform() -> Non
 def test_settings_added_later_leave_old_digests_unchanged() -> None:
     """A folder written before ``mutation`` existed carries a digest of a config without it."""
     from dnnevo.config import LATER_SETTINGS
-    from dnnevo.runs.rundir import config_digest
+    from dnnevo.runs import config_digest
 
     config = EvolutionConfig()
     old = {k: v for k, v in config.to_dict().items() if k not in LATER_SETTINGS}

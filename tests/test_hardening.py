@@ -26,7 +26,7 @@ from cli_helpers import assert_one_line_error, run_cli
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 
 FULL = os.environ.get("DNNEVO_FULL_HARDENING") == "1"
 SMALL = ["--set", "population=12", "--set", "generations=6"]

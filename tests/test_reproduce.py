@@ -26,7 +26,7 @@ from dnnevo.experiments import report
 from dnnevo.experiments import runsview
 from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError
-from dnnevo.runs.rundir import RunFileError
+from dnnevo.runs import RunFileError
 
 QUICK = jobs.Settings(quick=True, eval_trials=10, dt_check=False)
 

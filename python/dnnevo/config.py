@@ -28,7 +28,7 @@ them, and every value is checked there (:meth:`EvolutionConfig.__post_init__`), 
 cannot drift. Python checks types only."""
 
 #: Settings added after run folders began to carry a config digest. At their defaults they are
-#: left out of the digest (``rundir.config_digest``), and a stored config without them reads as
+#: left out of the digest (``dnnevo.runs.config_digest``), and a stored config without them reads as
 #: having their defaults (:func:`with_later_defaults`), so folders written before them still resume.
 LATER_SETTINGS = ("mutation", "mutation_scale", "champion_step_check")
 

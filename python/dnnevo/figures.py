@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from dnnevo import plot, tasks
-from dnnevo.runs.rundir import RunDir, save_figure
+from dnnevo.runs import RunDir, save_figure
 
 __all__ = ["draw_run"]
 

@@ -16,7 +16,7 @@ from dnnevo import _core, analysis, plot, tasks
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
-from dnnevo.runs.rundir import RunDir, save_figure, write_atomic
+from dnnevo.runs import RunDir, save_figure, write_atomic
 
 EXAMPLE = """examples:
   dnnevo run sequence-1bit --quick --out runs/demo && dnnevo analyze runs/demo

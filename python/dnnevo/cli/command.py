@@ -28,7 +28,7 @@ from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
 from dnnevo.tasks import DEFAULT_TRIALS
 from dnnevo.errors import DnnevoError
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 
 EXAMPLES = """examples:
   dnnevo presets                                   list the experiments

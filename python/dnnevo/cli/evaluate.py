@@ -16,7 +16,7 @@ from dnnevo import tasks
 from dnnevo.evaluation.assessment import Assessment, Rate
 from dnnevo.evaluation.stats import Verdict
 from dnnevo.errors import ConfigError
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 from dnnevo.evaluation.stepcheck import StepCheck, step_check, with_dt
 
 EXAMPLE = """examples:

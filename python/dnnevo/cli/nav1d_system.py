@@ -11,7 +11,7 @@ from typing import Any
 
 from dnnevo.errors import ConfigError
 from dnnevo.evaluation.stats import wilson
-from dnnevo.runs.rundir import write_atomic
+from dnnevo.runs import write_atomic
 from dnnevo.tasks import nav1d
 
 SYSTEM_EXAMPLE = (

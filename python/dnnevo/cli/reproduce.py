@@ -18,7 +18,7 @@ from dnnevo.experiments import plan
 from dnnevo.experiments import report
 from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.runs.rundir import LOCK_NAME, RunDir, check_settings, write_atomic
+from dnnevo.runs import LOCK_NAME, RunDir, check_settings, write_atomic
 from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "reproduce.json"

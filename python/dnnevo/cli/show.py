@@ -25,7 +25,7 @@ import numpy as np
 
 from dnnevo.config import EvolutionConfig
 from dnnevo.evolution.evolve import PYTHON_TASK
-from dnnevo.runs.rundir import RunDir, save_figure
+from dnnevo.runs import RunDir, save_figure
 
 __all__ = ["champion_line", "next_line", "outcome", "show", "success_line"]
 

@@ -20,7 +20,7 @@ from dnnevo._checks import nonnegative
 from dnnevo.tasks import DEFAULT_TRIALS, UNITS
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.runs.rundir import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
+from dnnevo.runs import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
 from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "sweep.json"

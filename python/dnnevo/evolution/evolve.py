@@ -29,7 +29,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError, did_you_mean
 from dnnevo.evolution.ga import GeneticAlgorithm
 from dnnevo.evolution.progress import Progress
-from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short
+from dnnevo.runs import RunDir, RunFileError, first_difference, short
 
 __all__ = ["EvolutionResult", "evaluate", "evolve", "resume"]
 

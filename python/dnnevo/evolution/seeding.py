@@ -35,7 +35,7 @@ from typing import Any
 from dnnevo import _core
 from dnnevo.errors import ConfigError
 from dnnevo.evolution.ga import GeneticAlgorithm
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 
 __all__ = ["SPARE_SEED_STRIDE", "Seeding", "add_arguments"]
 

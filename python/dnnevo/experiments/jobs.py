@@ -8,7 +8,7 @@ is ``EXPERIMENT/seed-N.json``, written atomically when the job is done. :func:`r
   run's bits are those of an uninterrupted run;
 - starts afresh a folder that holds no checkpoint yet.
 
-Every result file is checked when read: a malformed one is a :class:`~dnnevo.runs.rundir.RunFileError`
+Every result file is checked when read: a malformed one is a :class:`~dnnevo.runs.RunFileError`
 naming it, and one written under other settings is refused.
 
 The function is what a Dask worker runs, so it takes and returns plain data.
@@ -32,7 +32,7 @@ from dnnevo.experiments import sweep
 from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError
-from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.runs import RunDir, RunFileError, first_difference, short, write_atomic
 from dnnevo.evolution.seeding import Seeding
 
 __all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "Settings", "Stopped", "result_path", "read_result", "run_job"]

@@ -26,7 +26,7 @@ from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
 from dnnevo.evaluation.assessment import Assessment
 from dnnevo.experiments.jobs import ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings
-from dnnevo.runs.rundir import save_figure, write_atomic
+from dnnevo.runs import save_figure, write_atomic
 from dnnevo.experiments.scheduler import Outcome
 
 __all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "SUMMARY_HEADER",
@@ -156,7 +156,7 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
     from dnnevo import figures
     from dnnevo.tasks import nav1d
     from dnnevo.plot import plot_fitness_seeds
-    from dnnevo.runs.rundir import RunDir
+    from dnnevo.runs import RunDir
 
     done = [j for j in order if j.experiment == e.name and outcomes[j.id].status == "done"]
     if not done:

@@ -36,7 +36,7 @@ from dnnevo.evaluation import stats
 from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
-from dnnevo.runs.rundir import RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.runs import RunDir, RunFileError, first_difference, short, write_atomic
 from dnnevo.evolution.evolve import evolve
 from dnnevo.evolution.evolve import resume as resume_run
 from dnnevo.evolution.seeding import Seeding

@@ -28,54 +28,26 @@ from __future__ import annotations
 import contextlib
 import csv
 import fcntl
-import hashlib
 import io
 import json
 import math
 import os
 import re
-import tempfile
 import tomllib
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
 from dnnevo._core import Network
-from dnnevo.config import LATER_SETTINGS, EvolutionConfig, with_later_defaults
+from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FormatError
+from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
+from dnnevo.runs.files import FILE_MODE, RunFileError, fail, load_json, read_text, short, write_atomic
+from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, log_cell, history_rows
+from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth
 
+__all__ = ["FIGURES", "LOCK_NAME", "RUN_FILES", "RunDir"]
 
-__all__ = [
-    "LOG_COLUMNS",
-    "RunDir",
-    "RunFileError",
-    "config_digest",
-    "first_difference",
-    "save_figure",
-    "short",
-    "write_atomic",
-]
-
-LOG_COLUMNS = (
-    "generation",
-    "best",
-    "mean",
-    "std",
-    "min",
-    "champion_success",
-    "validation_rate",
-    "validation_score",
-    "evals_per_s",
-    "elapsed_s",
-)
-#: Columns a history from before they existed may lack (those generations have no value).
-OPTIONAL_COLUMNS = ("champion_success", "validation_rate", "validation_score")
-#: Columns log.csv writes as integers (``7``, not ``7.0``; ``nan`` stays ``nan``). Files written
-#: before, with ``7.0``, read the same.
-INTEGER_COLUMNS = ("generation", "champion_success")
-CHECKPOINT_FORMAT = "dnnevo-checkpoint"
-#: Version 2 added the run table and the config digest; version 1 is still read.
-CHECKPOINT_VERSION = 2
 LOCK_NAME = ".dnnevo.lock"
 RUN_FILES = ("config.toml", "log.csv", "best.json", "checkpoint.json")
 #: Every file ``show``, ``plot`` and ``analyze`` derive from a run; ``--force`` removes them with
@@ -98,229 +70,6 @@ FIGURES = (
 #: Temporary files of atomic writes: ``.NAME.RANDOM.tmp`` (Python, Rust), optionally with the
 #: final name's extension after it, and ``.NAME.tmpPID`` (Rust before version 0.1.1).
 _TEMP = re.compile(r"^\.(?P<name>.+)\.(?:[A-Za-z0-9_]{8,16}\.tmp(?:\.[a-z]+)?|tmp\d+)$")
-
-
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-#: Files are created with mode 0666 & ~umask, as ``open()`` and Rust's ``File::create`` do.
-FILE_MODE = 0o666 & ~_umask()
-
-
-class RunFileError(DnnevoError):
-    """A file of a run folder is missing, damaged or disagrees with the others."""
-
-
-def _fail(path: Path, problem: str) -> RunFileError:
-    return RunFileError(f"{path}: {problem}")
-
-
-# -- writing --------------------------------------------------------------------------------
-
-
-def write_atomic_with(path: Path, write: Callable[[str], None], *, suffix: str = "") -> None:
-    """Calls ``write(tmp)`` on a new, exclusively created temporary file beside ``path`` (named
-    ``.NAME.RANDOM.tmp`` + ``suffix``), syncs it and renames it over ``path``. The rename replaces
-    a symlink at ``path``; it never writes through one."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{suffix}")
-    try:
-        os.fchmod(fd, FILE_MODE)
-        os.close(fd)
-        write(tmp)
-        with open(tmp, "rb+") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def write_atomic(path: Path, text: str) -> None:
-    """Writes ``text`` to a temporary file beside ``path``, syncs it, and renames it into place."""
-
-    def write(tmp: str) -> None:
-        with open(tmp, "w", encoding="utf-8") as f:
-            f.write(text)
-
-    write_atomic_with(path, write)
-
-
-def save_figure(fig: Any, path: Path, *, dpi: int = 120) -> None:
-    """Saves a matplotlib figure as ``path`` (PNG) atomically."""
-    write_atomic_with(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png"))
-
-
-def config_digest(config: EvolutionConfig, seed: int) -> str:
-    """SHA-256 of the complete run config (every setting and the seed), as canonical JSON."""
-    settings = config.to_dict()
-    defaults = EvolutionConfig()
-    for name in LATER_SETTINGS:
-        if getattr(config, name) == getattr(defaults, name):
-            del settings[name]
-    doc = {"config": settings, "seed": seed}
-    text = json.dumps(doc, sort_keys=True, separators=(",", ":"), allow_nan=False)
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def first_difference(a: Any, b: Any, prefix: str = "") -> tuple[str, Any, Any] | None:
-    """The first field (dotted name) where two config dicts differ, with both values; numbers
-    compare by value (1 equals 1.0), and ``None`` means they agree."""
-    if isinstance(a, Mapping) and isinstance(b, Mapping):
-        for key in [*a, *(k for k in b if k not in a)]:
-            name = f"{prefix}.{key}" if prefix else str(key)
-            if key not in a or key not in b:
-                return name, a.get(key, "(missing)"), b.get(key, "(missing)")
-            found = first_difference(a[key], b[key], name)
-            if found is not None:
-                return found
-        return None
-    same = a == b and isinstance(a, bool) == isinstance(b, bool)
-    return None if same else (prefix, a, b)
-
-
-#: The deepest nesting of tables and arrays accepted in config.toml (a run's own is 3 deep).
-MAX_CONFIG_DEPTH = 16
-
-
-def check_settings(manifest: Path, settings: dict[str, Any], *, what: str, force: bool = True) -> None:
-    """The settings file ``manifest`` of a folder of several runs (a ``what``, e.g. "sweep") must
-    hold ``settings``; else a one-line :class:`ConfigError` naming the first that differs, or a
-    :class:`RunFileError` when the file is unreadable. ``force``: the command has ``--force``."""
-    again = ", or pass --force" if force else ""
-    try:
-        found = json.loads(manifest.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise RunFileError(f"{manifest}: unreadable ({e}); choose another --out{again}") from None
-    if not isinstance(found, dict):
-        raise RunFileError(f"{manifest}: expected a JSON object of settings; choose another --out{again}")
-    if "config" in found:
-        found = {**found, "config": with_later_defaults(found["config"])}
-    diff = first_difference(found, json.loads(json.dumps(settings)))
-    if diff is not None:
-        raise ConfigError(
-            f"{manifest.parent} holds a {what} with {diff[0]} = {short(diff[1])}, not {short(diff[2])}; "
-            f"run the same command to continue it, or choose another --out{again}")
-
-
-def _depth(value: Any) -> int:
-    """How deeply ``value`` nests lists and dicts, without recursion."""
-    deepest, stack = 0, [(value, 0)]
-    while stack:
-        v, d = stack.pop()
-        if isinstance(v, dict | list):
-            deepest = max(deepest, d + 1)
-            if deepest > MAX_CONFIG_DEPTH:
-                return deepest
-            stack.extend((x, d + 1) for x in (v.values() if isinstance(v, dict) else v))
-    return deepest
-
-
-# -- reading --------------------------------------------------------------------------------
-
-
-def _read_text(path: Path) -> str:
-    if path.is_symlink() or not path.is_file():
-        problem = "is a symlink" if path.is_symlink() else "is missing or not a file"
-        raise _fail(path, problem)
-    data = path.read_bytes()
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as e:
-        raise _fail(path, f"is not UTF-8 text (byte {e.start})") from None
-
-
-def _load_json(path: Path, text: str) -> Any:
-    try:
-        return json.loads(text)
-    except RecursionError:
-        raise _fail(path, "JSON nested too deeply") from None
-    except ValueError as e:
-        raise _fail(path, f"not valid JSON: {e}") from None
-
-
-def _number(path: Path, where: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise _fail(path, f"{where} is {short(value)}; expected a number")
-    return float(value)
-
-
-def short(value: Any) -> str:
-    """``repr(value)``, cut to 40 characters."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
-def check_history(path: Path, rows: list[dict[str, float]], *, what: str = "generation") -> None:
-    """The rules every history obeys, in checkpoint.json and log.csv alike: rows of generations
-    0, 1, 2, ... in order; finite fitness statistics, std >= 0, min <= best; success 0, 1 or NaN;
-    a validation rate in [0, 1] and a finite score, or both NaN; evaluations per second finite
-    and >= 0; elapsed seconds finite, >= 0 and never decreasing."""
-    elapsed = 0.0
-    for i, row in enumerate(rows):
-        at = f"{what} row {i + 1}"
-        if row["generation"] != i:
-            raise _fail(path, f"{at} has generation {row['generation']:g}; expected {i}")
-        for k in ("best", "mean", "std", "min", "evals_per_s", "elapsed_s"):
-            if not math.isfinite(row[k]):
-                raise _fail(path, f"{at}: {k} is {row[k]}; expected a finite number")
-        if row["std"] < 0 or row["evals_per_s"] < 0 or row["elapsed_s"] < 0:
-            raise _fail(path, f"{at}: std, evals_per_s and elapsed_s must be >= 0")
-        if row["min"] > row["best"]:
-            raise _fail(path, f"{at}: min {row['min']} exceeds best {row['best']}")
-        success = row["champion_success"]
-        if not (math.isnan(success) or success in (0.0, 1.0)):
-            raise _fail(path, f"{at}: champion_success is {success}; expected 0, 1 or nan")
-        rate, score = row["validation_rate"], row["validation_score"]
-        if math.isnan(rate) != math.isnan(score) or not (
-                math.isnan(rate) or (0.0 <= rate <= 1.0 and math.isfinite(score))):
-            raise _fail(path, f"{at}: validation_rate {rate} and validation_score {score} "
-                              "must be a rate in [0, 1] and a finite score, or both nan")
-        if row["elapsed_s"] < elapsed:
-            raise _fail(path, f"{at}: elapsed_s goes back in time ({row['elapsed_s']} < {elapsed})")
-        elapsed = row["elapsed_s"]
-
-
-def _history_rows(path: Path, history: Any) -> list[dict[str, float]]:
-    if not isinstance(history, list):
-        raise _fail(path, f"history is {type(history).__name__}; expected a list")
-    rows = []
-    for i, raw in enumerate(history):
-        if not isinstance(raw, dict):
-            raise _fail(path, f"history[{i}] is {type(raw).__name__}; expected an object")
-        unknown = sorted(set(raw) - set(LOG_COLUMNS))
-        if unknown:
-            raise _fail(path, f"history[{i}] has unknown key {unknown[0]!r}")
-        row = {}
-        for k in LOG_COLUMNS:
-            if k not in raw and k not in OPTIONAL_COLUMNS:
-                raise _fail(path, f"history[{i}] has no {k!r}")
-            row[k] = _number(path, f"history[{i}].{k}", raw.get(k, math.nan))
-        rows.append(row)
-    check_history(path, rows, what="history")
-    return rows
-
-
-def _cell(column: str, value: float) -> str:
-    """One value of log.csv: an integer column's whole numbers as integers, any other number as
-    ``repr`` writes it (which reads back to the same bits)."""
-    if column in INTEGER_COLUMNS and value.is_integer():
-        return str(int(value))
-    return repr(value)
-
-
-class Checkpoint:
-    """A validated checkpoint: the GA state, the history and the run table."""
-
-    def __init__(self, state: dict[str, Any], history: list[dict[str, float]],
-                 run: dict[str, Any] | None, config: EvolutionConfig) -> None:
-        self.state = state
-        self.history = history
-        self.run = run
-        """The ``[run]`` table (seed, version, ...); None in a version-1 checkpoint."""
-        self.config = config
 
 
 class RunDir:
@@ -420,7 +169,7 @@ class RunDir:
     def write_log(self, history: list[dict[str, float]]) -> None:
         """Rewrites ``log.csv`` from the whole history (atomic, so never torn)."""
         lines = [",".join(LOG_COLUMNS)]
-        lines += [",".join(_cell(k, float(row.get(k, "nan"))) for k in LOG_COLUMNS) for row in history]
+        lines += [",".join(log_cell(k, float(row.get(k, "nan"))) for k in LOG_COLUMNS) for row in history]
         write_atomic(self.log, "\n".join(lines) + "\n")
 
     def write_checkpoint(self, state: dict[str, Any], history: list[dict[str, float]],
@@ -445,27 +194,27 @@ class RunDir:
         path = self.config
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no config.toml; is it a dnnevo run folder?")
-        text = _read_text(path)
+        text = read_text(path)
         try:
             doc = tomllib.loads(text)
         except tomllib.TOMLDecodeError as e:
-            raise _fail(path, f"not valid TOML: {e}") from None
+            raise fail(path, f"not valid TOML: {e}") from None
         except RecursionError:
-            raise _fail(path, "TOML nested too deeply") from None
-        if _depth(doc) > MAX_CONFIG_DEPTH:
-            raise _fail(path, f"tables and arrays nested deeper than {MAX_CONFIG_DEPTH}")
+            raise fail(path, "TOML nested too deeply") from None
+        if depth(doc) > MAX_CONFIG_DEPTH:
+            raise fail(path, f"tables and arrays nested deeper than {MAX_CONFIG_DEPTH}")
         run = doc.pop("run", {})
         if not isinstance(run, dict):
-            raise _fail(path, f"run is {short(run)}; expected a table")
+            raise fail(path, f"run is {short(run)}; expected a table")
         seed = run.get("seed", 0)
         if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-            raise _fail(path, f"run.seed is {short(seed)}; expected an integer in [0, 2**64)")
+            raise fail(path, f"run.seed is {short(seed)}; expected an integer in [0, 2**64)")
         if "task" not in doc:
-            raise _fail(path, "has no task")
+            raise fail(path, "has no task")
         try:
             config = EvolutionConfig.from_dict(doc)
         except ConfigError as e:
-            raise _fail(path, str(e)) from None
+            raise fail(path, str(e)) from None
         return config, run
 
     def read_checkpoint(self) -> Checkpoint:
@@ -474,32 +223,32 @@ class RunDir:
         path = self.checkpoint
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no checkpoint.json; is it a dnnevo run folder?")
-        doc = _load_json(path, _read_text(path))
+        doc = load_json(path, read_text(path))
         if not isinstance(doc, dict):
-            raise _fail(path, f"is a JSON {type(doc).__name__}; expected an object")
+            raise fail(path, f"is a JSON {type(doc).__name__}; expected an object")
         if doc.get("format") != CHECKPOINT_FORMAT or doc.get("version") not in (1, CHECKPOINT_VERSION):
-            raise _fail(path, f"format/version is {short(doc.get('format'))}/"
+            raise fail(path, f"format/version is {short(doc.get('format'))}/"
                               f"{short(doc.get('version'))}; expected {CHECKPOINT_FORMAT}/1 or 2")
         state = doc.get("state")
         if not isinstance(state, dict) or set(state) != {"config", "evolution"}:
-            raise _fail(path, "state must be an object with 'config' and 'evolution'")
+            raise fail(path, "state must be an object with 'config' and 'evolution'")
         if not isinstance(state["evolution"], str):
-            raise _fail(path, "state.evolution must be the GA state as JSON text")
-        if _depth(state["config"]) > MAX_CONFIG_DEPTH:
-            raise _fail(path, f"state.config nests deeper than {MAX_CONFIG_DEPTH}")
+            raise fail(path, "state.evolution must be the GA state as JSON text")
+        if depth(state["config"]) > MAX_CONFIG_DEPTH:
+            raise fail(path, f"state.config nests deeper than {MAX_CONFIG_DEPTH}")
         try:
             config = EvolutionConfig.from_dict(state["config"])
         except ConfigError as e:
-            raise _fail(path, f"state.config: {e}") from None
-        history = _history_rows(path, doc.get("history"))
+            raise fail(path, f"state.config: {e}") from None
+        history = history_rows(path, doc.get("history"))
         run = None
         if doc["version"] >= 2:
             run = doc.get("run")
             seed = run.get("seed") if isinstance(run, dict) else None
             if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-                raise _fail(path, "run.seed must be an integer in [0, 2**64)")
+                raise fail(path, "run.seed must be an integer in [0, 2**64)")
             if doc.get("config_sha256") != config_digest(config, seed):
-                raise _fail(path, "its config does not match the digest it carries (was it edited?)")
+                raise fail(path, "its config does not match the digest it carries (was it edited?)")
         return Checkpoint(state, history, run, config)
 
     def read_log(self, config: EvolutionConfig | None = None) -> list[dict[str, float]]:
@@ -508,33 +257,33 @@ class RunDir:
         path = self.log
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no log.csv; is it a dnnevo run folder?")
-        text = _read_text(path)
+        text = read_text(path)
         try:
             table = list(csv.reader(io.StringIO(text, newline=""), strict=True))
         except csv.Error as e:
-            raise _fail(path, f"not valid CSV: {e}") from None
+            raise fail(path, f"not valid CSV: {e}") from None
         if not table:
-            raise _fail(path, "is empty")
+            raise fail(path, "is empty")
         header = table[0]
         required = [c for c in LOG_COLUMNS if c not in OPTIONAL_COLUMNS]
         if len(set(header)) != len(header) or not set(required) <= set(header) <= set(LOG_COLUMNS):
-            raise _fail(path, f"has columns {','.join(header)[:80]}; expected {','.join(LOG_COLUMNS)}")
+            raise fail(path, f"has columns {','.join(header)[:80]}; expected {','.join(LOG_COLUMNS)}")
         rows = []
         for i, cells in enumerate(table[1:]):
             if len(cells) != len(header):
-                raise _fail(path, f"row {i + 1} has {len(cells)} values; expected {len(header)}")
+                raise fail(path, f"row {i + 1} has {len(cells)} values; expected {len(header)}")
             row = dict.fromkeys(LOG_COLUMNS, math.nan)
             for k, cell in zip(header, cells, strict=True):
                 try:
                     row[k] = float(cell)
                 except ValueError:
-                    raise _fail(path, f"row {i + 1}: {k} is {short(cell)}; expected a number") from None
+                    raise fail(path, f"row {i + 1}: {k} is {short(cell)}; expected a number") from None
             rows.append(row)
         check_history(path, rows)
         if not rows:
-            raise _fail(path, "has no generations yet")
+            raise fail(path, "has no generations yet")
         if config is not None and len(rows) > config.generations:
-            raise _fail(path, f"has {len(rows)} generations; config.toml has {config.generations}")
+            raise fail(path, f"has {len(rows)} generations; config.toml has {config.generations}")
         return rows
 
     def read_best(self, config: EvolutionConfig, run: Mapping[str, Any] | None = None) -> Network:
@@ -548,11 +297,11 @@ class RunDir:
         except FormatError as e:
             raise RunFileError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
         if (net.size, net.n_inputs) != (config.size, config.n_inputs):
-            raise _fail(path, f"is a network of size {net.size} with {net.n_inputs} inputs; the run "
+            raise fail(path, f"is a network of size {net.size} with {net.n_inputs} inputs; the run "
                               f"has size {config.size} with {config.n_inputs} inputs")
         meta = net.meta
         if "task" in meta and meta["task"] != config.task:
-            raise _fail(path, f"meta.task is {short(meta['task'])}; the run's task is {config.task!r}")
+            raise fail(path, f"meta.task is {short(meta['task'])}; the run's task is {config.task!r}")
         if run is not None and "seed" in meta and "seed" in run and meta["seed"] != run["seed"]:
-            raise _fail(path, f"meta.seed is {short(meta.get('seed'))}; the run's seed is {run.get('seed')}")
+            raise fail(path, f"meta.seed is {short(meta.get('seed'))}; the run's seed is {run.get('seed')}")
         return net

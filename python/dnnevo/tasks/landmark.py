@@ -32,7 +32,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.evaluation import assessment
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, combine, rate
-from dnnevo.runs.rundir import RunDir, save_figure, write_atomic_with
+from dnnevo.runs import RunDir, save_figure, write_atomic_with
 
 
 if TYPE_CHECKING:

@@ -39,7 +39,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.evaluation import assessment
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, Rate, combine
-from dnnevo.runs.rundir import RunDir, save_figure
+from dnnevo.runs import RunDir, save_figure
 
 
 if TYPE_CHECKING:

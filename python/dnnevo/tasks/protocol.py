@@ -16,7 +16,7 @@ import numpy.typing as npt
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
 from dnnevo.evaluation.assessment import Assessment
-from dnnevo.runs.rundir import RunDir
+from dnnevo.runs import RunDir
 
 __all__ = ["Task"]
 

@@ -21,7 +21,7 @@ from dnnevo import _core, plot
 from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, combine, rate
-from dnnevo.runs.rundir import RunDir, save_figure
+from dnnevo.runs import RunDir, save_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

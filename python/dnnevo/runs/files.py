@@ -1,0 +1,97 @@
+"""One file of a run folder: written atomically (a temporary file beside it, then a rename), read
+with every check of its type, and every failure a :class:`RunFileError` of one line naming the
+file."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from dnnevo.errors import DnnevoError
+
+__all__ = ['FILE_MODE', 'RunFileError', 'fail', 'load_json', 'number', 'read_text', 'save_figure', 'short', 'write_atomic', 'write_atomic_with']
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+#: Files are created with mode 0666 & ~umask, as ``open()`` and Rust's ``File::create`` do.
+FILE_MODE = 0o666 & ~_umask()
+
+
+class RunFileError(DnnevoError):
+    """A file of a run folder is missing, damaged or disagrees with the others."""
+
+
+def fail(path: Path, problem: str) -> RunFileError:
+    return RunFileError(f"{path}: {problem}")
+
+
+def write_atomic_with(path: Path, write: Callable[[str], None], *, suffix: str = "") -> None:
+    """Calls ``write(tmp)`` on a new, exclusively created temporary file beside ``path`` (named
+    ``.NAME.RANDOM.tmp`` + ``suffix``), syncs it and renames it over ``path``. The rename replaces
+    a symlink at ``path``; it never writes through one."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{suffix}")
+    try:
+        os.fchmod(fd, FILE_MODE)
+        os.close(fd)
+        write(tmp)
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Writes ``text`` to a temporary file beside ``path``, syncs it, and renames it into place."""
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+
+    write_atomic_with(path, write)
+
+
+def save_figure(fig: Any, path: Path, *, dpi: int = 120) -> None:
+    """Saves a matplotlib figure as ``path`` (PNG) atomically."""
+    write_atomic_with(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png"))
+
+
+def read_text(path: Path) -> str:
+    if path.is_symlink() or not path.is_file():
+        problem = "is a symlink" if path.is_symlink() else "is missing or not a file"
+        raise fail(path, problem)
+    data = path.read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise fail(path, f"is not UTF-8 text (byte {e.start})") from None
+
+
+def load_json(path: Path, text: str) -> Any:
+    try:
+        return json.loads(text)
+    except RecursionError:
+        raise fail(path, "JSON nested too deeply") from None
+    except ValueError as e:
+        raise fail(path, f"not valid JSON: {e}") from None
+
+
+def number(path: Path, where: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise fail(path, f"{where} is {short(value)}; expected a number")
+    return float(value)
+
+
+def short(value: Any) -> str:
+    """``repr(value)``, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

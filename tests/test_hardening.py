@@ -414,7 +414,7 @@ def test_an_interrupt_wrapped_during_import_is_one_line() -> None:
         "        except BaseException as e:\n"
         "            raise RuntimeError('wrapped') from e\n"
         "    except RuntimeError as e:\n"
-        "        dnnevo._interrupted_import(type(e), e, e.__traceback__)\n"
+        "        dnnevo._startup.interrupted_import(type(e), e, e.__traceback__)\n"
     )
     err = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stderr
     assert err.startswith("dnnevo: interrupted\nTraceback"), err

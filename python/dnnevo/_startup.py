@@ -14,6 +14,9 @@ from __future__ import annotations
 import os
 import signal
 import sys
+from types import TracebackType
+
+from dnnevo.errors import DnnevoError
 
 _BLOCKABLE = hasattr(signal, "pthread_sigmask")
 
@@ -43,3 +46,34 @@ def allow_interrupts() -> None:
     """Unblocks SIGINT; one that arrived while it was blocked is raised now."""
     if _BLOCKABLE:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+def interrupted_import(kind: type[BaseException], value: BaseException, tb: TracebackType | None) -> None:
+    """The exception hook while dnnevo imports (e.g. the ``dnnevo`` command starting up): Ctrl-C
+    is one line. Python may wrap the interrupt in another error (3.11 turns one raised while a
+    class is created into a RuntimeError from ``__set_name__``), so the whole chain of causes is
+    looked at."""
+    sys.excepthook = sys.__excepthook__
+    seen: BaseException | None = value
+    while seen is not None and not isinstance(seen, KeyboardInterrupt):
+        seen = seen.__cause__ or seen.__context__
+    if issubclass(kind, KeyboardInterrupt) or seen is not None:
+        sys.stderr.write("dnnevo: interrupted\n")
+    elif isinstance(value, DnnevoError) and is_the_command():
+        sys.stderr.write(f"dnnevo: error: {value}\n")  # e.g. a bad DNNEVO_SIMD
+    else:
+        sys.__excepthook__(kind, value, tb)
+
+
+def begin_import() -> None:
+    """The first thing ``import dnnevo`` does: Ctrl-C deferred (:func:`defer_interrupts`) and
+    reported in one line (:func:`interrupted_import`) until :func:`end_import`."""
+    defer_interrupts()
+    if sys.excepthook is sys.__excepthook__:
+        sys.excepthook = interrupted_import
+
+
+def end_import() -> None:
+    """The last thing ``import dnnevo`` does: the ordinary exception hook again."""
+    if sys.excepthook is interrupted_import:
+        sys.excepthook = sys.__excepthook__

@@ -6,17 +6,18 @@ from __future__ import annotations
 import sys
 
 import dnnevo
+from dnnevo import _startup
 
-# Ctrl-C while the rest of the command's modules load is one line too (see dnnevo/__init__.py).
+# Ctrl-C while the rest of the command's modules load is one line too (see dnnevo/_startup.py).
 if sys.excepthook is sys.__excepthook__:
-    sys.excepthook = dnnevo._interrupted_import
+    sys.excepthook = _startup.interrupted_import
 
 import argparse
 import os
 import traceback
 from pathlib import Path
 
-from dnnevo import _startup, figures
+from dnnevo import figures
 from dnnevo.cli import analyze as _cli_analyze
 from dnnevo.cli import evaluate as _cli_evaluate
 from dnnevo.cli import nav1d_system as _cli_nav1d_system
@@ -282,7 +283,7 @@ COMMANDS = {
 
 def main(argv: list[str] | None = None) -> int:
     """Runs the command line; returns the exit status."""
-    if sys.excepthook is dnnevo._interrupted_import:
+    if sys.excepthook is _startup.interrupted_import:
         sys.excepthook = sys.__excepthook__
     try:
         _startup.allow_interrupts()  # one pressed during start-up is raised here

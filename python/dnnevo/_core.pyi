@@ -8,8 +8,11 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "LANDMARK_SUCCESS_RATE",
     "LANES",
     "MAX_COUNT",
+    "NAV1D_SUCCESS_RATE",
+    "SEQUENCE_SUCCESS_FRACTION",
     "MUTATION_SCALE",
     "RETRY_STARTS",
     "RUN_DEFAULTS",
@@ -58,6 +61,9 @@ MAX_COUNT: int
 MUTATION_SCALE: float
 RETRY_STARTS: int
 STEP_CHECK_FINER: int
+SEQUENCE_SUCCESS_FRACTION: float
+NAV1D_SUCCESS_RATE: float
+LANDMARK_SUCCESS_RATE: float
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]
@@ -140,7 +146,8 @@ class Network:
     def __eq__(self, other: object, /) -> bool: ...
 
 def build_info() -> dict[str, Any]:
-    """This build's version, the CPU's architecture and SIMD features, the kernels it can run
+    """This build's version and git commit (``"unknown"`` outside a checkout; ``+changes`` when
+    the tree had uncommitted changes), the CPU's architecture and SIMD features, the kernels it can run
     ("portable", "avx2", "avx512", "neon") and the one in use.
 
     >>> import dnnevo

@@ -69,6 +69,13 @@ mod _core {
         let defaults = serde_json::to_string(&tasks::RunConfig::default());
         m.add("RUN_DEFAULTS", defaults.expect("defaults always serialise"))?;
         m.add("RETRY_STARTS", ctrnn::analysis::RETRY_STARTS)?;
+        // Each task's success rule, so that Python judges by the core's numbers, never copies.
+        m.add(
+            "SEQUENCE_SUCCESS_FRACTION",
+            tasks::sequence::SUCCESS_FRACTION,
+        )?;
+        m.add("NAV1D_SUCCESS_RATE", tasks::nav1d::SUCCESS_RATE)?;
+        m.add("LANDMARK_SUCCESS_RATE", tasks::landmark::SUCCESS_RATE)?;
         Ok(())
     }
 }

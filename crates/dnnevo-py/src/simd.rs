@@ -13,6 +13,7 @@ use crate::errors::IntoPy;
 pub fn build_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let info = PyDict::new(py);
     info.set_item("version", env!("CARGO_PKG_VERSION"))?;
+    info.set_item("commit", env!("DNNEVO_GIT_COMMIT"))?;
     info.set_item("arch", std::env::consts::ARCH)?;
     let features = PyDict::new(py);
     for (name, found) in simd::cpu_features() {

@@ -45,9 +45,10 @@ __all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT",
 NAME = "landmark"
 """The task's name in a config."""
 
-THRESHOLD = 0.95
-"""The fraction of fresh trials, over both landmarks, that must be classified right
-(``SUCCESS_RATE`` in ``crates/tasks/src/landmark/task.rs``)."""
+THRESHOLD: float = _core.LANDMARK_SUCCESS_RATE
+"""The fraction of fresh trials, over both landmarks, that must be classified right:
+the core's own number
+(``LANDMARK_SUCCESS_RATE`` of the binding)."""
 
 DEFAULT_TRIALS = 500
 """``dnnevo evaluate``'s default: trials per landmark (1000 robot trials take 1.2-1.7 s on one

@@ -83,9 +83,9 @@ __all__ = [
 NAME = "nav1d"
 """The task's name in a config."""
 
-THRESHOLD = 0.95
-"""The fraction of scored trials that must be right (``SUCCESS_RATE`` in
-``crates/tasks/src/nav1d/task.rs``)."""
+THRESHOLD: float = _core.NAV1D_SUCCESS_RATE
+"""The fraction of scored trials that must be right: the core's own number
+(``NAV1D_SUCCESS_RATE`` of the binding)."""
 
 DEFAULT_TRIALS = 1000
 """``dnnevo evaluate``'s default: chains of trials (the slowest objective's take 0.2 s on one

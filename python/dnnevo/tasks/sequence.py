@@ -35,9 +35,9 @@ __all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT",
 NAME = "sequence"
 """The task's name in a config."""
 
-THRESHOLD = 0.9
-"""The fraction of fresh trials per target that must be right (``SUCCESS_FRACTION`` in
-``crates/tasks/src/sequence/scoring.rs``)."""
+THRESHOLD: float = _core.SEQUENCE_SUCCESS_FRACTION
+"""The fraction of fresh trials per target that must be right: the core's own number
+(``SEQUENCE_SUCCESS_FRACTION`` of the binding)."""
 
 DEFAULT_TRIALS = 1000
 """``dnnevo evaluate``'s default: trials per target (4000 trials of the 2-bit task take under

@@ -8,7 +8,7 @@ Workload (preset sequence-1bit, paper §5.2):
 
 Figures, in seconds per generation (median of timed runs after a quarter-second warm-up, over generations
 0, 1, 2, ... so the timings vary as in a run):
-  dnnevo evaluate   dnnevo.evaluate("sequence", genomes, generation=g, seed=0, config=cfg), all cores
+  dnnevo assess   dnnevo.evaluate("sequence", genomes, generation=g, seed=0, config=cfg), all cores
                     (and with threads=1, for a per-core comparison)
   dnnevo generation one whole generation of the GA on the Rust side (evaluate + breed), as
                     dnnevo.evolution.evolve runs it (GeneticAlgorithm.step)
@@ -107,7 +107,7 @@ def main(argv=None) -> int:
             agree = (int(np.sum(diff <= TOL)), len(diff), float(diff.max()))
     t_numpy = statistics.median(numpy_times)
 
-    rows = [("dnnevo evaluate", t_eval), ("dnnevo evaluate, 1 thread", t_eval1),
+    rows = [("dnnevo assess", t_eval), ("dnnevo assess, 1 thread", t_eval1),
             ("dnnevo generation (eval + GA)", t_gen),
             ("numpy evaluate (1 core)", t_numpy)]
     header = (f"{'code':<30}  {'s/generation':>12}  {'generations/s':>13}  "
@@ -119,7 +119,7 @@ def main(argv=None) -> int:
         print(f"{name:<30}  {t:>12.4f}  {1.0 / t:>13.2f}  {total:>9.1f}s  "
               f"{'<=' + format(TARGET_S, 'g') + 's':>7}  {'yes' if total <= TARGET_S else 'NO':>3}")
     print()
-    print(f"speed-up, dnnevo evaluate vs numpy: {t_numpy / t_eval:.1f}x "
+    print(f"speed-up, dnnevo assess vs numpy: {t_numpy / t_eval:.1f}x "
           f"(one core each: {t_numpy / t_eval1:.1f}x; dnnevo on {threads()} threads: "
           f"{t_eval1 / t_eval:.2f}x its 1-thread speed)")
     print(f"speed-up, dnnevo generation vs numpy evaluate alone: {t_numpy / t_gen:.1f}x")

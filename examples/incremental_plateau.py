@@ -10,7 +10,7 @@ alternating network, probed by hand.
 3. The output neuron rewired as a relay of the alternating part: its weights from the 1-bit part
    and its sensor weights set to 0, the cross weight to +-16 and its threshold to half of it.
 
-Each network is judged as ``dnnevo evaluate`` judges (``sequence.assess``) on fresh timings of
+Each network is judged as ``dnnevo assess`` judges (``sequence.assess``) on fresh timings of
 the ``sequence-2bit-paper`` preset; the table gives, per target, the fraction of trials right after the
 warm-up.
 """

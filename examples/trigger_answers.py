@@ -5,7 +5,7 @@
 For each target of the preset (``sequence-2bit-paper``'s four unless ``--targets`` is given) and each
 trial, one line: the wanted bits, the network's answers (its mean output over each response window,
 thresholded at 0.5) and ``+`` where the answer is judged correct. The timings are fresh ones drawn
-from ``--seed``, as ``dnnevo evaluate`` draws them, so they are not the ones the network was
+from ``--seed``, as ``dnnevo assess`` draws them, so they are not the ones the network was
 trained on. A network file is judged under ``--preset``'s settings, a run folder under its own.
 """
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from dnnevo import tasks
-from dnnevo.cli import evaluate as _cli_evaluate
+from dnnevo.cli import assess as _cli_assess
 from dnnevo.tasks import nav1d
 import dnnevo
 from dnnevo.evaluation import assessment as assess
@@ -150,5 +150,5 @@ def test_defaults_and_bad_input() -> None:
     other = dnnevo.EvolutionConfig(task="mine", size=5, n_inputs=2)
     with pytest.raises(ConfigError, match="no success rule"):
         tasks.assess(other, net, 5, seed=0)
-    assert set(_cli_evaluate.EXIT_STATUS.values()) == {0, 1, 3}
+    assert set(_cli_assess.EXIT_STATUS.values()) == {0, 1, 3}
     assert math.isclose(tasks.THRESHOLDS["sequence"], 0.9)

@@ -22,17 +22,21 @@ def test_help_shows_a_working_example() -> None:
     assert "10-second" not in r.stdout and "a tiny demo run (under a second)" in r.stdout
 
 
-def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
+def test_run_show_assess_resume_sweep(tmp_path: Path) -> None:
     out = tmp_path / "demo"
     r = dnnevo("run", "sequence-1bit", "--quick", "--out", str(out), "--seed", "1")
     assert r.returncode == 0, r.stderr
-    assert r.stdout.splitlines()[-1].startswith(f"next: dnnevo evaluate {out}")
+    assert r.stdout.splitlines()[-1].startswith(f"next: dnnevo assess {out}")
     r = dnnevo("show", str(out))
     assert r.returncode == 0 and (out / "fitness.png").stat().st_size > 1000
-    r = dnnevo("evaluate", str(out), "--trials", "5", "--seed", "1")
+    r = dnnevo("assess", str(out), "--trials", "5", "--seed", "1")
     # Exit status 0 pass, 1 fail, 3 undecided: the overall verdict.
     verdict = {0: "pass", 1: "fail", 3: "undecided"}[r.returncode]
     assert f"overall: {verdict}" in r.stdout and "switch test" in r.stdout, r.stdout
+    # The command's old name still works, says it is deprecated, and judges the same.
+    old = dnnevo("evaluate", str(out), "--trials", "5", "--seed", "1")
+    assert (old.returncode, old.stdout) == (r.returncode, r.stdout)
+    assert old.stderr == "dnnevo: 'evaluate' is deprecated; use 'dnnevo assess'\n"
     r = dnnevo("plot", str(out))
     assert r.returncode == 0, r.stderr
     for name in ("fitness.png", "fig4-trials.png", "fig5-switch.png"):
@@ -69,8 +73,8 @@ def test_run_show_evaluate_resume_sweep(tmp_path: Path) -> None:
         (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
         (["resume", "/no/such/dir"], "has no checkpoint.json"),
         (["show", "/no/such/dir"], "has no config.toml"),
-        (["evaluate", "/no/such/dir"], "has no config.toml"),
-        (["evaluate", "x", "--trials", "0"], "must be >= 1"),
+        (["assess", "/no/such/dir"], "has no config.toml"),
+        (["assess", "x", "--trials", "0"], "must be >= 1"),
         (["sweep", "sequence-1bit", "--out", "x", "--eval-trials", "0"], "must be >= 1"),
         (["sweep", "sequence-1bit", "--out", "x", "--eval-seed", "-3"], "-3 is negative"),
         (["sweep", "sequence-1bit", "--out", "x", "--seeds", "0-1", "--eval-seed", str(2**64 - 1)],
@@ -100,7 +104,7 @@ def test_run_show_and_the_progress_bar_name_the_same_champion(tmp_path: Path) ->
     champion = (f"champion (best.json): fitness {meta['fitness']:.4f} (generation {meta['generation']}); "
                 f"validation rate {meta['validation_rate']:.3f}, score {meta['validation_score']:.4f}")
     success = "success rule: met at generation 0 (the champion passed it on fresh trials)"
-    after = f"next: dnnevo evaluate {out}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
+    after = f"next: dnnevo assess {out}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
     assert r.stdout.splitlines() == [r.stdout.splitlines()[0], champion, success, after], r.stdout
     assert r.stdout.startswith("2 generations in "), r.stdout
     bar = r.stderr.strip().splitlines()[-1]  # not a terminal: one line at the end

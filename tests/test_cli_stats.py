@@ -1,4 +1,4 @@
-"""``dnnevo evaluate`` and ``dnnevo sweep`` report rates with intervals: ``evaluate --json`` for
+"""``dnnevo assess`` and ``dnnevo sweep`` report rates with intervals: ``evaluate --json`` for
 each task, the exit status of each verdict, and the sweep's summary."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from cli_helpers import assert_one_line_error, run_cli
 
 from dnnevo import tasks
 import dnnevo
-from dnnevo.cli import evaluate as _cli_evaluate
+from dnnevo.cli import assess as _cli_assess
 from dnnevo.evaluation import assessment as assess
 from dnnevo.cli import command as cli
 from dnnevo import presets
@@ -50,7 +50,7 @@ def in_process(*args: object) -> tuple[str, int]:
 
 
 def evaluate_json(run: Path, *args: str) -> tuple[dict, int]:
-    stdout, status = in_process("evaluate", run, "--json", *args)
+    stdout, status = in_process("assess", run, "--json", *args)
     assert status in (0, 1, 3)
     return json.loads(stdout), status
 
@@ -85,7 +85,7 @@ def test_evaluate_json_sequence(runs: dict[str, Path]) -> None:
         assert rate["n"] == 30
         check_rate(rate, 0.9)
     assert d["verdict"] == assess.combine([r["verdict"] for r in d["rates"]])
-    assert status == _cli_evaluate.EXIT_STATUS[d["verdict"]]
+    assert status == _cli_assess.EXIT_STATUS[d["verdict"]]
     switch = d["switch_test"]
     assert (switch["switch_after"], switch["trials"]) == (8, 20)
     assert [(p["first"], p["second"]) for p in switch["pairs"]] == [("0", "1"), ("1", "0")]
@@ -110,7 +110,7 @@ def test_evaluate_json_nav1d_clusters_by_chain(runs: dict[str, Path]) -> None:
     for rate in d["rates"][:-1]:
         check_rate(rate, None)
     assert sum(r["n"] for r in d["rates"][:-1]) == 100
-    assert status == _cli_evaluate.EXIT_STATUS[d["verdict"]] and d["verdict"] == overall["verdict"]
+    assert status == _cli_assess.EXIT_STATUS[d["verdict"]] and d["verdict"] == overall["verdict"]
     same_as_api(runs["nav1d-single"], d)
 
 
@@ -127,12 +127,12 @@ def test_evaluate_json_landmark(runs: dict[str, Path], robot_like: bool) -> None
     check_rate(one, None)
     check_rate(two, None)
     check_rate(overall, 0.95)
-    assert status == _cli_evaluate.EXIT_STATUS[d["verdict"]]
+    assert status == _cli_assess.EXIT_STATUS[d["verdict"]]
     same_as_api(runs["landmark"], d, robot_like=robot_like)
 
 
 def test_text_shows_intervals(runs: dict[str, Path]) -> None:
-    stdout, _ = in_process("evaluate", runs["landmark"], "--trials", "6", "--seed", "1")
+    stdout, _ = in_process("assess", runs["landmark"], "--trials", "6", "--seed", "1")
     d, _ = evaluate_json(runs["landmark"], "--trials", "6", "--seed", "1")
     overall = d["rates"][-1]
     lo, hi = overall["interval"]
@@ -157,28 +157,28 @@ def test_exit_status_is_the_verdict(tmp_path: Path) -> None:
     zero_only = write_run(tmp_path / "zero", presets.get("sequence-1bit", overrides=['task_params.targets=["0"]']),
                           silent())
     # 20 perfect trials cannot show >= 90% with 95% confidence; 35 can.
-    r = run_cli("evaluate", zero_only, "--trials", "20", "--seed", "0")
+    r = run_cli("assess", zero_only, "--trials", "20", "--seed", "0")
     assert r.returncode == 3, (r.stdout, r.stderr)
     assert "overall: undecided" in r.stdout
     assert "0* is undecided: if its rate of 100.0% holds, --trials 35 (trials per target) would decide it" in r.stdout
     d, status = evaluate_json(zero_only, "--trials", "35", "--seed", "0")
     assert status == 0 and d["verdict"] == "pass"
     both = write_run(tmp_path / "both", presets.get("sequence-1bit"), silent())
-    r = run_cli("evaluate", both, "--trials", "20", "--seed", "0")
+    r = run_cli("assess", both, "--trials", "20", "--seed", "0")
     assert r.returncode == 1 and "overall: fail (1* fails; every target must pass)" in r.stdout
 
 
 def test_hint_when_the_rate_is_the_threshold() -> None:
     rate = assess.rate("1*", 9, 10, threshold=0.9)
     assert rate.verdict == "undecided" and rate.trials_to_decide is None
-    assert "equals the threshold (90.0%), so no number of trials decides it" in _cli_evaluate.hint(rate, "trials")
+    assert "equals the threshold (90.0%), so no number of trials decides it" in _cli_assess.hint(rate, "trials")
 
 
 def test_bad_run_folder_is_one_line(tmp_path: Path) -> None:
     other = write_run(tmp_path / "other", EvolutionConfig(task="mine", size=5, n_inputs=2), silent())
-    assert_one_line_error(run_cli("evaluate", other, "--json"), "no success rule")
+    assert_one_line_error(run_cli("assess", other, "--json"), "no success rule")
     seq = write_run(tmp_path / "seq", presets.get("sequence-1bit"), silent())
-    assert_one_line_error(run_cli("evaluate", seq, "--seed", str(2**64)), "seed is 18446744073709551616")
+    assert_one_line_error(run_cli("assess", seq, "--seed", str(2**64)), "seed is 18446744073709551616")
 
 
 def test_a_bug_exits_2_never_1(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
@@ -258,7 +258,7 @@ def test_dt_check_judges_the_same_trials_at_finer_steps(runs: dict[str, Path]) -
         changes = [abs(c["rate"] - b["rate"]) for a in check["checks"].values()
                    for b, c in zip(plain["rates"], a["rates"]) if b["verdict"] is not None]
         assert check["max_change"] == max(changes)
-    text, _ = in_process("evaluate", runs["sequence-1bit"], "--trials", "5", "--dt-check")
+    text, _ = in_process("assess", runs["sequence-1bit"], "--trials", "5", "--dt-check")
     assert "time-step check, same trials (run: euler, dt 0.1; dt/10: dt 0.01)" in text
     assert ("step check: no artefact" in text) != ("step artefact" in text)
 
@@ -268,8 +268,8 @@ def test_evaluate_with_a_finer_step(runs: dict[str, Path]) -> None:
     fine, _ = evaluate_json(runs["nav1d-single"], "--trials", "20", "--seed", "3", "--dt", "0.05")
     assert "integrator" not in coarse
     assert fine["integrator"] == {"method": "euler", "dt": 0.05, "substeps": 20}
-    text, _ = in_process("evaluate", runs["sequence-1bit"], "--trials", "5", "--dt", "0.02")
+    text, _ = in_process("assess", runs["sequence-1bit"], "--trials", "5", "--dt", "0.02")
     assert "integrated with dt = 0.02, 50 steps per time step" in text
     for bad in ("0.03", "-1", "nan"):
-        r = run_cli("evaluate", runs["landmark"], "--trials", "2", "--dt", bad)
+        r = run_cli("assess", runs["landmark"], "--trials", "2", "--dt", bad)
         assert_one_line_error(r, "--dt")

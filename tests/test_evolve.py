@@ -81,10 +81,10 @@ def test_bad_seed_is_a_config_error(seed: object) -> None:
 
 def test_seeding_puts_networks_first() -> None:
     seed_net = dnnevo.Network.random(2, 1, seed=9)
-    ga = dnnevo.GeneticAlgorithm(SMALL, seed=0, seeds=[seed_net])
+    ga = dnnevo.GeneticAlgorithm(SMALL, seed=0, founders=[seed_net])
     assert ga.ask().networks[0] == seed_net
     with pytest.raises(ConfigError, match="seed network 0 has N = 3"):
-        dnnevo.GeneticAlgorithm(SMALL, seed=0, seeds=[dnnevo.Network.random(3, 1, seed=1)])
+        dnnevo.GeneticAlgorithm(SMALL, seed=0, founders=[dnnevo.Network.random(3, 1, seed=1)])
 
 
 def test_builtin_run_is_identical_with_one_and_two_threads(tmp_path: Path) -> None:
@@ -282,3 +282,14 @@ def test_a_preset_name_with_its_config_runs_the_presets_task() -> None:
     assert by_name.history["best"].tolist() == by_task.history["best"].tolist()
     with pytest.raises(ConfigError, match="does not match config.task"):
         dnnevo.evolve("landmark", config, seed=1, progress=False)
+
+
+def test_founders_start_the_population_and_seeds_is_its_deprecated_name() -> None:
+    founder = dnnevo.Network.random(2, 1, seed=9)
+    ga = dnnevo.GeneticAlgorithm(SMALL, seed=0, founders=[founder])
+    assert np.array_equal(ga.ask()[1][0].tau, founder.tau)
+    with pytest.warns(DeprecationWarning, match="founders="):
+        old = dnnevo.GeneticAlgorithm(SMALL, seed=0, seeds=[founder])
+    assert np.array_equal(old.ask()[0], dnnevo.GeneticAlgorithm(SMALL, seed=0, founders=[founder]).ask()[0])
+    with pytest.raises(dnnevo.ConfigError, match="not both"):
+        dnnevo.GeneticAlgorithm(SMALL, seed=0, founders=[founder], seeds=[founder])

@@ -112,7 +112,7 @@ def checkpoint_edits(doc: dict) -> list[tuple[str, Callable[[dict], None]]]:
     ]
 
 
-COMMANDS = [["resume"], ["show"], ["evaluate", "--trials", "2", "--seed", "0"], ["plot"],
+COMMANDS = [["resume"], ["show"], ["assess", "--trials", "2", "--seed", "0"], ["plot"],
             ["analyze", "--no-lesions", "--steps", "5"]]
 
 
@@ -121,7 +121,7 @@ def check_outcome(r: subprocess.CompletedProcess[str], run: Path, command: str) 
     if r.returncode == 2:
         assert_one_line_error(r)
     else:
-        assert r.returncode in ((0, 1, 3) if command == "evaluate" else (0,)), r.stderr
+        assert r.returncode in ((0, 1, 3) if command == "assess" else (0,)), r.stderr
         assert "Traceback" not in r.stderr
         if command == "resume":
             assert_consistent(run)
@@ -195,7 +195,7 @@ def test_wrong_champion_and_deleted_best_json(pristine: Path, tmp_path: Path) ->
 
     run = copy(pristine, tmp_path / "run")
     dnnevo.Network.random(4, 2, seed=0).save(run / "best.json")
-    for command in ("evaluate", "plot", "analyze"):
+    for command in ("assess", "plot", "analyze"):
         assert_one_line_error(run_cli(command, run), "best.json", "size 4")
     (run / "best.json").unlink()
     assert run_cli("resume", run).returncode == 0

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
 from dnnevo import tasks
-from dnnevo.cli import evaluate as _cli_evaluate
+from dnnevo.cli import assess as _cli_assess
 import dnnevo
 from dnnevo.evaluation import assessment as assess
 from dnnevo.tasks import landmark
@@ -542,7 +542,7 @@ def test_quick_run_and_evaluate(run, robot_like):
     assert saved.to_dict() == presets.get("landmark", quick=True).to_dict()
     assert (saved.population, saved.generations) == (30, 5)
     extra = ["--robot-like"] if robot_like else []
-    r = run_cli("evaluate", run, "--trials", "10", "--seed", "1", *extra)
+    r = run_cli("assess", run, "--trials", "10", "--seed", "1", *extra)
     assert r.returncode in (0, 1, 3), r.stderr
     assert "landmark 1" in r.stdout and "landmark 2" in r.stdout and "overall" in r.stdout
     assert ("robot-like" in r.stdout) == robot_like
@@ -553,7 +553,7 @@ def test_quick_run_and_evaluate(run, robot_like):
     assert sum(map(sum, report["confusion"])) == 20
     judged = tasks.assess(saved, champion, 10, seed=1, robot_like=robot_like)
     assert f"overall: {report['rate']:.1%} right; success needs >= 95%: {judged.verdict}" in r.stdout
-    assert _cli_evaluate.EXIT_STATUS[judged.verdict] == r.returncode
+    assert _cli_assess.EXIT_STATUS[judged.verdict] == r.returncode
 
 
 def test_the_robust_preset_trains_on_varied_trials_and_runs(tmp_path):
@@ -570,7 +570,7 @@ def test_the_robust_preset_trains_on_varied_trials_and_runs(tmp_path):
     # Every generation's champion is validated (the set's make-up is tested in crates/tasks).
     rates = [float(row.split(",")[rate]) for row in rows]
     assert len(rates) == 2 and all(0 <= x <= 1 for x in rates), rates
-    r = run_cli("evaluate", out, "--robot-like", "--trials", "5", "--seed", "1")
+    r = run_cli("assess", out, "--robot-like", "--trials", "5", "--seed", "1")
     assert r.returncode in (0, 1, 3), r.stderr
 
 
@@ -595,7 +595,7 @@ def test_robot_like_refused_on_a_sequence_run(tmp_path):
     r = run_cli("run", "sequence-1bit", "--quick", "--set", "generations=1", "--set", "population=10",
                 "--out", seq)
     assert r.returncode == 0, r.stderr
-    r = run_cli("evaluate", seq, "--trials", "2", "--seed", "0", "--robot-like")
+    r = run_cli("assess", seq, "--trials", "2", "--seed", "0", "--robot-like")
     assert_one_line_error(r, "--robot-like")
 
 

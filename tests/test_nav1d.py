@@ -19,7 +19,7 @@ from cli_helpers import assert_one_line_error, assert_png, run_cli
 import nav1d_reference as ref
 
 from dnnevo import tasks
-from dnnevo.cli import evaluate as _cli_evaluate
+from dnnevo.cli import assess as _cli_assess
 import dnnevo
 from dnnevo.evaluation.stats import wilson
 from dnnevo.evaluation import assessment as assess
@@ -457,7 +457,7 @@ def test_quick_run_evaluate_and_plot(runs, name):
     run = runs[name]
     log = (run / "log.csv").read_text().splitlines()
     assert len(log) == 1 + 8  # header and the 8 generations of --quick
-    r = run_cli("evaluate", run, "--trials", "40", "--seed", "1")
+    r = run_cli("assess", run, "--trials", "40", "--seed", "1")
     assert r.returncode in (0, 1, 3), r.stderr
     # The verdict is the Python API's, on the same fresh chains.
     part = nav1d.load_part(run)
@@ -465,7 +465,7 @@ def test_quick_run_evaluate_and_plot(runs, name):
     report = nav1d.assess(part.config, part.network, 40, seed=1)
     judged = tasks.assess(part.config, part.network, 40, seed=1)
     assert f"overall: {report['rate']:.1%} right; success needs >= 95%: {judged.verdict}" in r.stdout
-    assert _cli_evaluate.EXIT_STATUS[judged.verdict] == r.returncode
+    assert _cli_assess.EXIT_STATUS[judged.verdict] == r.returncode
     r = run_cli("plot", run)
     assert r.returncode == 0, r.stderr
     pictures = ["fitness.png", "fig2-paths.png"]

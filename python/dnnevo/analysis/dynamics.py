@@ -18,7 +18,7 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
 
 The numerical work is in Rust (``ctrnn::analysis``); this module turns its results into
 dataclasses. The analysis is of the continuous-time system; tasks integrate it with Euler steps
-(``dnnevo evaluate --dt-check`` tells whether a champion's behaviour depends on the step).
+(``dnnevo assess --dt-check`` tells whether a champion's behaviour depends on the step).
 
 >>> import dnnevo
 >>> from dnnevo import analysis

@@ -30,7 +30,7 @@ saddle, unstable) and attracting limit cycles are found and printed. --sweep var
 points (H: a cycle is born); --sweep-cycles also follows the attracting cycles along it,
 each branch from where it appears to where it vanishes. Lesions clamp each
 neuron at its mean firing rate over real trials, and cut the N strongest connections, then judge
-the champion on the same fresh trials as 'dnnevo evaluate'. See docs/analysis.md. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
+the champion on the same fresh trials as 'dnnevo assess'. See docs/analysis.md. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
 two neurons, those that vary most unless --neurons, with a real trial, equilibria by stability, cycles,
 and nullclines for 2 neurons), analysis-bifurcation.png (the firing rate of the neuron whose
 equilibria move most), analysis-basins.png (the recorded trials over time, on a background that
@@ -56,7 +56,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--sweep-cycles", action="store_true",
                    help="also search each swept value for limit cycles (4 starts; about 100x slower)")
     p.add_argument("--trials", type=int, default=DEFAULT_LESION_TRIALS,
-                   help=f"fresh trials per lesion, in 'dnnevo evaluate --trials' units (default {DEFAULT_LESION_TRIALS})")
+                   help=f"fresh trials per lesion, in 'dnnevo assess --trials' units (default {DEFAULT_LESION_TRIALS})")
     p.add_argument("--cuts", type=int, default=None, help="strongest connections to cut (default N)")
     p.add_argument("--seed", type=int, default=0, help="seed of the trials shown and judged (default 0)")
     p.add_argument("--no-lesions", dest="lesions", action="store_false", help="skip the lesions")

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from dnnevo import figures
 from dnnevo.cli import analyze as _cli_analyze
-from dnnevo.cli import evaluate as _cli_evaluate
+from dnnevo.cli import assess as _cli_assess
 from dnnevo.cli import nav1d_system as _cli_nav1d_system
 from dnnevo.cli import reproduce as _cli_reproduce
 from dnnevo.cli import show as _cli_show
@@ -38,14 +38,14 @@ EXAMPLES = """examples:
   dnnevo run sequence-1bit --set population=200 --set mutation_rate=0.02
   dnnevo resume runs/demo                          continue a stopped run
   dnnevo show runs/demo                            summary and fitness.png
-  dnnevo evaluate runs/demo                        judge the champion on fresh conditions
-  dnnevo evaluate runs/demo --json                 ... as JSON; exit 0 pass, 1 fail, 3 undecided
+  dnnevo assess runs/demo                          judge the champion on fresh conditions
+  dnnevo assess runs/demo --json                   ... as JSON; exit 0 pass, 1 fail, 3 undecided
   dnnevo plot runs/demo                            fitness curve and the paper's figures
   dnnevo analyze runs/demo                         attractors, bifurcations, lesions
   dnnevo sweep sequence-1bit --quick --seeds 0-4 --out runs/sweep
   dnnevo run nav1d-classifier --out runs/cls       the paper's navigation classifier (6 s)
   dnnevo nav1d-system --classifier runs/cls --far runs/far --near runs/near
-  dnnevo run landmark --out runs/lm && dnnevo evaluate runs/lm --robot-like
+  dnnevo run landmark --out runs/lm && dnnevo assess runs/lm --robot-like
   dnnevo reproduce --quick --seeds 0-1 --out runs/repro   the whole paper in miniature, with a report
 """
 
@@ -157,7 +157,7 @@ def build_parser() -> argparse.ArgumentParser:
                    f"default {DEFAULT_TRIALS['nav1d']}); each default takes 2 s at most on one core")
     p = sub.add_parser("sweep", help="independent runs over seeds, with success statistics",
                        description="Independent runs of a preset over seeds; each final champion is "
-                                   "judged on fresh conditions as 'dnnevo evaluate' judges it.",
+                                   "judged on fresh conditions as 'dnnevo assess' judges it.",
                        epilog=_cli_sweep.EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("preset")
     p.add_argument("--seeds", type=_parse_seeds, default=_parse_seeds("0-9"), help="e.g. 0-9 or 1,4,7")
@@ -175,10 +175,11 @@ def build_parser() -> argparse.ArgumentParser:
     seeding.add_arguments(p)
     run_options(p)
 
-    p = sub.add_parser("evaluate", help="judge a champion on fresh random conditions",
+    p = sub.add_parser("assess", aliases=["evaluate"],
+                       help="judge a champion on fresh random conditions (evaluate: its old name, deprecated)",
                        description="Judge a run's champion on fresh random conditions: every rate "
                                    "with a 95% Wilson interval and a verdict (pass, fail or undecided).",
-                       epilog=_cli_evaluate.EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
+                       epilog=_cli_assess.EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("dir", type=Path)
     p.add_argument("--trials", type=_positive, default=None, help="fresh " + trials_help)
     p.add_argument("--seed", type=_nonnegative, default=None,
@@ -214,7 +215,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     seeds = how.networks(config.size, args.seed) if how else None
     info = how.info() if how else None
     result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,
-                           seeds=seeds, force=args.force, run_info=info)
+                           founders=seeds, force=args.force, run_info=info)
     return _report(result)
 
 
@@ -273,12 +274,16 @@ COMMANDS = {
     "show": _cli_show.show,
     "presets": _cmd_presets,
     "sweep": _cli_sweep.sweep_command,
-    "evaluate": _cli_evaluate.evaluate,
+    "assess": _cli_assess.assess,
     "plot": _cmd_plot,
     "analyze": _cli_analyze.analyze,
     "nav1d-system": _cli_nav1d_system.system,
     "reproduce": _cli_reproduce.reproduce,
 }
+
+
+DEPRECATED = {"evaluate": "assess"}
+"""Old command names that still work, each with a line on stderr naming the new one."""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -295,6 +300,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 0
+    if args.command in DEPRECATED:
+        sys.stderr.write(f"dnnevo: '{args.command}' is deprecated; use 'dnnevo {DEPRECATED[args.command]}'\n")
+        args.command = DEPRECATED[args.command]
     try:
         return COMMANDS[args.command](args)
     except BrokenPipeError:
@@ -311,7 +319,7 @@ def main(argv: list[str] | None = None) -> int:
         sys.stderr.write(f"dnnevo: {e}\n" if str(e) else "dnnevo: interrupted\n")
         return 130
     except Exception:
-        # A bug: show it, but exit 2 as for any error, never 1 (evaluate's "fail").
+        # A bug: show it, but exit 2 as for any error, never 1 (assess's "fail").
         if args.debug:
             raise
         sys.stderr.write("dnnevo: internal error, please report it:\n" + traceback.format_exc())

@@ -63,7 +63,7 @@ def add_parser(sub: Any, parse_seeds: Any, positive: Any) -> None:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a setting for every evolution, after its preset's, e.g. population=200")
     p.add_argument("--eval-trials", type=positive, metavar="N",
-                   help="fresh trials judging each final champion (default: the task's, as 'dnnevo evaluate')")
+                   help="fresh trials judging each final champion (default: the task's, as 'dnnevo assess')")
     p.add_argument("--no-dt-check", dest="dt_check", action="store_false",
                    help="skip judging each final champion again at a 10x finer step and with RK4")
     p.add_argument("--workers", type=positive, metavar="N", help="worker processes of the local Dask cluster "

@@ -65,7 +65,7 @@ def next_line(path: Path, config: EvolutionConfig, done: int, *, interrupted: bo
     for a Python fitness function's run, which the command line can neither resume nor judge."""
     if config.task.startswith(PYTHON_TASK):
         return None
-    judge = f"dnnevo evaluate {path}"
+    judge = f"dnnevo assess {path}"
     if interrupted or done < config.generations:
         return (f"next: dnnevo resume {path} to run the rest of its {config.generations} generations, "
                 f"or {judge} to judge the champion so far")

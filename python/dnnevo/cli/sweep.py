@@ -38,8 +38,8 @@ Reports the seeds whose run met the task's rule (k/n with a 95% Wilson interval)
 first-success generation (95% bootstrap interval, fixed bootstrap seed; a seed that never
 succeeded counts as +infinity, so "not reached" when more than half never did), and the final
 champions (best.json) that pass on fresh conditions from seed BASE + seed (--eval-seed), judged as
-'dnnevo evaluate' judges. Each final champion is also judged on the same conditions at a 10x
-finer step and with RK4 ('dnnevo evaluate --dt-check'); one that fails there where it did not at
+'dnnevo assess' judges. Each final champion is also judged on the same conditions at a 10x
+finer step and with RK4 ('dnnevo assess --dt-check'); one that fails there where it did not at
 the run's step is counted as a step artefact (--no-dt-check skips the check). Writes
 OUT/summary.csv (a row per seed, then a row 'all') and OUT/summary.json.
 
@@ -206,7 +206,7 @@ def lines(s: sweep.Summary, eval_seed: int, trials: int, unit: str) -> list[str]
     out = [
         "first success: the first generation whose champion met the task's success rule during the run",
         f"final: the run's final champion on fresh conditions (seed {eval_seed} + seed, {trials} {unit}),"
-        " judged as 'dnnevo evaluate' judges; the weakest judged rate is shown",
+        " judged as 'dnnevo assess' judges; the weakest judged rate is shown",
         f"{'seed':>5} {'best':>8} {'at gen':>7} {'first success':>14} {'wall s':>8}  "
         f"{'final rate':>16}  {'95% interval':<16}  verdict",
     ]

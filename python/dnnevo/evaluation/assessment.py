@@ -4,7 +4,7 @@ its 95% Wilson interval and a pass / fail / undecided verdict (see :mod:`dnnevo.
 This module knows no task. Each task module builds its :class:`Assessment` from its own trials
 (``judge`` in :mod:`dnnevo.tasks.sequence`, :mod:`dnnevo.tasks.nav1d`,
 :mod:`dnnevo.tasks.landmark`) with :func:`rate` and :func:`combine`, and
-:func:`dnnevo.tasks.assess` picks the task of a config. ``dnnevo evaluate`` prints an assessment
+:func:`dnnevo.tasks.assess` picks the task of a config. ``dnnevo assess`` prints an assessment
 and ``dnnevo sweep`` applies one to every seed's final champion.
 
 >>> r = rate("overall", 97, 100, threshold=0.9)

@@ -1,4 +1,4 @@
-"""The statistics behind ``dnnevo evaluate`` and ``dnnevo sweep``: Wilson score intervals for
+"""The statistics behind ``dnnevo assess`` and ``dnnevo sweep``: Wilson score intervals for
 success rates, the pass / fail / undecided verdict against a task's threshold, how many trials
 would decide an undecided verdict, and a bootstrap interval for the median first-success
 generation with censored runs.

@@ -27,7 +27,7 @@ from dnnevo import _core, presets
 from dnnevo._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError, did_you_mean
-from dnnevo.evolution.ga import GeneticAlgorithm
+from dnnevo.evolution.ga import GeneticAlgorithm, founders_argument
 from dnnevo.evolution.progress import Progress
 from dnnevo.runs import RunDir, RunFileError, first_difference, short
 
@@ -123,9 +123,10 @@ def evolve(
     progress: bool = True,
     callback: Callback | None = None,
     threads: int | None = None,
-    seeds: Sequence[_core.Network] | None = None,
+    founders: Sequence[_core.Network] | None = None,
     force: bool = False,
     run_info: Mapping[str, Any] | None = None,
+    seeds: Sequence[_core.Network] | None = None,
 ) -> EvolutionResult:
     """Evolves networks for ``task`` and returns the champion and the history.
 
@@ -133,9 +134,9 @@ def evolve(
     array`` (slower, but works with everything else, checkpoints included). With ``out`` the run
     writes a run folder (see :mod:`dnnevo.runs.rundir`); an existing non-empty folder is refused unless
     ``force``. ``callback(stats, ga)`` runs after every generation; returning True stops the run.
-    ``seeds`` are networks placed first in the initial population (e.g. from :func:`compose`).
-    ``run_info`` adds entries to the ``[run]`` table of ``config.toml``, e.g. where the seeds
-    came from.
+    ``founders`` are networks placed first in the initial population (e.g. from :func:`compose`;
+    ``seeds``, its old name, is deprecated). ``run_info`` adds entries to the ``[run]`` table of
+    ``config.toml``, e.g. where the founders came from.
     """
     if callable(task):
         config = dataclasses.replace(config or EvolutionConfig(), task=_python_task_name(task))
@@ -143,7 +144,7 @@ def evolve(
         config = _task_config(task, config)
         _check_layout(config)
         task = config.task  # a preset name stands for its config's task
-    ga = GeneticAlgorithm(config, seed=seed, seeds=seeds)
+    ga = GeneticAlgorithm(config, seed=seed, founders=founders_argument(founders, seeds))
     if out is None:
         return _loop(ga, task, [], None, progress=progress, callback=callback, threads=threads)
     run = RunDir(out)

@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import Any, NamedTuple
 
@@ -51,12 +52,14 @@ class GeneticAlgorithm:
         config: EvolutionConfig | None = None,
         *,
         seed: int = 0,
+        founders: Sequence[_core.Network] | None = None,
         seeds: Sequence[_core.Network] | None = None,
     ) -> None:
+        founders = founders_argument(founders, seeds)
         self.config = config or EvolutionConfig()
         if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not 0 <= seed < 2**64:
             raise ConfigError(f"seed is {seed!r}; it must be an integer in [0, 2**64)")
-        self._evo = _core.Evolution(self.config.to_json(), int(seed), list(seeds or []))
+        self._evo = _core.Evolution(self.config.to_json(), int(seed), list(founders or []))
 
     @property
     def seed(self) -> int:
@@ -135,3 +138,16 @@ class GeneticAlgorithm:
         ga = cls.__new__(cls)
         ga.load_state_dict(state)
         return ga
+
+
+def founders_argument(founders: Sequence[_core.Network] | None,
+                      seeds: Sequence[_core.Network] | None) -> Sequence[_core.Network] | None:
+    """The networks placed first in the initial population, from ``founders`` or from the
+    deprecated name ``seeds`` (which read as the random seed's plural), with a warning."""
+    if seeds is None:
+        return founders
+    if founders is not None:
+        raise ConfigError("give founders=, not both founders= and seeds= (its old name)")
+    warnings.warn("seeds= is deprecated: the networks that found the first population are now "
+                  "founders= (seed= stays the random seed)", DeprecationWarning, stacklevel=3)
+    return seeds

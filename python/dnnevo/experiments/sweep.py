@@ -156,7 +156,7 @@ def run_seed(
         seeds = seeding.networks(config.size, seed) if seeding else None
         info = seeding.info() if seeding else None
         result = evolve(config.task, config, seed=seed, out=out, threads=threads, force=force,
-                        seeds=seeds, run_info=info, progress=progress)
+                        founders=seeds, run_info=info, progress=progress)
         wall = time.perf_counter() - t0
     champion = RunDir(out).read_best(config, {"seed": seed})
     fresh = eval_seed(seed, eval_seed_base)

@@ -51,7 +51,7 @@ the core's own number
 (``LANDMARK_SUCCESS_RATE`` of the binding)."""
 
 DEFAULT_TRIALS = 500
-"""``dnnevo evaluate``'s default: trials per landmark (1000 robot trials take 1.2-1.7 s on one
+"""``dnnevo assess``'s default: trials per landmark (1000 robot trials take 1.2-1.7 s on one
 core)."""
 
 UNIT = "trials per landmark"
@@ -168,7 +168,7 @@ def judge(config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *
 
 
 def preface(where: Path, a: Assessment) -> list[str]:
-    """What ``evaluate`` ran on a ``landmark`` run, and the confusion matrix."""
+    """What ``assess`` ran on a ``landmark`` run, and the confusion matrix."""
     kind = ("robot-like (sonar noise, specular misses, jittered room)" if a.details["robot_like"]
             else "ideal")
     (p, q), (r, s) = a.details["confusion"]

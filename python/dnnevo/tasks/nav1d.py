@@ -88,7 +88,7 @@ THRESHOLD: float = _core.NAV1D_SUCCESS_RATE
 (``NAV1D_SUCCESS_RATE`` of the binding)."""
 
 DEFAULT_TRIALS = 1000
-"""``dnnevo evaluate``'s default: chains of trials (the slowest objective's take 0.2 s on one
+"""``dnnevo assess``'s default: chains of trials (the slowest objective's take 0.2 s on one
 core)."""
 
 UNIT = "chains"
@@ -365,7 +365,7 @@ def _by_trial(rates: dict[str, Any], episodes: Sequence[dict[str, Any]], first_s
 
 
 def preface(where: Path, a: Assessment) -> list[str]:
-    """What ``evaluate`` ran on a ``nav1d`` run, and the rates by case (``classify``) or by
+    """What ``assess`` ran on a ``nav1d`` run, and the rates by case (``classify``) or by
     environment type and trial index."""
     objective = a.details["objective"]
     episodes = a.report["episodes"]

@@ -1,5 +1,5 @@
 """What a task is on the Python side: the names and functions every task module defines, so that
-the layers above (``dnnevo evaluate``, ``plot``, ``sweep``, ``reproduce``) never branch on a
+the layers above (``dnnevo assess``, ``plot``, ``sweep``, ``reproduce``) never branch on a
 task's name. The built-in tasks' modules (:mod:`dnnevo.tasks.sequence`, :mod:`.nav1d`,
 :mod:`.landmark`) each implement it, and :mod:`dnnevo.tasks.registry` maps names to them, as
 ``crates/tasks`` does in Rust.
@@ -29,11 +29,11 @@ class Task(Protocol):
     THRESHOLD: float
     """The rate the task's success rule needs."""
     DEFAULT_TRIALS: int
-    """``dnnevo evaluate``'s default trial count, in :attr:`UNIT`."""
+    """``dnnevo assess``'s default trial count, in :attr:`UNIT`."""
     UNIT: str
     """What a trial count counts (trials per target, trials per landmark, chains)."""
     ROBOT_LIKE: bool
-    """Whether the task has a robot-like test (``dnnevo evaluate --robot-like``)."""
+    """Whether the task has a robot-like test (``dnnevo assess --robot-like``)."""
     INPUT_NAMES: list[str]
     """The network's inputs, in order."""
     ANALYSIS_CONDITIONS: dict[str, list[float]]
@@ -48,16 +48,16 @@ class Task(Protocol):
         """``net`` judged on ``trials`` fresh conditions drawn from ``seed``."""
 
     def preface(self, where: Path, a: Assessment) -> list[str]:
-        """``dnnevo evaluate``'s first lines: what was run, and the task's own table."""
+        """``dnnevo assess``'s first lines: what was run, and the task's own table."""
 
     def rate_column(self, a: Assessment) -> tuple[str, dict[str, str]] | None:
-        """An extra column of ``evaluate``'s rate table: its header and its cells by rate name."""
+        """An extra column of ``assess``'s rate table: its header and its cells by rate name."""
 
     def overall(self, a: Assessment) -> str:
-        """``evaluate``'s verdict line."""
+        """``assess``'s verdict line."""
 
     def evaluate_extra(self, config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
-        """Further tests ``evaluate`` runs on a champion, as JSON types (``{}`` for none)."""
+        """Further tests ``assess`` runs on a champion, as JSON types (``{}`` for none)."""
 
     def extra_lines(self, extra: dict[str, Any]) -> list[str]:
         """The text of :meth:`evaluate_extra`'s tests."""

@@ -27,7 +27,7 @@ _TASKS: dict[str, Task] = {t.NAME: t for t in (landmark, nav1d, sequence)}
 THRESHOLDS = {name: t.THRESHOLD for name, t in _TASKS.items()}
 """Each task's success threshold, by name."""
 DEFAULT_TRIALS = {name: t.DEFAULT_TRIALS for name, t in _TASKS.items()}
-"""``dnnevo evaluate``'s default trial count of each task, by name."""
+"""``dnnevo assess``'s default trial count of each task, by name."""
 UNITS = {name: t.UNIT for name, t in _TASKS.items()}
 """What each task's trial count counts, by name."""
 

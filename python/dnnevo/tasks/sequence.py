@@ -40,7 +40,7 @@ THRESHOLD: float = _core.SEQUENCE_SUCCESS_FRACTION
 (``SEQUENCE_SUCCESS_FRACTION`` of the binding)."""
 
 DEFAULT_TRIALS = 1000
-"""``dnnevo evaluate``'s default: trials per target (4000 trials of the 2-bit task take under
+"""``dnnevo assess``'s default: trials per target (4000 trials of the 2-bit task take under
 half a second on one core)."""
 
 UNIT = "trials per target"
@@ -244,11 +244,11 @@ def judge(config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *
 
 
 SWITCH_TRIALS = 20
-"""Fresh trials per ordered pair of targets in ``evaluate``'s switch test."""
+"""Fresh trials per ordered pair of targets in ``assess``'s switch test."""
 
 
 def preface(where: Path, a: Assessment) -> list[str]:
-    """What ``evaluate`` ran, and the rule it judges by."""
+    """What ``assess`` ran, and the rule it judges by."""
     return [
         f"{where}: champion on {a.trials} fresh {a.unit} (seed {a.seed}).",
         "A trial is correct when every trigger from index 2 x len(target) on is. A target passes "

@@ -1,4 +1,4 @@
-"""The ``dnnevo evaluate`` command: a run's champion judged on fresh conditions by
+"""The ``dnnevo assess`` command (``assess``, its old name, still works): a run's champion judged on fresh conditions by
 :func:`dnnevo.tasks.assess`, printed as text (default) or JSON (``--json``). The exit status is
 the verdict: 0 pass, 1 fail, 3 undecided (2 is an error)."""
 
@@ -20,11 +20,11 @@ from dnnevo.runs import RunDir
 from dnnevo.evaluation.stepcheck import StepCheck, step_check, with_dt
 
 EXAMPLE = """examples:
-  dnnevo evaluate runs/demo                      the champion on fresh trials, default counts
-  dnnevo evaluate runs/demo --trials 2000 --seed 1
-  dnnevo evaluate runs/lm --robot-like --json    the whole assessment as JSON on stdout
-  dnnevo evaluate runs/demo --dt 0.01            the same champion integrated 10x finer
-  dnnevo evaluate runs/demo --dt-check           also at a 10x finer step and with RK4
+  dnnevo assess runs/demo                      the champion on fresh trials, default counts
+  dnnevo assess runs/demo --trials 2000 --seed 1
+  dnnevo assess runs/lm --robot-like --json    the whole assessment as JSON on stdout
+  dnnevo assess runs/demo --dt 0.01            the same champion integrated 10x finer
+  dnnevo assess runs/demo --dt-check           also at a 10x finer step and with RK4
 
 Each rate gets a 95% Wilson score interval. Verdict: pass when the interval lies at or above the
 task's threshold (sequence: 90% of trials per target; landmark and nav1d: 95%), fail when it lies
@@ -39,11 +39,11 @@ at either; an artefact's exit status is 1, whatever the run's step says.
 Exit status: 0 pass, 1 fail, 3 undecided, 2 error."""
 
 EXIT_STATUS: dict[Verdict, int] = {"pass": 0, "fail": 1, "undecided": 3}
-"""``dnnevo evaluate``'s exit status per verdict (2 is a usage or input error, 130 Ctrl-C)."""
+"""``dnnevo assess``'s exit status per verdict (2 is a usage or input error, 130 Ctrl-C)."""
 
 
-def evaluate(args: argparse.Namespace) -> int:
-    """``dnnevo evaluate``."""
+def assess(args: argparse.Namespace) -> int:
+    """``dnnevo assess``."""
     run = RunDir(args.dir)
     config, table = run.read_config()
     champion = run.read_best(config, table)

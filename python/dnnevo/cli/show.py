@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from dnnevo import plot
 from dnnevo.config import EvolutionConfig
 from dnnevo.evolution.evolve import PYTHON_TASK
 from dnnevo.runs import RunDir, save_figure
@@ -102,10 +103,8 @@ def show(args: argparse.Namespace) -> int:
     print("\n".join(lines[:2]))
     print(f"last generation ({int(last['generation'])}): gen best {last['best']:.4f}, "
           f"gen mean {last['mean']:.4f}")
-    from dnnevo.plot import plot_fitness
-
     arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
-    ax = plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
+    ax = plot.plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
     save_figure(ax.figure, run.path / "fitness.png")
     print(f"wrote {run.path / 'fitness.png'}")
     for line in lines[2:]:

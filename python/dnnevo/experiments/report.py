@@ -16,17 +16,21 @@ from __future__ import annotations
 import base64
 import html
 import math
+import os
+import platform
 import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from dnnevo import _core, figures, plot
 from dnnevo.experiments import plan
 from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
 from dnnevo.evaluation.assessment import Assessment
 from dnnevo.experiments.jobs import ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings
-from dnnevo.runs import save_figure, write_atomic
+from dnnevo.runs import RunDir, save_figure, write_atomic
+from dnnevo.tasks import nav1d
 from dnnevo.experiments.scheduler import Outcome
 
 __all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "SUMMARY_HEADER",
@@ -151,13 +155,6 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
 def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, Outcome], root: Path) -> list[Block]:
     """Draws and returns the experiment's figures: fitness over seeds, and the first finished
     seed's own figures."""
-    import matplotlib.pyplot as plt
-
-    from dnnevo import figures
-    from dnnevo.tasks import nav1d
-    from dnnevo.plot import plot_fitness_seeds
-    from dnnevo.runs import RunDir
-
     done = [j for j in order if j.experiment == e.name and outcomes[j.id].status == "done"]
     if not done:
         return []
@@ -168,11 +165,11 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
             run = RunDir(root / job.id)
             rows = run.read_log(run.read_config()[0])
             histories[job.seed] = {k: [r[k] for r in rows] for k in ("generation", "best", "mean")}
-        ax = plot_fitness_seeds(histories, title=f"{e.name}: fitness over {len(histories)} seed(s)")
+        ax = plot.plot_fitness_seeds(histories, title=f"{e.name}: fitness over {len(histories)} seed(s)")
         name = f"{FIGURES}/fitness-{e.name}.png"
         (root / FIGURES).mkdir(exist_ok=True)
         save_figure(ax.figure, root / name)
-        plt.close(ax.figure)
+        plot.close(ax.figure)
         blocks.append(Block("img", f"{e.name}: best (solid) and mean (dotted) fitness per seed", path=name))
         first = done[0]
         for file in figures.draw_run(root / first.id, seed=0):
@@ -301,31 +298,16 @@ def write(root: Path, blocks: Sequence[Block]) -> list[Path]:
 
 def environment(*, workers: str, threads: int | None, wall_s: float) -> dict[str, str]:
     """The machine and settings of a reproduction, for its report."""
-    import os
-    import platform
-    import subprocess
-
-    import dnnevo
-
-    info = dnnevo.build_info()
+    info = _core.build_info()
     cpu = platform.processor() or "unknown"
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as f:
             cpu = next((line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), cpu)
     except OSError:
         pass
-    commit = "not a git checkout"
-    try:
-        here = Path(dnnevo.__file__).resolve().parent
-        done = subprocess.run(["git", "-C", str(here), "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, timeout=5, check=False)
-        if done.returncode == 0:
-            commit = done.stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        pass
     features = ", ".join(k for k, v in info["cpu_features"].items() if v) or "none"
     return {
-        "dnnevo": f"{info['version']} (git {commit})", "Python": platform.python_version(),
+        "dnnevo": f"{info['version']} (git {info['commit']})", "Python": platform.python_version(),
         "system": f"{platform.system()} {platform.release()} ({platform.machine()})", "CPU": cpu,
         "CPU features": features, "SIMD kernel": f"{info['kernel']} ({info['lanes']} lanes)",
         "cores": str(os.cpu_count()), "workers": workers,

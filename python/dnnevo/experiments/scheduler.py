@@ -93,8 +93,6 @@ def run_in_process(tasks: Sequence[Task], view: RunsView, *,
 def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str, Outcome]:
     """Submits ``tasks`` to the Dask ``client``, each with the futures of the tasks it needs as
     extra arguments after its own, so the scheduler runs it after them."""
-    from distributed import as_completed
-
     token = uuid.uuid4().hex[:8]
     futures: dict[str, Any] = {}
     for task in tasks:
@@ -103,7 +101,7 @@ def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str,
                                          key=f"{task.id}-{token}", pure=False)
     by_key = {f.key: task for task, f in zip(tasks, futures.values(), strict=True)}
     ended: dict[str, tuple[bool, Any]] = {}  # (finished, its result or its error), as it ended
-    for future in as_completed(list(futures.values())):
+    for future in _distributed().as_completed(list(futures.values())):
         task = by_key[future.key]
         ok = future.status == "finished"
         ended[task.id] = (ok, future.result() if ok else future.exception())
@@ -153,17 +151,26 @@ def check_options(*, workers: int | None, scheduler: str | None) -> None:
         raise ConfigError(f"Dask is not installed; {CLUSTER_EXTRA}")
 
 
+
+def _distributed() -> Any:
+    """The ``distributed`` package, imported here and only when a Dask cluster is used: it is an
+    optional extra (``pip install "dnnevo[cluster]"``), and its import takes about a second."""
+    import distributed
+
+    return distributed
+
+
 @contextlib.contextmanager
 def dask_client(*, workers: int | None, scheduler: str | None) -> Iterator[Any]:
     """A Dask client: of a new local cluster of ``workers`` processes (default: one per core),
     one task at a time each, or of the running cluster at ``scheduler``. The cluster and its
     workers end with the block; a running cluster's workers finish the tasks they hold."""
     check_options(workers=workers, scheduler=scheduler)
-    from distributed import Client, LocalCluster
+    distributed = _distributed()
 
     if scheduler is not None:
         try:
-            client = Client(scheduler, timeout="20s")
+            client = distributed.Client(scheduler, timeout="20s")
         except (OSError, ValueError, TypeError) as e:
             raise ConfigError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
         with client:
@@ -173,8 +180,8 @@ def dask_client(*, workers: int | None, scheduler: str | None) -> Iterator[Any]:
     # The scheduler serves HTTP (the dashboard with bokeh) even without a dashboard: on a free
     # port, never 8787, which another cluster on this machine may hold. A task's own error is
     # reported by the caller, not as the workers' log of its traceback.
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.CRITICAL) as cluster, Client(cluster) as client:
+    with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                      silence_logs=logging.CRITICAL) as cluster, distributed.Client(cluster) as client:
         yield client
 
 

@@ -1,0 +1,33 @@
+"""The package keeps the shape docs/architecture.md describes (measured by tests/structure.py)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from structure import measure
+
+PACKAGE = Path(__file__).resolve().parent.parent / "python" / "dnnevo"
+
+
+def test_no_import_loop_and_no_task_name_outside_the_tasks() -> None:
+    shape = measure(PACKAGE)
+    assert shape.loops == []
+    assert shape.task_name_branches == [], "a layer above the tasks branches on a task's name"
+
+
+def test_at_most_five_deferred_imports() -> None:
+    # pyplot, tqdm, Dask and Pillow: each one costs start-up time or is an optional extra, and
+    # says so where it is imported.
+    deferred = measure(PACKAGE).deferred
+    assert len(deferred) <= 5, "\n".join(deferred)
+
+
+def test_the_measure_sees_a_loop_and_a_deferred_import(tmp_path: Path) -> None:
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from pkg import b\n")
+    (pkg / "b.py").write_text("def f():\n    from pkg import a\n    return a\n")
+    (pkg / "c.py").write_text("def g(config):\n    return config.task == 'nav1d'\n")
+    shape = measure(pkg)
+    assert shape.loops and len(shape.deferred) == 1 and len(shape.task_name_branches) == 1

@@ -1,0 +1,191 @@
+"""The results tables are made from docs/results/ alone: collecting a reproduction's results,
+rendering the tables between marker lines, ``render --check`` failing on a stale table, and the
+repository's own tables being up to date."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cli_helpers import run_cli
+from dnnevo.errors import DnnevoError
+from dnnevo.experiments import plan, results
+
+ROOT = Path(__file__).resolve().parent.parent
+README = "# dnnevo\n\nBefore.\n\n<!-- results-table:begin -->\nold\n<!-- results-table:end -->\n\nAfter.\n"
+
+
+def _results(*args: object) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "dnnevo.experiments.results", *map(str, args)],
+                          capture_output=True, text=True, timeout=120)
+
+
+@pytest.fixture(scope="module")
+def reproduction(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A quick reproduction of the landmark family, seed 0."""
+    out = tmp_path_factory.mktemp("repro") / "out"
+    r = run_cli("reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--eval-trials", "10",
+                "--no-dt-check", "--in-process", "--out", out)
+    assert r.returncode == 0, r.stderr
+    return out
+
+
+@pytest.fixture
+def repo(tmp_path: Path, reproduction: Path) -> Path:
+    """A repository whose docs/results holds the quick reproduction's results, its README and
+    results page holding markers, and the reproduction's run folders gone."""
+    source = tmp_path / "source"
+    shutil.copytree(reproduction, source)
+    repo = tmp_path / "repo"
+    (repo / "docs" / "results").mkdir(parents=True)
+    shutil.copy(ROOT / "docs" / "results" / "index.md", repo / "docs" / "results" / "index.md")
+    (repo / "README.md").write_text(README, encoding="utf-8")
+    r = _results("collect", source, repo / "docs" / "results", "--seeds", "0", "--commit", "abc1234")
+    assert r.returncode == 0, r.stderr
+    assert "collected 4 results" in r.stdout
+    shutil.rmtree(source)  # the tables need no run folder
+    return repo
+
+
+def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) -> None:
+    stored = repo / "docs" / "results"
+    assert sorted(p.relative_to(stored).as_posix() for p in stored.rglob("*.json")) == [
+        "landmark-robot/seed-0.json", "landmark-robust-robot/seed-0.json", "landmark-robust/seed-0.json",
+        "landmark/seed-0.json", "provenance.json", "reproduce.json"]
+    provenance = json.loads((stored / "provenance.json").read_text())
+    assert provenance["commit"] == "abc1234" and provenance["seeds"] == [0]
+    assert provenance["environment"]["SIMD kernel"] and provenance["environment"]["dnnevo"].endswith("(git abc1234)")
+    assert provenance["families"]["landmark"]["runs"] == provenance["families"]["landmark"]["planned"] == 4
+    assert provenance["families"]["landmark"]["command"] == (
+        "dnnevo reproduce --seeds 0 --only landmark --quick --eval-trials 10 --no-dt-check")
+
+    r = _results("render", "--root", repo)
+    assert r.returncode == 0, r.stderr
+    readme = (repo / "README.md").read_text()
+    assert readme.startswith("# dnnevo\n\nBefore.\n\n<!-- results-table:begin -->\n")
+    assert readme.endswith("<!-- results-table:end -->\n\nAfter.\n") and "\nold\n" not in readme
+    # The rows are the reproduction's own report's rows, made by the same code.
+    own = (reproduction / "report.md").read_text()
+    for e in (e for e in plan.EXPERIMENTS if e.family == "landmark"):
+        row = next(line for line in own.splitlines() if line.startswith(f"| {e.name} | "))
+        assert row in readme.splitlines()
+    assert "| nav1d-far | §4.2: solved at generation 0 | not yet run | - |" in readme
+    assert "| sequence-3bit | §5.4: 1 success, at generation 700 | not yet run |" in readme
+    assert "commit abc1234" in readme and "4 of 21 runs done" in readme and "Quick mode" in readme
+
+    page = (stored / "index.md").read_text()
+    assert "<!-- results:landmark:begin -->\n\n### landmark\n\nPaper: §3" in page
+    assert "| seed | right (95% interval) | confusion" in page
+    assert ("### nav1d-far\n\nPaper: §4.2: solved at generation 0. Preset `nav1d-far`.\n\n"
+            "Not yet run over seeds 0.") in page
+    assert "| landmark | (whole family) | 4/4 |" in page and "| nav1d | (whole family) | not yet run |" in page
+    assert "| commit | abc1234 |" in page
+
+    assert _results("render", "--root", repo, "--check").returncode == 0
+    assert results.render(repo) == []  # rendering again changes nothing
+
+
+def test_render_only_named_files(repo: Path) -> None:
+    readme, page = repo / "README.md", repo / "docs" / "results" / "index.md"
+    r = _results("render", "--root", repo, page)
+    assert r.returncode == 0 and r.stdout == f"wrote {page}\n", r.stderr
+    assert readme.read_text() == README
+    assert results.render(repo, check=True) == [readme]
+
+
+def test_check_fails_on_an_edited_table_and_changes_nothing(repo: Path) -> None:
+    assert results.render(repo) == [repo / "README.md", repo / "docs" / "results" / "index.md"]
+    readme = repo / "README.md"
+    edited = readme.read_text().replace("| landmark | §3: solved by generation 15 in simulation | 1/1 |",
+                                        "| landmark | §3: solved by generation 15 in simulation | 9/9 |")
+    assert edited != readme.read_text()
+    readme.write_text(edited)
+    r = _results("render", "--root", repo, "--check")
+    assert r.returncode == 1 and r.stdout == ""
+    assert r.stderr.strip().splitlines() == [f"{readme}: results tables differ from docs/results; run "
+                                             "python -m dnnevo.experiments.results render"]
+    assert readme.read_text() == edited
+    assert results.render(repo) == [readme] and "| 1/1 |" in readme.read_text()
+
+
+def test_without_results_every_experiment_is_not_yet_run(tmp_path: Path) -> None:
+    (tmp_path / "README.md").write_text(README)
+    assert results.render(tmp_path) == [tmp_path / "README.md"]
+    text = (tmp_path / "README.md").read_text()
+    assert "No results yet in docs/results/" in text
+    assert sum(f"| {e.name} | {e.paper} | not yet run |" in text for e in plan.EXPERIMENTS) == len(plan.EXPERIMENTS)
+
+
+def test_bad_markers_and_mixed_reproductions_are_named(tmp_path: Path, repo: Path) -> None:
+    page = tmp_path / "docs" / "page.md"
+    page.parent.mkdir()
+    page.write_text("<!-- results:vision:begin -->\n<!-- results:vision:end -->\n")
+    with pytest.raises(DnnevoError, match="unknown results marker 'vision'"):
+        results.render(tmp_path)
+    page.write_text("<!-- results:landmark:begin -->\n")
+    with pytest.raises(DnnevoError, match="page.md: <!-- results:landmark:begin --> has no <!-- results:landmark:end"):
+        results.render(tmp_path)
+    page.write_text("<!-- results:summary:nav1d:begin -->\n<!-- results:summary:nav1d:end -->\n"
+                    "<!-- results:machine:begin -->\n<!-- results:machine:end -->\n")
+    assert results.render(tmp_path) == [page] and "| nav1d-far |" in page.read_text()
+    assert "| landmark |" not in page.read_text().split("results:machine")[0]
+
+    stored = repo / "docs" / "results"
+    original = (stored / "reproduce.json").read_text()
+    settings = json.loads(original)
+    settings["settings"]["eval_trials"] = 11
+    (stored / "reproduce.json").write_text(json.dumps(settings))
+    r = _results("render", "--root", repo)
+    assert r.returncode == 2 and "made with other settings" in r.stderr and len(r.stderr.splitlines()) == 1
+    (stored / "reproduce.json").write_text(original)
+    good = (stored / "landmark" / "seed-0.json").read_text()
+    broken = json.loads(good)
+    del broken["run"]["final"]
+    (stored / "landmark" / "seed-0.json").write_text(json.dumps(broken))
+    with pytest.raises(DnnevoError, match=r"landmark/seed-0.json: not a valid job result \(KeyError"):
+        results.load(stored)
+    (stored / "landmark" / "seed-0.json").write_text(good)
+    (stored / "landmark-old").mkdir()
+    (stored / "landmark-old" / "seed-0.json").write_text("{}")
+    with pytest.raises(DnnevoError, match="landmark-old is no experiment of the plan"):
+        results.load(stored)
+
+
+def test_collect_refuses_another_reproductions_folder(tmp_path: Path, reproduction: Path) -> None:
+    dest = tmp_path / "results"
+    dest.mkdir()
+    (dest / "reproduce.json").write_text("{}\n")
+    r = _results("collect", reproduction, dest, "--seeds", "0")
+    assert r.returncode == 2 and "another reproduction's settings" in r.stderr
+    assert not (dest / "landmark").exists()
+
+
+def test_the_committed_tables_are_made_from_docs_results() -> None:
+    """README.md and the docs say what docs/results holds: run
+    ``python -m dnnevo.experiments.results render`` after collecting results."""
+    if not (ROOT / results.RESULTS_DIR / results.SETTINGS_FILE).exists():
+        pytest.skip("docs/results holds no reproduction yet")
+    stale = results.render(ROOT, check=True)
+    names = ", ".join(str(f.relative_to(ROOT)) for f in stale)
+    assert not stale, f"tables differ from docs/results in {names}: run python -m dnnevo.experiments.results render"
+
+
+def test_collect_needs_the_commit_when_the_report_names_none(tmp_path: Path, reproduction: Path) -> None:
+    """``pip install .`` from a clone leaves the report without a commit: ``--commit`` names it."""
+    source = tmp_path / "source"
+    shutil.copytree(reproduction, source)
+    md = source / "report.md"
+    md.write_text("\n".join(line if not line.startswith("| dnnevo |") else "| dnnevo | 0.1.0 (git not a git checkout) |"
+                            for line in md.read_text().splitlines()) + "\n")
+    r = _results("collect", source, tmp_path / "results", "--seeds", "0")
+    assert r.returncode == 2 and "names no commit" in r.stderr and "pass --commit" in r.stderr
+    assert not list((tmp_path / "results").rglob("*.json"))
+    r = _results("collect", source, tmp_path / "results", "--seeds", "0", "--commit", "ca5f9b8")
+    assert r.returncode == 0, r.stderr
+    provenance = json.loads((tmp_path / "results" / "provenance.json").read_text())
+    assert provenance["environment"]["dnnevo"] == "0.1.0 (git ca5f9b8)" and provenance["commit"] == "ca5f9b8"

@@ -23,7 +23,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from dnnevo import _core, figures, plot
+from dnnevo import _core, figures, plot, presets
 from dnnevo.experiments import plan
 from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
@@ -93,7 +93,7 @@ def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[st
                   else f"not reached ({m.censored} of {s.seeds} seeds never met the rule)")
         artefacts = f"{s.artefacts}/{s.checked}" if s.checked else "not checked"
         return (*head, _k_of_n(s.succeeded, s.seeds), _k_of_n(s.passed, s.seeds), median, artefacts,
-                _median_wall(walls))
+                _median_wall([r.wall_s for r in runs]))
     if e.kind == plan.ROBOT_LIKE:
         verdicts = [Assessment.from_dict(o.result["assessment"]).verdict for o in done if o.result]
         passed = sum(v == "pass" for v in verdicts)
@@ -115,7 +115,7 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
     for job in (j for j in order if j.experiment == e.name):
         o = outcomes[job.id]
         if o.status != "done" or o.result is None:
-            rows.append((str(job.seed), o.status, o.message, "", "", "", ""))
+            rows.append((str(job.seed), o.status, o.message))
         elif e.kind == plan.EVOLVE:
             r = sweep.SeedResult.from_dict(o.result["run"])
             w = r.final.weakest
@@ -130,7 +130,7 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
             (p, q), (s, t) = a.details["confusion"]
             rows.append((str(job.seed), f"{overall.k}/{overall.n} ({_pct(overall.interval[0])}-"
                          f"{_pct(overall.interval[1])})", f"[[{p}, {q}], [{s}, {t}]]",
-                         ", ".join(f"{r.name} {_pct(r.rate)}" for r in a.rates[:-1]), a.verdict, "",
+                         ", ".join(f"{r.name} {_pct(r.rate)}" for r in a.rates[:-1]), a.verdict,
                          f"{o.result['wall_s']:.0f} s"))
         else:
             res = o.result
@@ -138,17 +138,18 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
             rows.append((str(job.seed), f"{_pct(res['goal_rate'])} ({_pct(res['goal_interval'][0])}-"
                          f"{_pct(res['goal_interval'][1])})", f"{_pct(res['classification_rate'])}",
                          ", ".join(_pct(x) for x in later), f"{res['environments']} environments x "
-                         f"{res['trials']} trials, seed {res['seed']}", "", f"{res['wall_s']:.0f} s"))
+                         f"{res['trials']} trials, seed {res['seed']}", f"{res['wall_s']:.0f} s"))
     if not rows:
         return None
     header = {
         plan.EVOLVE: ("seed", "best training fitness", "first success", "weakest judged rate, fresh trials",
-                      "verdict", "largest change at a finer step", "wall"),
+                      "verdict", "largest change at a finer step", "wall (the run's, every session)"),
         plan.ROBOT_LIKE: ("seed", "right (95% interval)", "confusion [[1 as 1, 1 as 2], [2 as 1, 2 as 2]]",
-                          "per landmark", "verdict (95% rule)", "", "wall"),
+                          "per landmark", "verdict (95% rule)", "wall"),
         plan.SYSTEM: ("seed", "goal reached (95% interval, by environment)", "classifier right",
-                      "goal rate in trials 2-5", "conditions", "", "wall"),
+                      "goal rate in trials 2-5", "conditions", "wall"),
     }[e.kind]
+    rows = [row + ("",) * (len(header) - len(row)) for row in rows]
     return Block("table", rows=(header, *rows))
 
 
@@ -194,6 +195,9 @@ def describe(e: plan.Experiment) -> str:
         what += f" Uses the runs of {', '.join(e.needs)} of the same seed."
     if e.note:
         what += f" {e.note[0].upper()}{e.note[1:]}."
+    if e.preset and presets.get(e.preset, overrides=list(e.overrides)).task_params.get("near_first_weight", 0) > 0:
+        what += (" Its training fitness can exceed 1: near_first_weight adds a bonus for reaching the goal "
+                 "in the first, unscored trial of landmark-near chains; the success rule is unchanged.")
     return what
 
 
@@ -233,7 +237,7 @@ def build(root: Path, order: Sequence[plan.Job], outcomes: dict[str, Outcome], *
         if draw:
             blocks.extend(_figures(e, order, outcomes, root))
     blocks.append(Block("h2", "Environment"))
-    blocks.append(Block("table", rows=(("", ""), *environment.items())))
+    blocks.append(Block("table", rows=(("what", "value"), *environment.items())))
     return blocks
 
 

@@ -13,22 +13,14 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
   the folds (an equilibrium pair appears or vanishes) and Hopf points (a complex pair crosses the
   imaginary axis) located; optionally the attracting cycles followed as :class:`CycleBranch` es,
   each with where it appears and disappears;
-- :func:`clamp`, :func:`cut` and :func:`lesions`: a neuron held at a constant output, or a
-  connection removed, and the champion re-scored on fresh trials by :func:`dnnevo.tasks.assess`.
-
 The numerical work is in Rust (``ctrnn::analysis``); this module turns its results into
 dataclasses. The analysis is of the continuous-time system; tasks integrate it with Euler steps
 (``dnnevo assess --dt-check`` tells whether a champion's behaviour depends on the step).
 
 >>> import dnnevo
->>> from dnnevo import analysis
->>> # One self-exciting neuron (w = 8) with its threshold at the centre (theta = w / 2): bistable.
 >>> net = dnnevo.Network(tau=[1.0], theta=[4.0], weights=[[8.0]], sensor_weights=[[1.0]])
->>> [e.stability for e in analysis.equilibria(net, [0.0])]
-['stable_node', 'unstable_node', 'stable_node']
->>> b = analysis.bifurcation(net, 0, -4.0, 4.0, steps=41)
->>> [(e.kind, round(e.value, 4)) for e in b.events]
-[('fold', -1.0657), ('fold', 1.0657)]
+>>> len(limit_cycles(net, [0.0]))  # one neuron cannot oscillate
+0
 """
 
 

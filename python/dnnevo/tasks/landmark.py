@@ -30,9 +30,9 @@ from dnnevo import _core, plot
 from dnnevo._checks import bounded_count, nonnegative, task_params
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
-from dnnevo.evaluation import assessment
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, combine, rate
 from dnnevo.runs import RunDir, save_figure, write_atomic_with
+from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
 
 
 if TYPE_CHECKING:
@@ -253,26 +253,6 @@ def _animate(rec: Record, classifier: int, path: Any) -> None:
     write_atomic_with(path, lambda tmp: images[0].save(
         tmp, format="GIF", save_all=True, append_images=images[1:], duration=100, loop=0), suffix=".gif")
     plot.close(fig)
-
-
-def rate_column(a: Assessment) -> tuple[str, dict[str, str]] | None:
-    """No extra column."""
-    return None
-
-
-def overall(a: Assessment) -> str:
-    """The verdict line of the overall rate."""
-    return assessment.verdict_line(a)
-
-
-def evaluate_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
-    """No further test."""
-    return {}
-
-
-def extra_lines(extra: dict[str, Any]) -> list[str]:
-    """No further test."""
-    return []
 
 
 def recorded_trials(config: EvolutionConfig, net: _core.Network, *,

@@ -40,6 +40,7 @@ from dnnevo.errors import ConfigError
 from dnnevo.evaluation import assessment
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, Rate, combine
 from dnnevo.runs import RunDir, save_figure
+from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
 
 
 if TYPE_CHECKING:
@@ -456,26 +457,6 @@ def _join(first: Record, rest: Record) -> Record:
         classification=first.classification + rest.classification,
         final_state=rest.final_state,
     )
-
-
-def rate_column(a: Assessment) -> tuple[str, dict[str, str]] | None:
-    """No extra column."""
-    return None
-
-
-def overall(a: Assessment) -> str:
-    """The verdict line of the overall rate."""
-    return assessment.verdict_line(a)
-
-
-def evaluate_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
-    """No further test."""
-    return {}
-
-
-def extra_lines(extra: dict[str, Any]) -> list[str]:
-    """No further test."""
-    return []
 
 
 def recorded_trials(config: EvolutionConfig, net: _core.Network, *,

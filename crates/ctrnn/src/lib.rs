@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod batch;
 pub mod error;
 pub mod evolve;
 pub mod ga;
@@ -33,6 +34,7 @@ pub mod testing;
 pub mod validation;
 mod vector;
 
+pub use batch::Batch;
 pub use error::{Error, Result};
 pub use evolve::{Evolution, Fill, Stats, Task};
 pub use ga::{GaConfig, Selection};

@@ -6,6 +6,7 @@
 //! `ctrnn::testing`, which is not public API.
 
 mod analysis;
+mod batch;
 mod error;
 mod evolve;
 mod ga;

@@ -1,0 +1,425 @@
+//! [`Batch`]: many networks stepped one input row at a time, for tasks whose next inputs depend
+//! on the last outputs (closed loop).
+//!
+//! A batch holds `P` networks times `E` replicas, `B = P * E` rows; row `p * E + e` is replica
+//! `e` of network `p`, so that one network's episodes sit side by side. Each call of
+//! [`Batch::step`] holds one row of inputs per row for `substeps` integration steps and returns
+//! every row's firing rates. Rows can be left out of a step (an ended episode), reset to zero (a
+//! new one), or given any state.
+//!
+//! One row fed the same inputs gives the same bits as [`Network::run`]: both step through the
+//! same kernel in the same order of operations.
+
+use std::borrow::Borrow;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::integrate::{Integrator, LANES};
+use crate::network::Network;
+use crate::population::Block;
+
+/// Integration steps of one block between two looks at the cancel flag, as in the integrator.
+const CANCEL_CHECK_STEPS: usize = 1024;
+
+/// Block-steps (blocks x N x N x substeps) from which a step runs its blocks on all cores; below
+/// it, handing the blocks to the thread pool costs more than it saves.
+const PARALLEL_WORK: usize = 1 << 14;
+
+/// `P` networks times `E` replicas, stepped together one input row per call.
+///
+/// # Example
+/// ```
+/// use ctrnn::{Batch, Integrator, Network};
+/// let net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None)?;
+/// let mut batch = Batch::new(&[net], 2, Integrator::default())?;
+/// let mut rates = vec![0.0; batch.rows() * batch.size()];
+/// // Row 1 senses 1, row 0 senses 0; only row 1 is stepped.
+/// batch.step(&[0.0, 1.0], Some(&[false, true]), &mut rates, None)?;
+/// assert_eq!(batch.states(), vec![0.0, 0.1]);
+/// # Ok::<(), ctrnn::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Batch {
+    size: usize,
+    n_inputs: usize,
+    replicas: usize,
+    integ: Integrator,
+    networks: Vec<Network>,
+    blocks: Vec<Block>,
+    /// Each block's work arrays, reused from step to step so that a step allocates nothing.
+    slots: Vec<Slot>,
+    /// The row in each lane, `row_at[b * LANES + l]`, and each row's lane, `lane_of[row]`.
+    row_at: Vec<usize>,
+    lane_of: Vec<usize>,
+}
+
+/// One block's work arrays.
+#[derive(Clone, Debug)]
+struct Slot {
+    /// The lanes that take part in the current step, one bit per lane.
+    on: u32,
+    /// The inputs of the step, `[sensor][lane]`.
+    inputs: Vec<[f64; LANES]>,
+    /// The states of the lanes left out of the step, lane by lane.
+    kept: Vec<f64>,
+    /// The rates after the step, lane by lane.
+    rates: Vec<f64>,
+}
+
+impl Batch {
+    /// `replicas` rows for each of `networks` (at least one, all of the same N and M), each
+    /// starting from its network's state, stepped with `integ`.
+    pub fn new<N: Borrow<Network>>(
+        networks: &[N],
+        replicas: usize,
+        integ: Integrator,
+    ) -> Result<Self> {
+        integ.validate()?;
+        if replicas == 0 {
+            return Err(Error::InvalidArgument(
+                "replicas is 0; a batch needs at least 1 replica per network".into(),
+            ));
+        }
+        let networks: Vec<Network> = networks.iter().map(|n| n.borrow().clone()).collect();
+        let first = networks
+            .first()
+            .ok_or_else(|| Error::InvalidArgument("a batch needs at least 1 network".into()))?;
+        let (n, m) = (first.size(), first.n_inputs());
+        if let Some(p) = networks
+            .iter()
+            .position(|x| (x.size(), x.n_inputs()) != (n, m))
+        {
+            return Err(Error::InvalidArgument(format!(
+                "network {p} has N = {}, M = {}; every network of a batch must have N = {n}, M = {m}",
+                networks[p].size(),
+                networks[p].n_inputs()
+            )));
+        }
+        let rows = networks.len() * replicas;
+        let slot = Slot {
+            on: 0,
+            inputs: vec![[0.0; LANES]; m],
+            kept: vec![0.0; LANES * n],
+            rates: vec![0.0; LANES * n],
+        };
+        let mut batch = Batch {
+            size: n,
+            n_inputs: m,
+            replicas,
+            integ,
+            networks,
+            blocks: Vec::new(),
+            slots: vec![slot; rows.div_ceil(LANES)],
+            row_at: (0..rows).collect(),
+            lane_of: (0..rows).collect(),
+        };
+        batch.blocks = batch.pack(None)?;
+        Ok(batch)
+    }
+
+    /// Rows B = networks x replicas.
+    pub fn rows(&self) -> usize {
+        self.row_at.len()
+    }
+    /// Networks P.
+    pub fn networks(&self) -> usize {
+        self.networks.len()
+    }
+    /// Replicas E of each network.
+    pub fn replicas(&self) -> usize {
+        self.replicas
+    }
+    /// Neurons per network N.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+    /// Sensors per network M.
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs
+    }
+    /// The integration settings of every step.
+    pub fn integrator(&self) -> &Integrator {
+        &self.integ
+    }
+
+    /// Blocks laid out as `row_at` says, each row's state taken from `states` (row-major
+    /// `B x N`), or from its network when `None`.
+    fn pack(&self, states: Option<&[f64]>) -> Result<Vec<Block>> {
+        let n = self.size;
+        self.row_at
+            .par_chunks(LANES)
+            .map(|rows| {
+                let refs: Vec<&Network> = rows
+                    .iter()
+                    .map(|&r| &self.networks[r / self.replicas])
+                    .collect();
+                let mut block = Block::new(&refs)?;
+                if let Some(states) = states {
+                    for (l, &r) in rows.iter().enumerate() {
+                        block.set_lane_state(l, &states[r * n..(r + 1) * n]);
+                    }
+                }
+                Ok(block)
+            })
+            .collect()
+    }
+
+    /// Moves the rows of `active` (`running` of them) to the first lanes, in row order, when
+    /// they are spread over clearly more blocks than they fill.
+    fn pack_active(&mut self, active: &[bool], running: usize) -> Result<()> {
+        let touched = self.slots.iter().filter(|s| s.on != 0).count();
+        let needed = running.div_ceil(LANES);
+        if touched <= needed + needed / 4 + 1 {
+            return Ok(());
+        }
+        let states = self.states();
+        let (on, off): (Vec<usize>, Vec<usize>) = (0..self.rows()).partition(|&r| active[r]);
+        self.row_at = on.into_iter().chain(off).collect();
+        for (at, &r) in self.row_at.iter().enumerate() {
+            self.lane_of[r] = at;
+        }
+        self.blocks = self.pack(Some(&states))?;
+        self.mark(Some(active));
+        Ok(())
+    }
+
+    /// Marks the lanes whose row is in `active` (every lane without a mask); returns how many.
+    fn mark(&mut self, active: Option<&[bool]>) -> usize {
+        let mut running = 0;
+        for (slot, rows) in self.slots.iter_mut().zip(self.row_at.chunks(LANES)) {
+            slot.on = 0;
+            for (l, &r) in rows.iter().enumerate() {
+                slot.on |= u32::from(active.is_none_or(|mask| mask[r])) << l;
+            }
+            running += slot.on.count_ones() as usize;
+        }
+        running
+    }
+
+    /// Fills each stepping block's inputs from `inputs` (`B x M`), 0 in lanes that do not step;
+    /// fails on an input of a stepping row that is not finite.
+    fn gather<T: Copy + Into<f64>>(&mut self, inputs: &[T]) -> Result<()> {
+        let m = self.n_inputs;
+        for (slot, rows) in self.slots.iter_mut().zip(self.row_at.chunks(LANES)) {
+            if slot.on == 0 {
+                continue;
+            }
+            for (l, &r) in rows.iter().enumerate() {
+                let on = slot.on >> l & 1 == 1;
+                for (k, sensor) in slot.inputs.iter_mut().enumerate() {
+                    let x = if on { inputs[r * m + k].into() } else { 0.0 };
+                    if !x.is_finite() {
+                        return Err(Error::InvalidArgument(format!(
+                            "inputs[{r}, {k}] is {x}; every input of a stepped row must be finite"
+                        )));
+                    }
+                    sensor[l] = x;
+                }
+            }
+            for sensor in &mut slot.inputs {
+                sensor[rows.len()..].fill(0.0);
+            }
+        }
+        Ok(())
+    }
+
+    /// Holds each row's inputs (row-major `B x M`, any type that widens exactly to `f64`) for
+    /// `substeps` integration steps, then writes each stepped row's firing rates `f(v - theta)`
+    /// into `rates` (row-major `B x N`). With `active`, rows where it is false keep their state
+    /// and their entries of `rates`, and cost nothing once they fill whole blocks: the rows
+    /// still running are then moved together.
+    ///
+    /// Fails, with every state as it was, on arrays of the wrong length or inputs of a stepped
+    /// row that are not finite. Fails with [`Error::Interrupted`] soon after `cancel` is set, and when an active
+    /// row's integration diverges; the states are then part-way through the step, so reset or
+    /// set them before stepping again.
+    pub fn step<T: Copy + Into<f64> + Sync>(
+        &mut self,
+        inputs: &[T],
+        active: Option<&[bool]>,
+        rates: &mut [f64],
+        cancel: Option<&AtomicBool>,
+    ) -> Result<()> {
+        let (rows, n, m) = (self.rows(), self.size, self.n_inputs);
+        self.check_len("inputs", inputs.len(), rows * m, "B x M")?;
+        self.check_len("rates", rates.len(), rows * n, "B x N")?;
+        if let Some(mask) = active {
+            self.check_len("active", mask.len(), rows, "B")?;
+        }
+        // Rows left out may hold anything: an ended episode's last observation is not read.
+        let running = self.mark(active);
+        if let Some(mask) = active {
+            self.pack_active(mask, running)?;
+        }
+        self.gather(inputs)?;
+        let integ = self.integ;
+        let row_at = &self.row_at;
+        let work = |b: usize, block: &mut Block, slot: &mut Slot| {
+            if slot.on == 0 {
+                return Ok(());
+            }
+            let lanes = block.len();
+            let first = b * LANES;
+            let off = |l: usize| slot.on >> l & 1 == 0;
+            for l in (0..lanes).filter(|&l| off(l)) {
+                block.lane_state(l, &mut slot.kept[l * n..(l + 1) * n]);
+            }
+            step_held_in_chunks(block, &slot.inputs, &integ, cancel)?;
+            check_finite(block, |l| (!off(l)).then(|| row_at[first + l]))?;
+            let stepped = block.outputs();
+            for l in 0..lanes {
+                for (i, rate) in stepped.iter().enumerate() {
+                    slot.rates[l * n + i] = rate[l];
+                }
+            }
+            for l in (0..lanes).filter(|&l| off(l)) {
+                block.set_lane_state(l, &slot.kept[l * n..(l + 1) * n]);
+            }
+            Ok(())
+        };
+        let busy = self.slots.iter().filter(|s| s.on != 0).count();
+        if busy * n * n * integ.substeps >= PARALLEL_WORK && busy > 1 {
+            self.blocks
+                .par_iter_mut()
+                .zip(self.slots.par_iter_mut())
+                .enumerate()
+                .try_for_each(|(b, (block, slot))| work(b, block, slot))?;
+        } else {
+            self.blocks
+                .iter_mut()
+                .zip(self.slots.iter_mut())
+                .enumerate()
+                .try_for_each(|(b, (block, slot))| work(b, block, slot))?;
+        }
+        for (slot, rows) in self.slots.iter().zip(row_at.chunks(LANES)) {
+            for (l, &r) in rows
+                .iter()
+                .enumerate()
+                .filter(|&(l, _)| slot.on >> l & 1 == 1)
+            {
+                rates[r * n..(r + 1) * n].copy_from_slice(&slot.rates[l * n..(l + 1) * n]);
+            }
+        }
+        Ok(())
+    }
+
+    fn check_len(&self, name: &str, len: usize, want: usize, shape: &str) -> Result<()> {
+        if len == want {
+            Ok(())
+        } else {
+            Err(Error::InvalidArgument(format!(
+                "{name} has {len} values; expected {shape} = {want} (B = {}, M = {}, N = {})",
+                self.rows(),
+                self.n_inputs,
+                self.size
+            )))
+        }
+    }
+
+    /// Every row's state, row-major `B x N`.
+    pub fn states(&self) -> Vec<f64> {
+        let n = self.size;
+        let mut out = vec![0.0; self.rows() * n];
+        for (r, &at) in self.lane_of.iter().enumerate() {
+            self.blocks[at / LANES].lane_state(at % LANES, &mut out[r * n..(r + 1) * n]);
+        }
+        out
+    }
+
+    /// Every row's firing rates `f(v - theta)`, row-major `B x N`.
+    pub fn rates(&mut self) -> Vec<f64> {
+        let n = self.size;
+        let mut out = vec![0.0; self.rows() * n];
+        for (b, block) in self.blocks.iter_mut().enumerate() {
+            let lanes = block.len();
+            let rates = block.outputs();
+            for l in 0..lanes {
+                let r = self.row_at[b * LANES + l];
+                for (i, rate) in rates.iter().enumerate() {
+                    out[r * n + i] = rate[l];
+                }
+            }
+        }
+        out
+    }
+
+    /// Sets the state of the rows where `rows` is true (every row without a mask) from
+    /// `states` (row-major `B x N`, finite; other rows' values are not read).
+    pub fn set_states(&mut self, states: &[f64], rows: Option<&[bool]>) -> Result<()> {
+        let (b_len, n) = (self.rows(), self.size);
+        self.check_len("states", states.len(), b_len * n, "B x N")?;
+        if let Some(mask) = rows {
+            self.check_len("rows", mask.len(), b_len, "B")?;
+        }
+        let chosen = |r: usize| rows.is_none_or(|mask| mask[r]);
+        if let Some(k) = (0..b_len * n).find(|&k| chosen(k / n) && !states[k].is_finite()) {
+            return Err(Error::InvalidArgument(format!(
+                "states[{}, {}] is {}; every state must be finite",
+                k / n,
+                k % n,
+                states[k]
+            )));
+        }
+        for (r, &at) in self.lane_of.iter().enumerate() {
+            if chosen(r) {
+                self.blocks[at / LANES].set_lane_state(at % LANES, &states[r * n..(r + 1) * n]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets the state of the rows where `rows` is true (every row without a mask) to zero, as
+    /// every built-in task starts a trial.
+    pub fn reset(&mut self, rows: Option<&[bool]>) -> Result<()> {
+        let zeros = vec![0.0; self.rows() * self.size];
+        self.set_states(&zeros, rows)
+    }
+}
+
+/// One input row held for `integ.substeps` steps, taken [`CANCEL_CHECK_STEPS`] at a time with a
+/// look at `cancel` in between (holding the inputs gives the same bits as one long row).
+fn step_held_in_chunks(
+    block: &mut Block,
+    inputs: &[[f64; LANES]],
+    integ: &Integrator,
+    cancel: Option<&AtomicBool>,
+) -> Result<()> {
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+    let chunk = |substeps: usize| Integrator { substeps, ..*integ };
+    let mut left = integ.substeps;
+    let first = left.min(CANCEL_CHECK_STEPS);
+    block.step_row(inputs, &chunk(first));
+    left -= first;
+    while left > 0 {
+        if cancelled() {
+            return Err(Error::Interrupted);
+        }
+        let now = left.min(CANCEL_CHECK_STEPS);
+        block.step_held(&chunk(now));
+        left -= now;
+    }
+    Ok(())
+}
+
+/// Fails when a stepped lane's state is no longer finite (an Euler step with `dt / tau > 2`);
+/// `row(l)` is the row in lane `l` if it was stepped.
+fn check_finite(block: &Block, row: impl Fn(usize) -> Option<usize>) -> Result<()> {
+    for i in 0..block.size() {
+        let state = block.state(i);
+        if state.iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        for l in 0..block.len() {
+            if let Some(r) = row(l).filter(|_| !state[l].is_finite()) {
+                return Err(Error::InvalidArgument(format!(
+                    "integration diverged: state[{i}] of row {r} became {}; use a smaller dt \
+                     (Euler needs dt / tau well below 2)",
+                    state[l]
+                )));
+            }
+        }
+    }
+    Ok(())
+}

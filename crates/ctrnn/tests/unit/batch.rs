@@ -1,0 +1,230 @@
+use std::sync::atomic::AtomicBool;
+
+use ctrnn::integrate::{Integrator, Method};
+use ctrnn::math::sigmoid;
+use ctrnn::testing::integrate::random_networks;
+use ctrnn::{Batch, Error, Network};
+use proptest::prelude::*;
+
+fn integrator(rk4: bool, substeps: usize) -> Integrator {
+    Integrator {
+        method: if rk4 { Method::Rk4 } else { Method::Euler },
+        dt: 0.1,
+        substeps,
+    }
+}
+
+fn bits(x: &[f64]) -> Vec<u64> {
+    x.iter().map(|v| v.to_bits()).collect()
+}
+
+/// Each row's inputs at step t: a function of (row, t), so that rows differ.
+fn input(row: usize, t: usize, k: usize) -> f64 {
+    ((row * 7 + t * 3 + k) % 11) as f64 / 5.0 - 1.0
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    /// Every row, stepped only on its active steps, ends where `Network::run` on those steps'
+    /// inputs ends, bit for bit, and the rates of a row stepped last are `f(v - theta)` of its state.
+    #[test]
+    fn rows_equal_network_run_bit_for_bit(
+        n in 1usize..7, m in 0usize..3, p in 1usize..20, e in 1usize..4,
+        steps in 1usize..8, rk4 in any::<bool>(), seed in 0u64..1000, sub in 1usize..4,
+    ) {
+        let nets = random_networks(p, n, m, seed);
+        let integ = integrator(rk4, sub);
+        let mut batch = Batch::new(&nets, e, integ).unwrap();
+        let rows = p * e;
+        // Row r sits out step t when (r + t) % 3 == 0.
+        let on = |r: usize, t: usize| !(r + t).is_multiple_of(3);
+        let mut rates = vec![0.0; rows * n];
+        for t in 0..steps {
+            let x: Vec<f64> = (0..rows * m).map(|k| input(k / m.max(1), t, k % m.max(1))).collect();
+            let mask: Vec<bool> = (0..rows).map(|r| on(r, t)).collect();
+            batch.step(&x, Some(&mask), &mut rates, None).unwrap();
+        }
+        let states = batch.states();
+        for r in 0..rows {
+            let mut single = nets[r / e].clone();
+            let own: Vec<f64> = (0..steps)
+                .filter(|&t| on(r, t))
+                .flat_map(|t| (0..m).map(move |k| input(r, t, k)))
+                .collect();
+            single.run(&own, own.len() / m.max(1), &integ).unwrap();
+            let mine = &states[r * n..(r + 1) * n];
+            if m > 0 {
+                prop_assert_eq!(bits(single.state()), bits(mine), "row {}", r);
+            }
+            if on(r, steps - 1) {
+                let want: Vec<f64> = (0..n).map(|i| sigmoid(mine[i] - nets[r / e].theta()[i])).collect();
+                prop_assert_eq!(bits(&want), bits(&rates[r * n..(r + 1) * n]));
+            }
+        }
+    }
+}
+
+#[test]
+fn many_threads_give_the_bits_of_one() {
+    // Large enough to run blocks in parallel.
+    let nets = random_networks(200, 20, 2, 3);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut batch = Batch::new(&nets, 2, integrator(false, 5)).unwrap();
+            let mut rates = vec![0.0; 400 * 20];
+            for t in 0..10 {
+                let x: Vec<f64> = (0..800).map(|k| input(k / 2, t, k % 2)).collect();
+                batch.step(&x, None, &mut rates, None).unwrap();
+            }
+            bits(&batch.states())
+        })
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn reset_and_set_states_touch_only_the_chosen_rows() {
+    let nets = random_networks(3, 2, 1, 9);
+    let mut batch = Batch::new(&nets, 2, Integrator::default()).unwrap();
+    let mut rates = vec![0.0; 12];
+    batch.step(&[1.0; 6], None, &mut rates, None).unwrap();
+    let before = batch.states();
+    let chosen = [false, true, false, false, true, false];
+    batch.reset(Some(&chosen)).unwrap();
+    let after = batch.states();
+    for r in 0..6 {
+        let want = if chosen[r] {
+            vec![0.0; 2]
+        } else {
+            before[r * 2..r * 2 + 2].to_vec()
+        };
+        assert_eq!(after[r * 2..r * 2 + 2], want[..], "row {r}");
+    }
+    let mut states = vec![0.5; 12];
+    states[0] = f64::NAN; // row 0 is not chosen, so never read
+    batch
+        .set_states(&states, Some(&[false, false, true, false, false, false]))
+        .unwrap();
+    assert_eq!(batch.states()[4..6], [0.5, 0.5]);
+    assert_eq!(batch.states()[0..2], after[0..2]);
+    // The rates follow the new states.
+    let rates = batch.rates();
+    assert_eq!(rates[4], sigmoid(0.5 - nets[1].theta()[0]));
+}
+
+#[test]
+fn bad_arguments_are_refused_and_leave_the_states_alone() {
+    let nets = random_networks(2, 3, 2, 1);
+    let mut batch = Batch::new(&nets, 2, Integrator::default()).unwrap();
+    let before = batch.states();
+    let mut rates = vec![0.0; 12];
+    let msg = |e: Error| e.to_string();
+    let short = batch.step(&[0.0; 7], None, &mut rates, None).unwrap_err();
+    assert!(msg(short).contains("inputs has 7 values; expected B x M = 8"));
+    let mut nan = [0.0; 8];
+    nan[5] = f64::NAN;
+    let err = batch.step(&nan, None, &mut rates, None).unwrap_err();
+    assert!(msg(err).contains("inputs[2, 1] is NaN"));
+    assert_eq!(bits(&batch.states()), bits(&before));
+    // A row left out may hold anything.
+    let mask = [true, true, false, true];
+    batch.step(&nan, Some(&mask), &mut rates, None).unwrap();
+    let before = batch.states();
+    let err = batch
+        .step(&[0.0; 8], Some(&[true; 3]), &mut rates, None)
+        .unwrap_err();
+    assert!(msg(err).contains("active has 3 values"));
+    let err = batch.set_states(&[f64::INFINITY; 12], None).unwrap_err();
+    assert!(msg(err).contains("states[0, 0] is inf"));
+    assert_eq!(bits(&batch.states()), bits(&before));
+    assert!(Batch::new(&nets, 0, Integrator::default()).is_err());
+    assert!(Batch::new::<Network>(&[], 1, Integrator::default()).is_err());
+    let mixed = [nets[0].clone(), random_networks(1, 4, 2, 0).remove(0)];
+    let err = Batch::new(&mixed, 3, Integrator::default()).unwrap_err();
+    assert!(msg(err).contains("network 1 has N = 4"));
+}
+
+#[test]
+fn a_long_step_stops_when_cancelled_and_a_diverging_one_says_so() {
+    let nets = random_networks(1, 2, 1, 1);
+    let mut batch = Batch::new(&nets, 1, integrator(false, 1 << 40)).unwrap();
+    let cancel = AtomicBool::new(true);
+    let mut rates = vec![0.0; 2];
+    let err = batch
+        .step(&[0.0], None, &mut rates, Some(&cancel))
+        .unwrap_err();
+    assert!(matches!(err, Error::Interrupted));
+    let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    let mut batch = Batch::new(&[fast], 1, integrator(false, 1000)).unwrap();
+    let mut rates = vec![0.0; 1];
+    let err = batch.step(&[1.0], None, &mut rates, None).unwrap_err();
+    assert!(err.to_string().contains("integration diverged"), "{err}");
+}
+
+#[test]
+fn rows_left_out_keep_their_states_and_their_rates() {
+    let nets = random_networks(40, 3, 1, 4);
+    let mut batch = Batch::new(&nets, 1, Integrator::default()).unwrap();
+    let mut rates = vec![0.0; 120];
+    batch.step(&[1.0; 40], None, &mut rates, None).unwrap();
+    let before = batch.states();
+    let mut again = vec![-1.0; 120];
+    let mut mask = [false; 40];
+    mask[7] = true;
+    batch
+        .step(&[1.0; 40], Some(&mask), &mut again, None)
+        .unwrap();
+    let after = batch.states();
+    for r in 0..40 {
+        let (old, new) = (&before[r * 3..r * 3 + 3], &after[r * 3..r * 3 + 3]);
+        assert_eq!(old == new, r != 7, "row {r}");
+        assert_eq!(again[r * 3] == -1.0, r != 7, "row {r}");
+    }
+}
+
+/// Episodes that end at different times, and some that start again from zero: the running rows
+/// are moved between lanes as the others end, and every row still ends where `Network::run`
+/// ends on its own episodes.
+#[test]
+fn packing_the_running_rows_does_not_change_their_bits() {
+    let (p, e, n, m, steps) = (40, 3, 4, 2, 40);
+    let nets = random_networks(p, n, m, 11);
+    let integ = integrator(false, 2);
+    let rows = p * e;
+    let end = |r: usize| 1 + (r * 37) % 25; // the first episode's last step
+    let restart = |r: usize| r.is_multiple_of(5).then_some(30); // a second episode from step 30
+    let on = |r: usize, t: usize| t < end(r) || restart(r).is_some_and(|s| t >= s);
+    let mut batch = Batch::new(&nets, e, integ).unwrap();
+    let mut rates = vec![0.0; rows * n];
+    for t in 0..steps {
+        let fresh: Vec<bool> = (0..rows).map(|r| restart(r) == Some(t)).collect();
+        batch.reset(Some(&fresh)).unwrap();
+        let x: Vec<f64> = (0..rows * m).map(|k| input(k / m, t, k % m)).collect();
+        let mask: Vec<bool> = (0..rows).map(|r| on(r, t)).collect();
+        batch.step(&x, Some(&mask), &mut rates, None).unwrap();
+    }
+    let states = batch.states();
+    for r in 0..rows {
+        let mut single = nets[r / e].clone();
+        let run = |from: usize, to: usize, single: &mut Network| {
+            let own: Vec<f64> = (from..to)
+                .flat_map(|t| (0..m).map(move |k| input(r, t, k)))
+                .collect();
+            single.run(&own, to - from, &integ).unwrap();
+        };
+        run(0, end(r), &mut single);
+        if let Some(s) = restart(r) {
+            single.set_state(None).unwrap();
+            run(s, steps, &mut single);
+        }
+        assert_eq!(
+            bits(single.state()),
+            bits(&states[r * n..(r + 1) * n]),
+            "row {r}"
+        );
+    }
+}

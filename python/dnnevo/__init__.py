@@ -17,6 +17,7 @@ _startup.begin_import()  # Ctrl-C during the command's start-up: one line, after
 from dnnevo import _core, plot, presets  # noqa: E402
 from dnnevo._core import (
     LANES,
+    Batch,
     Network,
     Trace,
     __version__,
@@ -33,6 +34,7 @@ from dnnevo.errors import (
     FormatError,
     InvalidArgumentError,
     InvalidNetworkError,
+    TaskError,
 )
 from dnnevo.evolution.evolve import EvolutionResult, evaluate, evolve, resume
 from dnnevo.evolution.ga import GeneticAlgorithm
@@ -43,6 +45,7 @@ _startup.end_import()
 
 __all__ = [
     "LANES",
+    "Batch",
     "ConfigError",
     "EvolutionConfig",
     "EvolutionResult",
@@ -60,6 +63,7 @@ __all__ = [
     "InvalidArgumentError",
     "InvalidNetworkError",
     "Network",
+    "TaskError",
     "Trace",
     "__version__",
     "build_info",

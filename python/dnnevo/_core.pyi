@@ -17,6 +17,7 @@ __all__ = [
     "RETRY_STARTS",
     "RUN_DEFAULTS",
     "STEP_CHECK_FINER",
+    "Batch",
     "Evolution",
     "Network",
     "Trace",
@@ -28,6 +29,7 @@ __all__ = [
     "analysis_cycles",
     "analysis_equilibria",
     "check_config",
+    "condition_seed",
     "compose",
     "decode",
     "encode",
@@ -171,6 +173,50 @@ def run_population(
     method: _Method = "euler",
     record: bool = True,
 ) -> _Array: ...
+
+@final
+class Batch:
+    """P networks times E replicas, stepped together one time step per call."""
+
+    def __new__(
+        cls,
+        networks: Sequence[Network] | Mapping[str, npt.ArrayLike],
+        *,
+        replicas: int = 1,
+        dt: float = 0.1,
+        substeps: int = 1,
+        method: _Method = "euler",
+    ) -> Batch: ...
+    @property
+    def rows(self) -> int: ...
+    @property
+    def networks(self) -> int: ...
+    @property
+    def replicas(self) -> int: ...
+    @property
+    def size(self) -> int: ...
+    @property
+    def n_inputs(self) -> int: ...
+    @property
+    def integrator(self) -> dict[str, Any]: ...
+    @property
+    def states(self) -> _Array: ...
+    @property
+    def rates(self) -> _Array: ...
+    def step(
+        self,
+        inputs: npt.ArrayLike,
+        *,
+        active: npt.ArrayLike | None = None,
+        out: _Array | None = None,
+    ) -> _Array: ...
+    def reset(self, rows: npt.ArrayLike | None = None) -> None: ...
+    def set_states(self, states: npt.ArrayLike, rows: npt.ArrayLike | None = None) -> None: ...
+    def __len__(self) -> int: ...
+
+def condition_seed(seed: int, generation: int, purpose: Literal["trial", "validate", "evaluate"] = "trial") -> int:
+    """The first word of dnnevo's random stream (seed, generation, purpose): the seed of a
+    Python task's conditions."""
 
 @final
 class Evolution:

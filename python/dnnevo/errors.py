@@ -15,6 +15,7 @@ __all__ = [
     "FormatError",
     "ConfigError",
     "FitnessError",
+    "TaskError",
 ]
 
 
@@ -40,6 +41,11 @@ class ConfigError(DnnevoError, ValueError):
 
 class FitnessError(DnnevoError, ValueError):
     """A fitness value cannot be selected on (NaN, or negative under proportional selection)."""
+
+
+class TaskError(DnnevoError, ValueError):
+    """A user's task broke its protocol: a method raised, or returned a wrong shape, a wrong
+    dtype or a value that is not finite. The message names the method and the problem."""
 
 
 def did_you_mean(name: str, known: Iterable[str]) -> str:

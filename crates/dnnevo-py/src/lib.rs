@@ -5,6 +5,7 @@
 
 mod analysis;
 mod arrays;
+mod batch;
 mod detach;
 mod errors;
 mod evolution;
@@ -16,6 +17,7 @@ mod population;
 mod pyjson;
 mod sequence;
 mod simd;
+mod streams;
 
 use pyo3::prelude::*;
 
@@ -31,6 +33,8 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 mod _core {
     #[pymodule_export]
     use super::analysis::{analysis_bifurcation, analysis_cycles, analysis_equilibria};
+    #[pymodule_export]
+    use super::batch::PyBatch;
     #[pymodule_export]
     use super::evolution::{
         check_config, decode, encode, evaluate, task_layout, task_names, PyEvolution,
@@ -55,6 +59,8 @@ mod _core {
     };
     #[pymodule_export]
     use super::simd::{apply_simd_env, build_info, use_kernel};
+    #[pymodule_export]
+    use super::streams::condition_seed;
 
     use pyo3::prelude::*;
 

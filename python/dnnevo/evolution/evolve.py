@@ -131,7 +131,9 @@ def evolve(
     """Evolves networks for ``task`` and returns the champion and the history.
 
     ``task`` is a built-in task or preset name, or a Python callable ``fitness(networks) ->
-    array`` (slower, but works with everything else, checkpoints included). With ``out`` the run
+    array`` (slower, but works with everything else, checkpoints included). A callable that
+    takes ``generation`` and ``seed`` keywords gets them, to draw each generation's conditions
+    from (see :class:`dnnevo.closedloop.ClosedLoop` for a task in closed loop). With ``out`` the run
     writes a run folder (see :mod:`dnnevo.runs.rundir`); an existing non-empty folder is refused unless
     ``force``. ``callback(stats, ga)`` runs after every generation; returning True stops the run.
     ``founders`` are networks placed first in the initial population (e.g. from :func:`compose`;
@@ -206,6 +208,8 @@ def resume(
             digest = None if isinstance(task, str) else _fitness_digest(task)
             # Same name, other source: a different function all the same.
             edited = digest is not None and table.get("fitness_sha256", digest) != digest
+            if not edited and _moved(name, ga.config.task, digest, table):
+                name = ga.config.task  # the same source, imported from another module
             if name != ga.config.task or edited:
                 if not new_fitness:
                     raise ConfigError(
@@ -232,6 +236,21 @@ def resume(
         _write_best(run, ga)
         return _loop(ga, fitness, history, run, progress=progress, callback=callback,
                      threads=threads, table=table)
+
+
+def _moved(name: str, recorded: str, digest: str | None, table: Mapping[str, Any]) -> bool:
+    """Whether a fitness function named ``name`` is the run's own (``recorded``) imported from
+    another module: the same qualified name after the module, the same source digest, and one of
+    the two defined in a script (``__main__``). A run started by ``python light.py`` then
+    resumes from a script that does ``from light import ...``."""
+    if digest is None or table.get("fitness_sha256") != digest:
+        return False
+    if not (name.startswith(PYTHON_TASK) and recorded.startswith(PYTHON_TASK)):
+        return False
+    main = f"{PYTHON_TASK}__main__."
+    mine, theirs = name.removeprefix(main), recorded.removeprefix(main)
+    one_is_main = (mine != name) != (theirs != recorded)
+    return one_is_main and (mine.endswith("." + theirs) or theirs.endswith("." + mine))
 
 
 def _python_task_name(task: FitnessFn) -> str:
@@ -286,9 +305,25 @@ def _restored(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], di
     return ga, cp.history, table
 
 
+def _takes_conditions(task: FitnessFn) -> bool:
+    """Whether a fitness function takes the generation and the run's seed as keywords, to draw
+    its conditions from (``fitness(networks, *, generation, seed)``)."""
+    try:
+        params = inspect.signature(task).parameters
+    except (TypeError, ValueError):
+        return False
+    keyword = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    named = all(k in params and params[k].kind in keyword for k in ("generation", "seed"))
+    return named or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+
+
 def _fitness_digest(task: FitnessFn) -> str | None:
     """SHA-256 of a Python fitness function's source, so that resume can tell an edited function
-    from the run's own; None when Python cannot find the source (e.g. typed at a prompt)."""
+    from the run's own; None when Python cannot find the source (e.g. typed at a prompt). A
+    callable object can say what identifies it in a ``fitness_source`` text (as
+    :class:`dnnevo.closedloop.ClosedLoop` does: its environment's source and settings)."""
+    if isinstance(given := getattr(task, "fitness_source", None), str):
+        return hashlib.sha256(given.encode()).hexdigest()
     target = task if inspect.isfunction(task) or inspect.ismethod(task) else type(task)
     try:
         source = inspect.getsource(target)
@@ -359,6 +394,7 @@ def _loop(
     success = history[-1]["champion_success"] if history else float("nan")
     interrupted = False
     saved = ""
+    conditions = callable(task) and _takes_conditions(task)
 
     def save_state() -> None:
         if run is not None:
@@ -372,7 +408,11 @@ def _loop(
                 t0 = time.perf_counter()
                 if callable(task):
                     networks = ga.ask().networks
-                    fitness = np.asarray(task(networks), dtype=np.float64)
+                    if conditions:
+                        scores = task(networks, generation=ga.generation, seed=ga.seed)
+                    else:
+                        scores = task(networks)
+                    fitness = np.asarray(scores, dtype=np.float64)
                     if fitness.shape != (config.population,):
                         raise FitnessError(
                             f"the fitness function returned shape {fitness.shape}; "

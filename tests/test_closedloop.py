@@ -1,0 +1,335 @@
+"""dnnevo.Batch (a population stepped one row at a time) and dnnevo.closedloop (a task written in
+NumPy, run by rollout): exact against Network.run, the NumPy reference and the built-in task, and
+every misuse a one-line error that names it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import reference as ref
+
+import dnnevo
+from dnnevo import Batch, InvalidArgumentError, TaskError
+from dnnevo.closedloop import FarSeeker, rollout
+
+
+def networks(count: int, n: int = 4, m: int = 2, seed: int = 0) -> list[dnnevo.Network]:
+    return [dnnevo.Network.random(n, m, seed=seed + k) for k in range(count)]
+
+
+def params(nets: list[dnnevo.Network]) -> tuple[np.ndarray, ...]:
+    return tuple(np.stack([getattr(net, k) for net in nets])
+                 for k in ("tau", "theta", "weights", "sensor_weights"))
+
+
+# ---------------------------------------------------------------------------------------------
+# Batch
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_each_row_gives_the_bits_of_network_run(method: str, dtype: type) -> None:
+    nets = networks(7, seed=3)
+    batch = Batch(nets, replicas=3, dt=0.05, substeps=4, method=method)
+    rng = np.random.default_rng(1)
+    inputs = rng.uniform(-2, 2, size=(10, batch.rows, 2)).astype(dtype)
+    out = np.empty((batch.rows, batch.size))
+    for row in inputs:
+        assert batch.step(row, out=out) is out
+    for r in range(batch.rows):
+        net = nets[r // 3].copy()
+        trace = net.run(inputs[:, r].astype(np.float64), dt=0.05, substeps=4, method=method)
+        assert np.array_equal(batch.states[r], trace.states[-1])
+        assert np.array_equal(out[r], trace.outputs[-1])
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(1, 6), m=st.integers(0, 3), p=st.integers(1, 20), replicas=st.integers(1, 3),
+       steps=st.integers(1, 6), seed=st.integers(0, 10_000), method=st.sampled_from(["euler", "rk4"]))
+def test_a_batch_agrees_with_the_numpy_reference(n: int, m: int, p: int, replicas: int, steps: int,
+                                                 seed: int, method: str) -> None:
+    """Rows stepped only while active, against tests/reference.py integrating the same inputs."""
+    nets = networks(p, n, m, seed=seed)
+    for net in nets:
+        net.reset()
+    batch = Batch(nets, replicas=replicas, dt=0.1, substeps=2, method=method)
+    rows = batch.rows
+    rng = np.random.default_rng(seed)
+    inputs = rng.uniform(-1, 1, size=(steps, rows, m))
+    active = rng.random((steps, rows)) < 0.7
+    for t in range(steps):
+        batch.step(inputs[t], active=active[t])
+    tau, theta, w, s = (np.repeat(x, replicas, axis=0) for x in params(nets))
+    v = np.zeros((rows, n))
+    do_step = ref.step(method)
+    for t in range(steps):
+        for _ in range(2):
+            moved = do_step(v, 0.1, (tau, theta, w, s), inputs[t])
+            v = np.where(active[t][:, None], moved, v)
+    np.testing.assert_allclose(batch.states, v, rtol=1e-12, atol=1e-12)
+
+
+def test_rows_left_out_keep_their_state_and_may_hold_anything() -> None:
+    batch = Batch(networks(5), replicas=2)
+    out = np.full((10, 4), -1.0)
+    inputs = np.ones((10, 2))
+    inputs[3] = np.nan
+    active = np.ones(10, dtype=bool)
+    active[3] = False
+    batch.step(inputs, active=active, out=out)
+    assert np.all(batch.states[3] == 0) and np.all(out[3] == -1.0)
+    assert np.all(out[active] != -1.0)
+
+
+def test_reset_set_states_and_rates() -> None:
+    nets = networks(3)
+    batch = Batch(nets, replicas=2)
+    batch.step(np.ones((6, 2)))
+    before = batch.states
+    batch.reset([1, -1])
+    after = batch.states
+    assert np.all(after[[1, 5]] == 0) and np.array_equal(after[[0, 2, 3, 4]], before[[0, 2, 3, 4]])
+    batch.set_states(np.full((6, 4), 0.5), rows=np.array([False, False, True, False, False, False]))
+    assert np.all(batch.states[2] == 0.5)
+    theta = nets[1].theta
+    np.testing.assert_array_equal(batch.rates[2], 1 / (1 + np.exp(-(0.5 - theta))))
+    batch.reset()
+    assert not batch.states.any()
+    assert (batch.rows, batch.networks, batch.replicas, batch.size, batch.n_inputs) == (6, 3, 2, 4, 2)
+    assert len(batch) == 6 and "replicas=2" in repr(batch)
+    assert batch.integrator == {"method": "euler", "dt": 0.1, "substeps": 1}
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda b: b.step(np.ones((5, 2))), r"inputs has shape \(5, 2\); expected \(B, M\) = \(4, 2\)"),
+    (lambda b: b.step(np.full((4, 2), np.nan)), r"inputs\[0, 0\] is NaN"),
+    (lambda b: b.step(np.ones((4, 2)), active=[1, 0, 1, 1]), "active is a int64 array"),
+    (lambda b: b.step(np.ones((4, 2)), active=np.ones(3, bool)), r"expected booleans of shape \(4,\)"),
+    (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 4), np.float32)), "out is array"),
+    (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 3))), r"out has shape \(4, 3\)"),
+    (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 8))[:, ::2]), "not C-contiguous"),
+    (lambda b: b.reset([4]), "rows holds index 4; this batch has 4 rows"),
+    (lambda b: b.reset(np.array([0.5])), "expected a boolean mask"),
+    (lambda b: b.set_states(np.full((4, 4), np.inf)), r"states\[0, 0\] is inf"),
+    (lambda b: b.set_states(np.zeros((4, 3))), r"states has shape \(4, 3\)"),
+])
+def test_misuse_is_an_invalid_argument_error_that_names_it(call, message: str) -> None:
+    batch = Batch(networks(2), replicas=2)
+    with pytest.raises(InvalidArgumentError, match=message):
+        call(batch)
+    assert not batch.states.any()
+
+
+def test_a_read_only_out_is_refused() -> None:
+    batch = Batch(networks(1))
+    out = np.empty((1, 4))
+    out.flags.writeable = False
+    with pytest.raises(InvalidArgumentError, match="out cannot be written"):
+        batch.step(np.ones((1, 2)), out=out)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"replicas": 0}, "replicas is 0"),
+    ({"replicas": -1}, "replicas is -1"),
+    ({"dt": float("nan")}, "dt"),
+    ({"substeps": 0}, "substeps"),
+    ({"method": "heun"}, "method"),
+])
+def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:
+    with pytest.raises(InvalidArgumentError, match=message):
+        Batch(networks(1), **kwargs)
+
+
+def test_networks_of_different_shapes_are_refused() -> None:
+    with pytest.raises(InvalidArgumentError, match="network 1 has N = 3"):
+        Batch([dnnevo.Network.random(4, 2, seed=0), dnnevo.Network.random(3, 2, seed=0)])
+
+
+# ---------------------------------------------------------------------------------------------
+# rollout
+
+
+def test_the_numpy_far_seeker_gives_the_built_in_fitness_bit_for_bit() -> None:
+    """The protocol loses nothing: the paper's far seeker in NumPy against nav1d's Rust world."""
+    config = dnnevo.presets.get("nav1d-far")
+    config = dnnevo.EvolutionConfig(**{**config.to_dict(), "population": 96})
+    nets = dnnevo.GeneticAlgorithm(config, seed=5).ask().networks
+    built_in = dnnevo.evaluate("nav1d-far", nets, generation=0, seed=5, config=config)
+    result = rollout(nets, FarSeeker(), episodes=2, max_steps=10_000, dt=0.1)
+    assert np.array_equal(result.fitness, built_in)
+    assert 0 < built_in.mean() < 1  # the population is neither all right nor all wrong
+    assert result.returns.shape == result.lengths.shape == (96, 2)
+    assert result.lengths.max() <= 10_000 and result.lengths.min() >= 1
+
+
+class Drift:
+    """A 1-D world: the agent drifts at the rate of neuron 0 towards a target drawn per episode."""
+
+    observation_size = 1
+
+    def __init__(self, length: int = 5) -> None:
+        self.length = length
+        self.drawn: list[np.ndarray] = []
+
+    def reset(self, episodes, rng):
+        targets = rng.uniform(-1, 1, size=episodes.max() + 1)
+        self.drawn.append(targets)
+        self.target = targets[episodes]
+        self.x = np.zeros(len(episodes))
+        self.t = 0
+        return (self.target - self.x)[:, None]
+
+    def step(self, rates, active):
+        self.x = self.x + 0.1 * rates[:, 0]
+        self.t += 1
+        done = np.full(len(self.x), self.t >= self.length)
+        return (self.target - self.x)[:, None], -np.abs(self.target - self.x), done
+
+
+def test_conditions_are_common_to_every_network_and_follow_seed_and_generation() -> None:
+    nets = networks(4, m=1)
+    env = Drift()
+    a = rollout(nets, env, episodes=3, max_steps=50, seed=1, generation=2)
+    b = rollout(nets, env, episodes=3, max_steps=50, seed=1, generation=2)
+    rollout(nets, env, episodes=3, max_steps=50, seed=1, generation=3)
+    assert np.array_equal(env.drawn[0], env.drawn[1]) and not np.array_equal(env.drawn[0], env.drawn[2])
+    assert np.array_equal(a.returns, b.returns)
+    assert np.all(a.lengths == 5)
+    # One network copied four times scores the same in every row: the episodes are common.
+    same = rollout([nets[0]] * 4, Drift(), episodes=3, max_steps=50, seed=1, generation=2)
+    assert np.all(same.returns == same.returns[0])
+
+
+def test_ended_episodes_stop_counting_and_the_step_limit_holds() -> None:
+    result = rollout(networks(2, m=1), Drift(length=1000), episodes=2, max_steps=7)
+    assert np.all(result.lengths == 7)
+
+
+class Broken(Drift):
+    def __init__(self, fault: str) -> None:
+        super().__init__()
+        self.fault = fault
+
+    def reset(self, episodes, rng):
+        obs = super().reset(episodes, rng)
+        return obs[:, 0] if self.fault == "reset shape" else obs
+
+    def step(self, rates, active):
+        obs, reward, done = super().step(rates, active)
+        fault = self.fault
+        if fault == "raises":
+            raise KeyError("velocity")
+        if fault == "nan obs":
+            obs[0] = np.nan
+        if fault == "nan reward":
+            reward[1] = np.nan
+        if fault == "text obs":
+            obs = np.array([["a"]] * len(obs))
+        if fault == "int done":
+            done = done.astype(int)
+        if fault == "pair":
+            return obs, reward
+        return obs, reward, done
+
+
+@pytest.mark.parametrize("fault, message", [
+    ("raises", r"Broken.step raised KeyError: 'velocity'"),
+    ("nan obs", r"Broken.step returned observations that are not finite \(inputs\[0, 0\] is NaN"),
+    ("nan reward", r"Broken.step returned rewards\[1\] = nan"),
+    ("text obs", r"observations from step of dtype <U1; expected numbers"),
+    ("int done", r"Broken.step returned done of type ndarray, dtype int64"),
+    ("pair", r"Broken.step returned tuple; expected a tuple \(observations, rewards, done\)"),
+    ("reset shape", r"Broken.reset returned observations of shape \(8,\); expected \(B, M\) = \(8, 1\)"),
+])
+def test_a_broken_task_gets_a_task_error_naming_the_method(fault: str, message: str) -> None:
+    with pytest.raises(TaskError, match=message):
+        rollout(networks(4, m=1), Broken(fault), episodes=2, max_steps=10)
+
+
+def test_observation_size_must_match_the_networks() -> None:
+    with pytest.raises(TaskError, match="Drift.observation_size is 1; the networks have 2 inputs"):
+        rollout(networks(2, m=2), Drift(), max_steps=3)
+
+
+def test_condition_seed_checks_its_arguments() -> None:
+    seed = dnnevo._core.condition_seed
+    assert seed(0, 0) != seed(0, 1) != seed(1, 0)
+    assert seed(3, 4, "validate") != seed(3, 4)
+    with pytest.raises(InvalidArgumentError, match="seed is -1"):
+        seed(-1, 0)
+    with pytest.raises(InvalidArgumentError, match="purpose is 'test'"):
+        seed(0, 0, "test")
+
+
+# ---------------------------------------------------------------------------------------------
+# evolve
+
+
+def test_a_closed_loop_run_resumes_to_the_end_of_an_unbroken_one(tmp_path) -> None:
+    from dnnevo.closedloop import ClosedLoop
+
+    config = dnnevo.EvolutionConfig(population=24, generations=4, size=3, n_inputs=1, selection="rank")
+    fitness = ClosedLoop(Drift(), episodes=3, max_steps=20)
+    whole = dnnevo.evolve(fitness, config, seed=2, progress=False, out=tmp_path / "whole")
+    part = dnnevo.evolve(fitness, config, seed=2, progress=False, out=tmp_path / "part",
+                         callback=lambda stats, ga: ga.generation >= 2)
+    assert len(part.history["best"]) == 2
+    text = (tmp_path / "part" / "config.toml").read_text()
+    assert 'task = "python:test_closedloop.Drift"' in text
+    with pytest.raises(dnnevo.ConfigError, match="was evolved with python:test_closedloop.Drift, not an edited"):
+        dnnevo.resume(tmp_path / "part", ClosedLoop(Drift(), episodes=4, max_steps=20), progress=False)
+    resumed = dnnevo.resume(tmp_path / "part", ClosedLoop(Drift(), episodes=3, max_steps=20),
+                            progress=False)
+    assert np.array_equal(resumed.history["best"], whole.history["best"])
+    assert resumed.best == whole.best
+
+
+def test_a_fitness_function_that_asks_gets_the_generation_and_the_seed() -> None:
+    seen = []
+
+    def fitness(networks, *, generation, seed):
+        seen.append((generation, seed))
+        return np.zeros(len(networks))
+
+    config = dnnevo.EvolutionConfig(population=8, generations=3, size=2, n_inputs=1)
+    dnnevo.evolve(fitness, config, seed=7, progress=False)
+    assert seen == [(0, 7), (1, 7), (2, 7)]
+
+
+def test_a_run_started_as_a_script_resumes_from_a_module_that_imports_the_same_code(tmp_path) -> None:
+    """A run of ``python light.py`` names ``__main__.Light``; another script that does ``from
+    light import Light`` resumes it, since the source is the same. An edited source is refused."""
+    (tmp_path / "light.py").write_text(
+        "import numpy as np, dnnevo\n"
+        "from dnnevo.closedloop import ClosedLoop\n"
+        "class Light:\n"
+        "    observation_size = 1\n"
+        "    def reset(self, episodes, rng):\n"
+        "        self.x = np.zeros(len(episodes))\n"
+        "        return np.ones((len(episodes), 1))\n"
+        "    def step(self, rates, active):\n"
+        "        self.x += rates[:, 0]\n"
+        "        return np.ones((len(self.x), 1)), self.x.copy(), self.x > 3\n"
+        "if __name__ == '__main__':\n"
+        "    config = dnnevo.EvolutionConfig(population=8, generations=3, size=2, n_inputs=1)\n"
+        "    dnnevo.evolve(ClosedLoop(Light(), max_steps=10), config, out='run', progress=False,\n"
+        "                  callback=lambda stats, ga: ga.generation >= 1)\n")
+    import subprocess
+    import sys
+    subprocess.run([sys.executable, "light.py"], cwd=tmp_path, check=True)
+    assert 'task = "python:__main__.Light"' in (tmp_path / "run" / "config.toml").read_text()
+    sys.path.insert(0, str(tmp_path))
+    try:
+        import light
+    finally:
+        sys.path.remove(str(tmp_path))
+    from dnnevo.closedloop import ClosedLoop
+
+    done = dnnevo.resume(tmp_path / "run", ClosedLoop(light.Light(), max_steps=10), progress=False)
+    assert len(done.history["best"]) == 3
+    with pytest.raises(dnnevo.ConfigError, match="was evolved with python:__main__.Light"):
+        dnnevo.resume(tmp_path / "run", ClosedLoop(light.Light(), max_steps=11), progress=False,
+                      generations=4)

@@ -115,7 +115,7 @@ impl Batch {
             row_at: (0..rows).collect(),
             lane_of: (0..rows).collect(),
         };
-        batch.blocks = batch.pack(None)?;
+        batch.blocks = batch.pack(&batch.row_at, None)?;
         Ok(batch)
     }
 
@@ -144,11 +144,11 @@ impl Batch {
         &self.integ
     }
 
-    /// Blocks laid out as `row_at` says, each row's state taken from `states` (row-major
-    /// `B x N`), or from its network when `None`.
-    fn pack(&self, states: Option<&[f64]>) -> Result<Vec<Block>> {
+    /// Blocks with the rows of `order` lane by lane, each row's state taken from `states`
+    /// (row-major `B x N`), or from its network when `None`.
+    fn pack(&self, order: &[usize], states: Option<&[f64]>) -> Result<Vec<Block>> {
         let n = self.size;
-        self.row_at
+        order
             .par_chunks(LANES)
             .map(|rows| {
                 let refs: Vec<&Network> = rows
@@ -176,11 +176,13 @@ impl Batch {
         }
         let states = self.states();
         let (on, off): (Vec<usize>, Vec<usize>) = (0..self.rows()).partition(|&r| active[r]);
-        self.row_at = on.into_iter().chain(off).collect();
+        let order: Vec<usize> = on.into_iter().chain(off).collect();
+        // The blocks first: if packing failed, the batch would be as it was.
+        self.blocks = self.pack(&order, Some(&states))?;
+        self.row_at = order;
         for (at, &r) in self.row_at.iter().enumerate() {
             self.lane_of[r] = at;
         }
-        self.blocks = self.pack(Some(&states))?;
         self.mark(Some(active));
         Ok(())
     }
@@ -232,9 +234,11 @@ impl Batch {
     /// still running are then moved together.
     ///
     /// Fails, with every state as it was, on arrays of the wrong length or inputs of a stepped
-    /// row that are not finite. Fails with [`Error::Interrupted`] soon after `cancel` is set, and when an active
-    /// row's integration diverges; the states are then part-way through the step, so reset or
-    /// set them before stepping again.
+    /// row that are not finite. Fails with [`Error::Interrupted`] soon after `cancel` is set
+    /// (between blocks, and every 1024 integration steps within one), and with
+    /// [`Error::InvalidArgument`] when a stepped row's integration diverges. Rows left out then
+    /// still keep their state, but the stepped rows' states are part-way through the step and
+    /// `rates` is not written: reset or set them before stepping again.
     pub fn step<T: Copy + Into<f64> + Sync>(
         &mut self,
         inputs: &[T],
@@ -260,22 +264,27 @@ impl Batch {
             if slot.on == 0 {
                 return Ok(());
             }
+            if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                return Err(Error::Interrupted);
+            }
             let lanes = block.len();
             let first = b * LANES;
             let off = |l: usize| slot.on >> l & 1 == 0;
             for l in (0..lanes).filter(|&l| off(l)) {
                 block.lane_state(l, &mut slot.kept[l * n..(l + 1) * n]);
             }
-            step_held_in_chunks(block, &slot.inputs, &integ, cancel)?;
-            check_finite(block, |l| (!off(l)).then(|| row_at[first + l]))?;
-            let stepped = block.outputs();
-            for l in 0..lanes {
-                for (i, rate) in stepped.iter().enumerate() {
-                    slot.rates[l * n + i] = rate[l];
-                }
-            }
+            let stepped = step_held_in_chunks(block, &slot.inputs, &integ, cancel)
+                .and_then(|()| check_finite(block, |l| (!off(l)).then(|| row_at[first + l])));
+            // Rows left out keep their state, whatever happened to the others.
             for l in (0..lanes).filter(|&l| off(l)) {
                 block.set_lane_state(l, &slot.kept[l * n..(l + 1) * n]);
+            }
+            stepped?;
+            let rates = block.outputs();
+            for l in 0..lanes {
+                for (i, rate) in rates.iter().enumerate() {
+                    slot.rates[l * n + i] = rate[l];
+                }
             }
             Ok(())
         };

@@ -158,11 +158,16 @@ fn a_long_step_stops_when_cancelled_and_a_diverging_one_says_so() {
         .step(&[0.0], None, &mut rates, Some(&cancel))
         .unwrap_err();
     assert!(matches!(err, Error::Interrupted));
+    // A diverging row beside one left out: the error names it, and the other keeps its state.
     let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
-    let mut batch = Batch::new(&[fast], 1, integrator(false, 1000)).unwrap();
-    let mut rates = vec![0.0; 1];
-    let err = batch.step(&[1.0], None, &mut rates, None).unwrap_err();
-    assert!(err.to_string().contains("integration diverged"), "{err}");
+    let mut batch = Batch::new(&[fast], 2, integrator(false, 1000)).unwrap();
+    batch.set_states(&[0.0, 0.5], None).unwrap();
+    let mut rates = vec![0.0; 2];
+    let err = batch
+        .step(&[1.0, 1.0], Some(&[true, false]), &mut rates, None)
+        .unwrap_err();
+    assert!(err.to_string().contains("state[0] of row 0"), "{err}");
+    assert_eq!(batch.states()[1], 0.5);
 }
 
 #[test]

@@ -333,3 +333,200 @@ def test_a_run_started_as_a_script_resumes_from_a_module_that_imports_the_same_c
     with pytest.raises(dnnevo.ConfigError, match="was evolved with python:__main__.Light"):
         dnnevo.resume(tmp_path / "run", ClosedLoop(light.Light(), max_steps=11), progress=False,
                       generations=4)
+
+
+# ---------------------------------------------------------------------------------------------
+# a task named in config.toml: dnnevo run, resume, show and assess
+
+
+SEEKER = '''
+import numpy as np
+
+
+class Seeker:
+    """A 1-D agent seeks a light."""
+
+    observation_size = 1
+    success_rate = 0.9
+
+    def __init__(self, speed=0.1):
+        self.speed = speed
+
+    def reset(self, episodes, rng):
+        lights = rng.uniform(-5, 5, size=episodes.max() + 1)
+        self.light, self.x = lights[episodes], np.zeros(len(episodes))
+        return np.sign(self.light - self.x)[:, None]
+
+    def step(self, rates, active):
+        self.x += self.speed * (rates[:, 1] - rates[:, 0])
+        distance = np.abs(self.light - self.x)
+        return np.sign(self.light - self.x)[:, None], -distance, distance < 0.05
+
+    def success(self, returns, lengths):
+        return lengths < 300
+
+
+class Ruleless(Seeker):
+    success_rate = None
+
+
+def not_a_class():
+    pass
+'''
+
+SETTINGS = ["--set", "n_inputs=1", "--set", "size=3", "--set", "selection=rank", "--set",
+            "task_params.max_steps=300", "--set", "task_params.episodes=4", "--set", "population=60",
+            "--set", "generations=6"]
+
+
+def dnnevo_command(folder, *args: str):
+    """The installed ``dnnevo`` command (not ``python -m``, which would put the folder on the
+    path) run in ``folder``."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    command = Path(sys.executable).parent / "dnnevo"
+    return subprocess.run([str(command), *args], cwd=folder, capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_a_task_class_named_on_the_command_line_runs_resumes_and_is_judged(tmp_path) -> None:
+    (tmp_path / "seeker_cli.py").write_text(SEEKER)
+    run = dnnevo_command(tmp_path, "run", "python:seeker_cli.Seeker", *SETTINGS)
+    assert run.returncode == 0, run.stderr
+    folder = tmp_path / "runs" / "seeker_cli.Seeker-seed0"
+    text = (folder / "config.toml").read_text()
+    assert 'task = "python:seeker_cli.Seeker"' in text and "max_steps = 300" in text
+    assert "next: dnnevo assess runs/seeker_cli.Seeker-seed0" in run.stdout
+    more = dnnevo_command(tmp_path, "resume", "runs/seeker_cli.Seeker-seed0", "--generations", "8")
+    assert more.returncode == 0, more.stderr
+    judged = dnnevo_command(tmp_path, "assess", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
+    assert judged.returncode in (0, 1, 3), judged.stderr
+    assert "fresh episodes (seed 3)" in judged.stdout and "needs" in judged.stdout
+    # show reads the folder without importing the task: it works with the module gone.
+    (tmp_path / "seeker_cli.py").unlink()
+    shown = dnnevo_command(tmp_path, "show", "runs/seeker_cli.Seeker-seed0")
+    assert shown.returncode == 0 and "8/8 generations" in shown.stdout, shown.stderr
+    gone = dnnevo_command(tmp_path, "resume", "runs/seeker_cli.Seeker-seed0", "--generations", "9")
+    assert gone.returncode == 2 and "cannot import seeker_cli" in gone.stderr
+
+
+@pytest.mark.parametrize("task, settings, message", [
+    ("python:seeker_bad.Nope", SETTINGS, "module seeker_bad has no Nope"),
+    ("python:seeker_bad.not_a_class", SETTINGS, "is a function; a task is a class with observation_size"),
+    ("python:seeker_bad_missing.Seeker", SETTINGS, "cannot import seeker_bad_missing"),
+    ("python:seeker_bad.Seeker", ["--set", "n_inputs=1"], "needs task_params.max_steps"),
+    ("python:seeker_bad.Seeker", SETTINGS + ["--set", "n_inputs=2"], "n_inputs is 2; Seeker.observation_size is 1"),
+    ("python:seeker_bad.Seeker", SETTINGS + ["--set", "task_params.sped=1"], "Seeker(**task_params) failed"),
+])
+def test_a_bad_task_name_or_setting_is_one_line(tmp_path, task: str, settings: list[str], message: str) -> None:
+    (tmp_path / "seeker_bad.py").write_text(SEEKER)
+    r = dnnevo_command(tmp_path, "run", task, *settings)
+    assert r.returncode == 2 and message in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+    assert not (tmp_path / "runs").exists() or not any((tmp_path / "runs").iterdir())
+
+
+def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:
+    (tmp_path / "seeker_rule.py").write_text(SEEKER)
+    assert dnnevo_command(tmp_path, "run", "python:seeker_rule.Ruleless", *SETTINGS).returncode == 0
+    r = dnnevo_command(tmp_path, "assess", "runs/seeker_rule.Ruleless-seed0")
+    assert r.returncode == 2 and "has no success rule: give Ruleless a success_rate" in r.stderr
+
+
+def test_naming_the_task_or_passing_it_evolves_the_same(tmp_path, monkeypatch) -> None:
+    from dnnevo.closedloop import ClosedLoop
+
+    (tmp_path / "seeker_py.py").write_text(SEEKER)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import seeker_py
+
+    base = dnnevo.EvolutionConfig(population=30, generations=3, size=3, n_inputs=1, selection="rank")
+    config = dnnevo.EvolutionConfig(**{**base.to_dict(), "task": "python:seeker_py.Seeker",
+                                       "task_params": {"max_steps": 100, "episodes": 2}})
+    by_name = dnnevo.evolve("python:seeker_py.Seeker", config, seed=4, progress=False)
+    loop = ClosedLoop(seeker_py.Seeker(), episodes=2, max_steps=100, substeps=10)
+    by_object = dnnevo.evolve(loop, base, seed=4, progress=False)
+    assert by_object.config == by_name.config
+    assert np.array_equal(by_name.history["best"], by_object.history["best"])
+
+
+def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path, monkeypatch) -> None:
+    """config.toml cannot record an environment object's arguments: a command that builds the
+    task from it builds Seeker() with its defaults, and the digest says when that is another
+    task."""
+    from dnnevo.closedloop import ClosedLoop
+
+    (tmp_path / "seeker_arg.py").write_text(SEEKER)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import seeker_arg
+
+    config = dnnevo.EvolutionConfig(population=10, generations=2, size=3, n_inputs=1, selection="rank")
+    for speed, folder in [(0.1, "same"), (0.2, "other")]:
+        loop = ClosedLoop(seeker_arg.Seeker(speed=speed), episodes=2, max_steps=50)
+        dnnevo.evolve(loop, config, out=tmp_path / folder, progress=False)
+    same = dnnevo_command(tmp_path, "assess", "same", "--trials", "20")
+    assert same.returncode in (0, 1, 3) and "20 fresh episodes" in same.stdout, same.stderr
+    other = dnnevo_command(tmp_path, "assess", "other")
+    assert other.returncode == 2 and "another version of python:seeker_arg.Seeker" in other.stderr
+    resumed = dnnevo_command(tmp_path, "resume", "other", "--generations", "3")
+    assert resumed.returncode == 2 and "another version" in resumed.stderr
+    # From Python, with the environment it began with, and by its name for the other.
+    loop = ClosedLoop(seeker_arg.Seeker(speed=0.2), episodes=2, max_steps=50)
+    assert len(dnnevo.resume(tmp_path / "other", loop, generations=3, progress=False).history["best"]) == 3
+    by_name = dnnevo.resume(tmp_path / "same", "python:seeker_arg.Seeker", generations=3, progress=False)
+    assert len(by_name.history["best"]) == 3
+
+
+def test_a_fitness_function_run_is_neither_resumed_nor_judged_by_the_command_line(tmp_path) -> None:
+    config = dnnevo.EvolutionConfig(population=6, generations=2, size=2, n_inputs=1)
+    dnnevo.evolve(lambda nets: np.zeros(len(nets)), config, out=tmp_path / "f", progress=False)
+    resumed = dnnevo_command(tmp_path, "resume", "f", "--generations", "3")
+    assert resumed.returncode == 2 and "resume it from Python" in resumed.stderr
+    judged = dnnevo_command(tmp_path, "assess", "f")
+    assert judged.returncode == 2 and "has no success rule" in judged.stderr
+
+
+class Echo:
+    """Hands the rates back as the next observations (N = M), and reads them later."""
+
+    observation_size = 2
+
+    def reset(self, episodes, rng):
+        return np.zeros((len(episodes), 2))
+
+    def step(self, rates, active):
+        assert not rates.flags.writeable and not active.flags.writeable
+        return rates, np.zeros(len(rates)), [False] * len(rates)
+
+
+def test_the_environment_sees_read_only_arrays_and_may_return_the_rates() -> None:
+    nets = [dnnevo.Network.random(2, 2, seed=s) for s in range(3)]
+    result = rollout(nets, Echo(), episodes=2, max_steps=5)
+    assert np.all(result.lengths == 5)
+
+
+def test_a_diverging_integration_is_not_blamed_on_the_task() -> None:
+    fast = dnnevo.Network(tau=[0.01], theta=[0.0], weights=[[0.0]], sensor_weights=[[1.0]])
+    with pytest.raises(InvalidArgumentError, match="integration diverged") as caught:
+        rollout([fast], Drift(length=1000), max_steps=1000, dt=0.1, substeps=100)
+    assert not isinstance(caught.value, TaskError)
+
+
+def test_the_digest_is_exact_and_ignores_what_changes_from_run_to_run() -> None:
+    from dnnevo.closedloop import ClosedLoop
+
+    class Slotted(Drift):
+        __slots__ = ("weight",)
+
+    def digest(env):
+        return ClosedLoop(env, max_steps=5).digest()
+
+    a, b = Drift(), Drift()
+    a.w, b.w = np.array([0.1, 0.2]), np.array([0.1, 0.2 + 1e-15])
+    assert digest(a) != digest(b)
+    a.rng, b.rng = np.random.default_rng(1), np.random.default_rng(2)
+    b.w = a.w.copy()
+    assert digest(a) == digest(b)
+    assert digest(Slotted()) == digest(Slotted())

@@ -64,6 +64,11 @@ class Ranges:
             object.__setattr__(self, f.name, (lo, hi))
 
 
+#: Prefix of ``config.task`` for a task written in Python: ``"python:module.Name"``, a
+#: closed-loop environment class (``dnnevo.closedloop``) or, from ``evolve``, a fitness function.
+PYTHON_TASK = "python:"
+
+
 @dataclass(frozen=True)
 class IntegratorConfig:
     """How networks are integrated: each input row is held for ``substeps`` steps of ``dt``."""
@@ -89,7 +94,9 @@ class EvolutionConfig:
     """
 
     task: str = _DEFAULTS["task"]
-    """Built-in task name (see ``dnnevo tasks``); ignored when ``evolve`` gets a Python callable."""
+    """Built-in task name (see ``dnnevo tasks``), or ``"python:module.Class"`` for a closed-loop
+    task written in Python (``dnnevo.closedloop``); set from the function when ``evolve`` gets a
+    Python callable."""
     population: int = _DEFAULTS["population"]
     generations: int = _DEFAULTS["generations"]
     crossover_rate: float = _DEFAULTS["crossover_rate"]

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo import tasks
+from dnnevo.closedloop import named
 from dnnevo.evaluation.assessment import Assessment, Rate
 from dnnevo.evaluation.stats import Verdict
 from dnnevo.errors import ConfigError
@@ -49,6 +50,12 @@ def assess(args: argparse.Namespace) -> int:
     champion = run.read_best(config, table)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     task = tasks.get(config.task)
+    if named.is_python_task(config.task) and not named.is_closed_loop(config):
+        raise ConfigError(f"{args.dir} was evolved with a Python fitness function ({config.task}), "
+                          "which has no success rule; a task class can have one (docs/closed-loop.md)")
+    if named.is_closed_loop(config):
+        # The task class must still be the run's own, before --dt changes the settings.
+        named.closed_loop(config, digest=table.get("fitness_sha256"))
     if args.robot_like and not task.ROBOT_LIKE:
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
     if args.dt is not None:

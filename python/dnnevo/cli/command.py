@@ -25,6 +25,8 @@ from dnnevo.cli import reproduce as _cli_reproduce
 from dnnevo.cli import show as _cli_show
 from dnnevo.cli import sweep as _cli_sweep
 from dnnevo import presets
+from dnnevo.closedloop import named
+from dnnevo.config import PYTHON_TASK, EvolutionConfig, apply_overrides
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
 from dnnevo.tasks import DEFAULT_TRIALS
@@ -49,6 +51,9 @@ EXAMPLES = """examples:
   dnnevo reproduce --quick --seeds 0-1 --out runs/repro   the whole paper in miniature, with a report
 """
 
+
+#: ``dnnevo run python:... --quick``: a demo's population and generations.
+PYTHON_QUICK = {"population": 20, "generations": 5}
 
 MAX_SEEDS = 10_000
 """The most seeds a sweep or reproduction takes."""
@@ -125,8 +130,14 @@ def build_parser() -> argparse.ArgumentParser:
                        help="small population, few generations: a demo, not a result")
         p.add_argument("--threads", type=_positive, help="worker threads (default: all cores)")
 
-    p = sub.add_parser("run", help="run a preset", epilog="example: dnnevo run sequence-1bit --quick --out runs/demo")
-    p.add_argument("preset", help="preset name (see 'dnnevo presets')")
+    p = sub.add_parser("run", help="run a preset, or a task written in Python",
+                       epilog="examples:\n  dnnevo run sequence-1bit --quick --out runs/demo\n"
+                              "  dnnevo run python:light.Light --set n_inputs=1 --set size=3 "
+                              "--set task_params.max_steps=300 --set task_params.episodes=4\n"
+                              "    (the class Light of light.py in this folder: docs/closed-loop.md)",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("preset", help="preset name (see 'dnnevo presets'), or python:module.Class for a "
+                                  "closed-loop task class")
     p.add_argument("--seed", type=_nonnegative, default=0, help="random seed (default 0)")
     p.add_argument("--out", type=Path, help="run folder (default runs/PRESET-seedN)")
     p.add_argument("--force", action="store_true",
@@ -209,8 +220,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    config = presets.get(args.preset, quick=args.quick, overrides=args.set)
-    out = args.out or Path("runs") / f"{args.preset}{'-quick' if args.quick else ''}-seed{args.seed}"
+    if named.is_python_task(args.preset):
+        # A task written in Python: its settings come from --set alone (docs/closed-loop.md).
+        quick = PYTHON_QUICK if args.quick else {}
+        config = apply_overrides(EvolutionConfig.from_dict({"task": args.preset, **quick}), args.set)
+        stem = args.preset.removeprefix(PYTHON_TASK)
+    else:
+        config = presets.get(args.preset, quick=args.quick, overrides=args.set)
+        stem = args.preset
+    out = args.out or Path("runs") / f"{stem}{'-quick' if args.quick else ''}-seed{args.seed}"
     how = seeding.Seeding.from_args(args)
     seeds = how.networks(config.size, args.seed) if how else None
     info = how.info() if how else None

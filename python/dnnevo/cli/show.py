@@ -25,7 +25,8 @@ import numpy as np
 
 from dnnevo import plot
 from dnnevo.config import EvolutionConfig
-from dnnevo.evolution.evolve import PYTHON_TASK
+from dnnevo.closedloop import named
+from dnnevo.config import PYTHON_TASK
 from dnnevo.runs import RunDir, save_figure
 
 __all__ = ["champion_line", "next_line", "outcome", "show", "success_line"]
@@ -42,9 +43,13 @@ def champion_line(fitness: float | None, generation: int | None,
     return text
 
 
-def success_line(task: str, success: Sequence[float]) -> str:
+def success_line(task: str, success: Sequence[float], *, closed_loop: bool = False) -> str:
     """Whether the champion met the task's success rule during the run, from log.csv's
-    ``champion_success`` column (one value per generation: 1, 0 or nan)."""
+    ``champion_success`` column (one value per generation: 1, 0 or nan). ``closed_loop``: the
+    run's task is a Python task class (:mod:`dnnevo.closedloop.named`)."""
+    if closed_loop:
+        return ("success rule: the task class's own, not checked during the run (dnnevo assess "
+                "judges the champion by it)")
     if task.startswith(PYTHON_TASK):
         return "success rule: none (a Python fitness function has no success rule)"
     judged = [s for s in success if not math.isnan(s)]
@@ -63,8 +68,9 @@ def success_line(task: str, success: Sequence[float]) -> str:
 
 def next_line(path: Path, config: EvolutionConfig, done: int, *, interrupted: bool = False) -> str | None:
     """The command to run next on the run folder ``path`` after ``done`` generations, or None
-    for a Python fitness function's run, which the command line can neither resume nor judge."""
-    if config.task.startswith(PYTHON_TASK):
+    for a Python fitness function's run, which the command line can neither resume nor judge
+    (a Python task class's run it can)."""
+    if config.task.startswith(PYTHON_TASK) and not named.is_closed_loop(config):
         return None
     judge = f"dnnevo assess {path}"
     if interrupted or done < config.generations:
@@ -84,7 +90,7 @@ def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
     fitness, generation = champion.get("fitness"), champion.get("generation")
     lines = [champion_line(None if fitness is None else float(fitness),
                            None if generation is None else int(generation), validation),
-             success_line(config.task, success)]
+             success_line(config.task, success, closed_loop=named.is_closed_loop(config))]
     step = next_line(path, config, len(success), interrupted=interrupted)
     return lines if step is None else [*lines, step]
 

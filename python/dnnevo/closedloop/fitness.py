@@ -13,8 +13,11 @@ the run's seed and generation.
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import inspect
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -22,32 +25,64 @@ import numpy.typing as npt
 from dnnevo import _core
 from dnnevo.closedloop.environment import Environment
 from dnnevo.closedloop.loop import rollout
+from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
 
 __all__ = ["ClosedLoop"]
 
 
+_INTEGRATOR = IntegratorConfig()
+
+
 class ClosedLoop:
     """``fitness(networks, *, generation, seed)``: the networks' mean returns in ``env``, for
-    ``episodes`` episodes of at most ``max_steps`` time steps of ``substeps`` integration steps
-    of ``dt``. A run folder names it after the environment's class, and ``resume`` accepts it
-    again only with the same class source and the same settings.
+    ``episodes`` episodes of at most ``max_steps`` time steps, each of ``substeps`` integration
+    steps of ``dt`` (by default the run config's defaults, as for a task named in a config).
+
+    A run folder names it after the environment's class (or ``name``, ``"python:module.Class"``)
+    and records the rollout's settings in ``config.toml``, with a digest of the class's source,
+    the environment's attributes and the settings; ``resume`` accepts it again only when the
+    digest is the same. Wrap a freshly made environment: one that has run episodes has more
+    attributes.
     """
 
-    def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int, dt: float = 0.1,
-                 substeps: int = 1, method: str = "euler") -> None:
+    def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int,
+                 dt: float = _INTEGRATOR.dt, substeps: int = _INTEGRATOR.substeps,
+                 method: str = _INTEGRATOR.method, name: str | None = None) -> None:
         self.env = env
         self.settings = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps,
                              method=method)
-        # What evolve records of a fitness function: the environment's name, and a text whose
-        # digest changes with its source, its parameters or the rollout's settings.
         kind = type(env)
-        self.__module__ = kind.__module__
-        self.__qualname__ = kind.__qualname__
+        module, qualname = kind.__module__, kind.__qualname__
+        if name is not None:
+            module, _, qualname = name.removeprefix(PYTHON_TASK).rpartition(".")
+        self.__module__, self.__qualname__ = module, qualname
         try:
             source = inspect.getsource(kind)
         except (OSError, TypeError):
             source = kind.__qualname__
-        self.fitness_source = f"{source}\n{vars(env)!r}\n{self.settings!r}"
+        try:
+            attributes = vars(env)
+        except TypeError:  # a class with __slots__
+            attributes = {k: getattr(env, k) for k in getattr(kind, "__slots__", ()) if hasattr(env, k)}
+        self.fitness_source = "\n".join([source, fingerprint(attributes), fingerprint(self.settings)])
+
+    def digest(self) -> str:
+        """SHA-256 of :attr:`fitness_source`, as ``config.toml``'s ``fitness_sha256`` records it."""
+        return hashlib.sha256(self.fitness_source.encode()).hexdigest()
+
+    def configured(self, config: EvolutionConfig) -> EvolutionConfig:
+        """``config`` saying what this fitness function runs: its name as ``task``, the rollout's
+        episodes and step limit as ``task_params`` and its integration as ``integrator``. The
+        environment's own parameters are not known, so ``task_params`` holds no others: a
+        command that builds the task from the config builds it with its defaults, and the digest
+        then tells whether that is the same task."""
+        s = self.settings
+        return dataclasses.replace(
+            config,
+            task=f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}",
+            integrator=IntegratorConfig(method=s["method"], dt=s["dt"], substeps=s["substeps"]),
+            task_params={"episodes": s["episodes"], "max_steps": s["max_steps"]},
+        )
 
     def __call__(self, networks: Sequence[_core.Network], *, generation: int = 0,
                  seed: int = 0) -> npt.NDArray[np.float64]:
@@ -56,3 +91,25 @@ class ClosedLoop:
     def __repr__(self) -> str:
         settings = ", ".join(f"{k}={v!r}" for k, v in self.settings.items())
         return f"ClosedLoop({type(self.env).__name__}(), {settings})"
+
+
+def fingerprint(value: Any) -> str:
+    """An exact text of ``value`` for the digest: numbers by ``repr`` (exact for floats), arrays
+    by dtype, shape and a hash of their bytes, containers item by item, and any other object by
+    its type alone (an address or a random generator's state would change from run to run)."""
+    if value is None or isinstance(value, bool | int | float | complex | str | bytes):
+        return repr(value)
+    if isinstance(value, np.generic):
+        return f"{value.dtype}:{value.item()!r}"
+    if isinstance(value, np.ndarray):
+        data = np.ascontiguousarray(value)
+        if data.dtype.hasobject:
+            return f"ndarray[{data.dtype}, {data.shape}]"
+        return f"ndarray[{data.dtype}, {data.shape}, {hashlib.sha256(data.tobytes()).hexdigest()}]"
+    if isinstance(value, list | tuple):
+        return f"{type(value).__name__}[{', '.join(fingerprint(v) for v in value)}]"
+    if isinstance(value, Mapping):
+        items = sorted((repr(k), fingerprint(v)) for k, v in value.items())
+        return "{" + ", ".join(f"{k}: {v}" for k, v in items) + "}"
+    return f"<{type(value).__module__}.{type(value).__qualname__}>"
+

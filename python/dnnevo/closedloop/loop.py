@@ -87,6 +87,9 @@ def rollout(
     returns = np.zeros(rows)
     lengths = np.zeros(rows, dtype=np.int64)
     rates = np.empty((rows, batch.size))
+    # The environment sees read-only views: it can neither change what the loop keeps nor
+    # hand the rates back as the next observations to be written over.
+    seen_rates, seen_active = _read_only(rates), _read_only(active)
     step = env.step
     # The loop is the hot path: one call of the batch and one of the environment per time step,
     # and five whole-array operations. The checks cost nothing while the environment keeps to
@@ -95,10 +98,12 @@ def rollout(
         try:
             batch.step(obs, active=active, out=rates)
         except InvalidArgumentError as e:
+            if not str(e).startswith("inputs["):
+                raise  # not the environment's doing: an integration that diverged
             raise TaskError(f"{_name(env)}.{'step' if t else 'reset'} returned observations that "
                             f"are not finite ({e})") from None
         try:
-            out = step(rates, active)
+            out = step(seen_rates, seen_active)
         except Exception as e:
             raise TaskError(f"{_name(env)}.step raised {type(e).__name__}: {e}") from e
         try:
@@ -108,9 +113,13 @@ def rollout(
                             "(observations, rewards, done)") from None
         if type(obs) is not np.ndarray or obs.shape != (rows, m) or obs.dtype not in _FLOATS:
             obs = _observations(obs, env, "step", rows, m)
+        if np.may_share_memory(obs, rates):
+            obs = obs.copy()  # the batch writes the rates while it reads the observations
         if type(reward) is not np.ndarray or reward.shape != (rows,) or reward.dtype.kind not in "biuf":
             reward = _row_values(reward, env, rows)
-        if type(done) is not np.ndarray or done.shape != (rows,) or done.dtype != np.bool_:
+        if type(done) is not np.ndarray:
+            done = np.asarray(done)
+        if done.shape != (rows,) or done.dtype != np.bool_:
             raise TaskError(f"{_name(env)}.step returned done of type {type(done).__name__}, dtype "
                             f"{getattr(done, 'dtype', '?')} and shape {np.shape(done)}; expected a "
                             f"bool array of shape (B,) = ({rows},)")
@@ -165,9 +174,17 @@ def _row_values(value: Any, env: Any, rows: int) -> npt.NDArray[Any]:
 
 
 def _check_rewards(reward: npt.NDArray[Any], env: Any, active: npt.NDArray[np.bool_]) -> None:
-    """Names a running row's reward that is not finite (a finite sum can still overflow)."""
+    """Names a running row's reward that is not finite, or says that the returns overflowed."""
     bad = ~np.isfinite(reward) & active
     if bad.any():
         r = int(np.flatnonzero(bad)[0])
         raise TaskError(f"{_name(env)}.step returned rewards[{r}] = {reward[r]}; every reward of a "
                         "running episode must be finite")
+    raise TaskError(f"the returns of {_name(env)}'s episodes overflowed (their sum exceeds "
+                    "1.8e308); scale its rewards down")
+
+
+def _read_only(array: npt.NDArray[Any]) -> npt.NDArray[Any]:
+    view = array.view()
+    view.flags.writeable = False
+    return view

@@ -25,7 +25,9 @@ import numpy.typing as npt
 
 from dnnevo import _core, presets
 from dnnevo._checks import nonnegative
-from dnnevo.config import EvolutionConfig
+from dnnevo.closedloop import named
+from dnnevo.closedloop.fitness import ClosedLoop
+from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError, did_you_mean
 from dnnevo.evolution.ga import GeneticAlgorithm, founders_argument
 from dnnevo.evolution.progress import Progress
@@ -36,8 +38,6 @@ __all__ = ["EvolutionResult", "evaluate", "evolve", "resume"]
 FitnessFn = Callable[[list[_core.Network]], npt.ArrayLike]
 Callback = Callable[[dict[str, float], GeneticAlgorithm], Any]
 
-#: Prefix of ``config.task`` for runs whose fitness is a Python callable (then named after it).
-PYTHON_TASK = "python:"
 #: Seconds between two checkpoints (one is also written at the end and on interruption).
 CHECKPOINT_SECONDS = 10.0
 #: Seconds between two rewrites of log.csv (it is also rewritten with every checkpoint).
@@ -140,7 +140,12 @@ def evolve(
     ``seeds``, its old name, is deprecated). ``run_info`` adds entries to the ``[run]`` table of
     ``config.toml``, e.g. where the founders came from.
     """
-    if callable(task):
+    if isinstance(task, str) and named.is_python_task(task):
+        config = dataclasses.replace(config or EvolutionConfig(), task=task)
+        task = named.closed_loop(config)  # imports the task's module, checks it, builds it
+    elif isinstance(task, ClosedLoop):
+        config = task.configured(config or EvolutionConfig())
+    elif callable(task):
         config = dataclasses.replace(config or EvolutionConfig(), task=_python_task_name(task))
     else:
         config = _task_config(task, config)
@@ -202,13 +207,17 @@ def resume(
             raise RunFileError(f"{run.checkpoint}: generation {ga.generation} is beyond the run's "
                                f"{ga.config.generations} generations")
         fitness: str | FitnessFn = ga.config.task
-        if task is not None:
+        if isinstance(task, str) and named.is_python_task(task):
+            if task != ga.config.task:
+                raise ConfigError(f"{run.path} was evolved with {ga.config.task}, not {task}")
+            fitness = _named_fitness(run, ga.config, table)
+        elif task is not None:
             fitness = task
             name = task if isinstance(task, str) else _python_task_name(task)
             digest = None if isinstance(task, str) else _fitness_digest(task)
             # Same name, other source: a different function all the same.
             edited = digest is not None and table.get("fitness_sha256", digest) != digest
-            if not edited and _moved(name, ga.config.task, digest, table):
+            if not edited and _moved(task, name, ga.config.task, digest, table):
                 name = ga.config.task  # the same source, imported from another module
             if name != ga.config.task or edited:
                 if not new_fitness:
@@ -224,11 +233,12 @@ def resume(
                 print(f"{run.path}: continuing at generation {ga.generation} with {name} "
                       f"(the run was evolved with {ga.config.task}); recorded in config.toml",
                       file=sys.stderr)
-        elif ga.config.task.startswith(PYTHON_TASK):
+        elif named.is_closed_loop(ga.config):
+            fitness = _named_fitness(run, ga.config, table)
+        elif named.is_python_task(ga.config.task):
             raise DnnevoError(
                 f"{run.path} was evolved with a Python fitness function ({ga.config.task}); resume it "
-                "from Python: dnnevo.resume(dir, task=fitness)"
-            )
+                "from Python: dnnevo.resume(dir, task=fitness)")
         # Every file rewritten from the state about to continue, so they agree from here on.
         run.write_checkpoint(ga.state_dict(), history, table, ga.seed)
         run.write_config(ga.config, table)
@@ -238,15 +248,32 @@ def resume(
                      threads=threads, table=table)
 
 
-def _moved(name: str, recorded: str, digest: str | None, table: Mapping[str, Any]) -> bool:
-    """Whether a fitness function named ``name`` is the run's own (``recorded``) imported from
-    another module: the same qualified name after the module, the same source digest, and one of
-    the two defined in a script (``__main__``). A run started by ``python light.py`` then
-    resumes from a script that does ``from light import ...``."""
+def _named_fitness(run: RunDir, config: EvolutionConfig, table: Mapping[str, Any]) -> FitnessFn:
+    """The task class a run's config names, built from the config (importing its module), when
+    its digest is the run's own."""
+    try:
+        return named.closed_loop(config, digest=table.get("fitness_sha256"))
+    except ConfigError as e:
+        raise ConfigError(f"{run.path}: {e}; resume it from Python with the environment it began "
+                          "with, or with new_fitness=True") from None
+
+
+def _moved(task: FitnessFn, name: str, recorded: str, digest: str | None,
+           table: Mapping[str, Any]) -> bool:
+    """Whether a fitness function named ``name`` is the run's own (``recorded``) under another
+    name: the same source digest, and either the same environment class (a task class reached
+    through another module) or one of the two names a script's (``__main__``) with the same
+    qualified name after the module. A run started by ``python light.py`` then resumes from a
+    script that does ``from light import ...``."""
     if digest is None or table.get("fitness_sha256") != digest:
         return False
     if not (name.startswith(PYTHON_TASK) and recorded.startswith(PYTHON_TASK)):
         return False
+    if isinstance(task, ClosedLoop):
+        try:
+            return named.environment_class(recorded) is type(task.env)
+        except ConfigError:
+            pass
     main = f"{PYTHON_TASK}__main__."
     mine, theirs = name.removeprefix(main), recorded.removeprefix(main)
     one_is_main = (mine != name) != (theirs != recorded)
@@ -271,7 +298,7 @@ def _restart(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], dic
     if "seeded_from" in table:
         raise RunFileError(f"{run.path} stopped before its first checkpoint and was seeded from other "
                            "runs; start it again with --force")
-    if not config.task.startswith(PYTHON_TASK):
+    if not named.is_python_task(config.task):
         _check_layout(config)
     return GeneticAlgorithm(config, seed=table["seed"]), [], table
 

@@ -17,8 +17,10 @@ from dnnevo._checks import nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
 from dnnevo.evaluation.assessment import Assessment
+from dnnevo.closedloop import named
 from dnnevo.tasks import landmark, nav1d, sequence
 from dnnevo.tasks.protocol import Task
+from dnnevo.tasks.user import UserTask
 
 __all__ = ["DEFAULT_TRIALS", "THRESHOLDS", "UNITS", "assess", "find", "get", "names"]
 
@@ -46,8 +48,11 @@ def find(name: str) -> Task | None:
 
 
 def get(name: str) -> Task:
-    """The task called ``name``; an unknown name is a :class:`~dnnevo.ConfigError` that lists the
-    tasks and suggests the closest."""
+    """The task called ``name``, a built-in one or a Python task (``"python:module.Class"``,
+    judged by its class's own rule); an unknown name is a :class:`~dnnevo.ConfigError` that lists
+    the tasks and suggests the closest."""
+    if named.is_python_task(name):
+        return UserTask(name)
     task = _TASKS.get(name)
     if task is None:
         close = difflib.get_close_matches(name, _TASKS, n=1)

@@ -1,0 +1,114 @@
+"""A closed-loop task named in a config, so that ``dnnevo run``, ``resume`` and ``evolve`` build
+it from ``config.toml`` alone.
+
+``config.task = "python:module.Class"`` names the environment class; ``task_params`` holds the
+rollout's ``episodes`` and ``max_steps`` and, besides them, the keyword arguments of the class;
+``config.integrator`` says how the networks are integrated. For example, ``config.toml``::
+
+    task = "python:light.Light"
+    n_inputs = 1
+    [task_params]
+    episodes = 4
+    max_steps = 300
+    speed = 0.1      # Light(speed=0.1)
+
+A run's ``config.toml`` also records a digest of the class's source, the environment's
+attributes and the rollout's settings (``fitness_sha256``): ``resume`` and ``assess`` refuse a
+task that no longer matches it.
+
+Building the task imports ``module``: a run folder that names a Python task names code to run,
+as a pickle does. Only the commands that run a task import it (``run``, ``resume``, ``assess``);
+``dnnevo show`` never does. The module is looked up on ``sys.path`` and then in the current
+folder.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import sys
+from typing import Any
+
+from dnnevo.closedloop.fitness import ClosedLoop
+from dnnevo.config import PYTHON_TASK, EvolutionConfig
+from dnnevo.errors import ConfigError, TaskError
+
+__all__ = ["ROLLOUT_KEYS", "closed_loop", "environment_class", "is_closed_loop", "is_python_task"]
+
+#: The keys of ``task_params`` that set the rollout; every other key goes to the class.
+ROLLOUT_KEYS = ("episodes", "max_steps")
+
+#: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
+_MEMBERS = ("observation_size", "reset", "step")
+
+
+def is_python_task(task: str) -> bool:
+    """Whether ``task`` names a task written in Python (``"python:..."``)."""
+    return task.startswith(PYTHON_TASK)
+
+
+def is_closed_loop(config: EvolutionConfig) -> bool:
+    """Whether ``config`` names a Python task class that the command line can build (its
+    ``task_params`` say the rollout's ``max_steps``), without importing anything."""
+    return is_python_task(config.task) and "max_steps" in config.task_params
+
+
+def environment_class(task: str) -> type:
+    """The class that ``task`` (``"python:module.Class"``) names, imported and checked against the
+    protocol before anything of it is called; a :class:`~dnnevo.ConfigError` says what is wrong."""
+    path = task.removeprefix(PYTHON_TASK)
+    module_name, _, attr = path.rpartition(".")
+    if not module_name or not attr:
+        raise ConfigError(f"task {task!r} names no class; expected python:module.Class")
+    module = _import(module_name, task)
+    cls = getattr(module, attr, None)
+    if cls is None:
+        raise ConfigError(f"task {task!r}: module {module_name} has no {attr}")
+    missing = [m for m in _MEMBERS if not hasattr(cls, m)]
+    if not isinstance(cls, type) or missing:
+        what = type(cls).__name__ if not isinstance(cls, type) else f"class without {', '.join(missing)}"
+        raise ConfigError(f"task {task!r} is a {what}; a task is a class with observation_size, "
+                          "reset(episodes, rng) and step(rates, active) (docs/closed-loop.md)")
+    return cls
+
+
+def _import(module_name: str, task: str) -> Any:
+    """Imports ``module_name``, looking in the current folder too, as ``python -m`` would."""
+    try:
+        return importlib.import_module(module_name)
+    except ModuleNotFoundError as e:
+        here = os.getcwd()
+        if e.name != module_name.split(".")[0] or here in sys.path:
+            raise ConfigError(f"task {task!r}: cannot import {module_name}: {e}") from None
+        sys.path.append(here)  # after everything else, so that it shadows no other module
+        return _import(module_name, task)
+    except Exception as e:
+        raise ConfigError(f"task {task!r}: importing {module_name} raised "
+                          f"{type(e).__name__}: {e}") from e
+
+
+def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> ClosedLoop:
+    """The fitness function of the task that ``config`` names (see the module docs). With
+    ``digest`` (a run's ``fitness_sha256``), it must be the run's own task."""
+    cls = environment_class(config.task)
+    params = dict(config.task_params)
+    settings = {k: params.pop(k) for k in ROLLOUT_KEYS if k in params}
+    if "max_steps" not in settings:
+        raise ConfigError(f"task {config.task!r} needs task_params.max_steps, the longest episode "
+                          "in time steps (and task_params.episodes, default 1)")
+    try:
+        env = cls(**params)
+    except TypeError as e:
+        raise ConfigError(f"{cls.__name__}(**task_params) failed: {e}") from None
+    except Exception as e:
+        raise TaskError(f"{cls.__name__}(**task_params) raised {type(e).__name__}: {e}") from e
+    if env.observation_size != config.n_inputs:
+        raise ConfigError(f"n_inputs is {config.n_inputs}; {cls.__name__}.observation_size is "
+                          f"{env.observation_size} (set n_inputs = {env.observation_size})")
+    i = config.integrator
+    loop = ClosedLoop(env, **settings, dt=i.dt, substeps=i.substeps, method=i.method, name=config.task)
+    if digest is not None and loop.digest() != digest:
+        raise ConfigError(f"the run was evolved with another version of {config.task} (its source, "
+                          "the environment's attributes or the rollout's settings differ, or the run "
+                          "began from Python with an environment made with other arguments)")
+    return loop

@@ -1,0 +1,76 @@
+"""dnnevo.closedloop.gym: Gymnasium's vector environments as closed-loop tasks, in every autoreset
+mode, with common random numbers where the environment allows them. That CartPole-v1 is solved
+is checked by docs/closed-loop.md's example, which tests/test_docs.py runs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dnnevo
+from dnnevo import ConfigError
+from dnnevo.closedloop import rollout
+from dnnevo.closedloop.gym import GymEnvironment
+
+
+def networks(count: int, n: int = 4, m: int = 4, seed: int = 0) -> list[dnnevo.Network]:
+    return [dnnevo.Network.random(n, m, seed=seed + k) for k in range(count)]
+
+
+@pytest.mark.parametrize("mode", ["next_step", "same_step", "disabled"])
+def test_every_autoreset_mode_gives_the_same_episodes(mode: str) -> None:
+    """Each row runs one episode and leaves when it ends, so what the vector environment does
+    after an end is never read; with autoreset disabled the ended sub-environments are reset so
+    that stepping them is allowed."""
+    nets = networks(6)
+    reference = rollout(nets, GymEnvironment("CartPole-v1", actions="threshold", vectorization_mode="sync"),
+                        episodes=3, max_steps=200, seed=5)
+    env = GymEnvironment("CartPole-v1", actions="threshold", vectorization_mode="sync",
+                         autoreset_mode=mode)
+    result = rollout(nets, env, episodes=3, max_steps=200, seed=5)
+    assert env.envs.metadata["autoreset_mode"].name.lower() == mode
+    assert np.array_equal(result.returns, reference.returns)
+    assert np.array_equal(result.lengths, reference.lengths)
+    assert result.lengths.min() < 200 and result.lengths.max() > result.lengths.min()
+
+
+def test_separate_environments_give_every_network_the_same_starts() -> None:
+    same = networks(1) * 4
+    sync = rollout(same, GymEnvironment("CartPole-v1", actions="threshold", vectorization_mode="sync"),
+                   episodes=3, max_steps=100, seed=1)
+    assert np.all(sync.returns == sync.returns[0])
+    # A natively vectorised environment takes one seed for all its rows: no common starts.
+    native = rollout(same, GymEnvironment("CartPole-v1", actions="threshold"), episodes=3,
+                     max_steps=100, seed=1)
+    assert not np.all(native.returns == native.returns[0])
+
+
+def test_actions_from_rates() -> None:
+    rates = np.array([[0.2, 0.9, 0.1], [0.7, 0.3, 0.8]])
+    argmax = GymEnvironment("CartPole-v1", actions="argmax")
+    assert argmax._act(rates).tolist() == [1, 0]
+    chosen = GymEnvironment("CartPole-v1", actions="argmax", outputs=[2, 0])
+    assert chosen._act(rates).tolist() == [1, 0]
+    threshold = GymEnvironment("CartPole-v1", actions="threshold", outputs=[2])
+    assert threshold._act(rates).tolist() == [0, 1]
+    box = GymEnvironment("Pendulum-v1", actions="box")  # one torque in [-2, 2]
+    assert box._act(rates).reshape(-1).tolist() == pytest.approx([-1.2, 0.8])
+
+
+def test_observations_kept_and_scaled() -> None:
+    env = GymEnvironment("CartPole-v1", observations=[0, 2], observation_scale=[1.0, 5.0])
+    assert env.observation_size == 2
+    obs = env._observe(np.array([[1.0, 2.0, 3.0, 4.0]], dtype=np.float32))
+    assert obs.tolist() == [[1.0, 15.0]]
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"actions": "softmax"}, "actions is 'softmax'"),
+    ({"actions": "box"}, "needs a Box action space"),
+    ({"outputs": [0]}, "outputs names 1 neurons"),
+    ({"observations": [4]}, "CartPole-v1 has 4 components"),
+    ({"autoreset_mode": "sometimes"}, "autoreset_mode is 'sometimes'"),
+])
+def test_bad_settings_are_config_errors(kwargs: dict, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        GymEnvironment("CartPole-v1", **kwargs)

@@ -71,7 +71,7 @@ def test_run_show_assess_resume_sweep(tmp_path: Path) -> None:
         (["run", "sequence-1bit", "--quick", "--set", "nonsense"], "is not key=value"),
         (["run", "sequence-1bit", "--seed", "-1"], "-1 is negative"),
         (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
-        (["resume", "/no/such/dir"], "has no checkpoint.json"),
+        (["resume", "/no/such/dir"], "/no/such/dir does not exist"),
         (["show", "/no/such/dir"], "has no config.toml"),
         (["assess", "/no/such/dir"], "has no config.toml"),
         (["assess", "x", "--trials", "0"], "must be >= 1"),

@@ -166,6 +166,10 @@ def test_edited_config_toml_is_refused_naming_the_field(pristine: Path, tmp_path
     (run / "config.toml").write_text("\n".join(lines) + "\n")
     r = run_cli("resume", run)
     assert_one_line_error(r, f"at {field}:")
+    # The readers apply the same rule: what they would report is not what the run was made with.
+    for command in (["show"], ["assess", "--trials", "2"], ["plot"]):
+        r = run_cli(command[0], run, *command[1:])
+        assert_one_line_error(r, "config.toml was edited after the run", f"{field} is")
 
 
 def test_log_damage_in_show_and_plot(pristine: Path, tmp_path: Path) -> None:
@@ -465,6 +469,15 @@ from dnnevo import presets
 from dnnevo.tasks import sequence
 refused(lambda: nets[0].run(np.zeros((3, 2)), substeps=2**64), InvalidArgumentError, "substeps is 18446744073709551616")
 refused(lambda: dnnevo.run_population(nets, np.zeros((3, 2)), substeps=2**70), InvalidArgumentError, "substeps is")
+# Sizes within the integer types that ask for years of work or terabytes: refused, never aborted.
+blind = dnnevo.Network.random(3, 0, seed=0)
+refused(lambda: blind.run(np.zeros((10**12, 0))), InvalidArgumentError, "integration steps")
+refused(lambda: blind.run(np.zeros((2**35, 0))), InvalidArgumentError, "cannot allocate the recorded states")
+refused(lambda: dnnevo.run_population([blind], np.zeros((10**12, 0))), InvalidArgumentError, "the limit is 68719476736")
+refused(lambda: dnnevo.run_population([blind] * 4, np.zeros((2**33, 0))), InvalidArgumentError, "cannot allocate")
+refused(lambda: nets[0].run(np.zeros((3, 2)), substeps=2**63), InvalidArgumentError, "integration steps")
+refused(lambda: dnnevo.Batch(nets, replicas=2**40), InvalidArgumentError, "the limit is 16777216")
+refused(lambda: dnnevo.Batch(nets, substeps=2**62).step(np.zeros((1, 2))), InvalidArgumentError, "integration steps")
 refused(lambda: analysis.equilibria(nets[0], [0.0, 0.0], starts=2**70), InvalidArgumentError, "starts is")
 refused(lambda: analysis.equilibria(nets[0], [0.0, 0.0], starts=10**9), InvalidArgumentError, "starts is 1000000000")
 refused(lambda: nav1d.fresh_chains(presets.get("nav1d-far"), 10**13, 3, 0), InvalidArgumentError, "count is 10000000000000")

@@ -19,7 +19,7 @@ def draw_run(path: str | Path, *, seed: int = 0, animate: bool = False) -> list[
     ``animate`` a GIF too), of trials drawn from ``seed``. Every file of the run is checked before
     any figure is written."""
     run = RunDir(path)
-    config, table = run.read_config()
+    config, table = run.read_run_config()
     history = run.read_log(config)
     task = tasks.find(config.task)
     if task is not None:

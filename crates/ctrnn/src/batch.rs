@@ -17,6 +17,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::integrate::{Integrator, LANES};
+use crate::limits::{check_work, MAX_BATCH_ROWS};
 use crate::network::Network;
 use crate::population::Block;
 
@@ -81,6 +82,13 @@ impl Batch {
             return Err(Error::InvalidArgument(
                 "replicas is 0; a batch needs at least 1 replica per network".into(),
             ));
+        }
+        let rows = (networks.len() as u128).saturating_mul(replicas as u128);
+        if rows > MAX_BATCH_ROWS {
+            return Err(Error::InvalidArgument(format!(
+                "{} networks x {replicas} replicas make {rows} rows; the limit is {MAX_BATCH_ROWS} (2^24)",
+                networks.len()
+            )));
         }
         let networks: Vec<Network> = networks.iter().map(|n| n.borrow().clone()).collect();
         let first = networks
@@ -247,6 +255,7 @@ impl Batch {
         cancel: Option<&AtomicBool>,
     ) -> Result<()> {
         let (rows, n, m) = (self.rows(), self.size, self.n_inputs);
+        check_work(rows, 1, self.integ.substeps)?;
         self.check_len("inputs", inputs.len(), rows * m, "B x M")?;
         self.check_len("rates", rates.len(), rows * n, "B x N")?;
         if let Some(mask) = active {

@@ -22,6 +22,7 @@ pub mod ga;
 pub mod genome;
 pub mod integrate;
 pub mod io;
+pub mod limits;
 pub mod math;
 pub mod names;
 pub mod network;

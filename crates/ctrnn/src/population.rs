@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::integrate::{check_inputs, copy_lane, Integrator, Lanes, LANES};
+use crate::limits;
 use crate::network::Network;
 
 /// A block of [`LANES`] networks stepped together.
@@ -112,6 +113,7 @@ impl Population {
     ) -> Result<Vec<f64>> {
         integ.validate()?;
         let (m, p_len) = (self.n_inputs, self.len);
+        limits::check_work(p_len, steps, integ.substeps)?;
         match inputs {
             Inputs::Shared(x) => {
                 check_inputs(x, steps * m, "T x M")?;
@@ -149,7 +151,12 @@ impl Population {
         let n = self.size;
         let fill = &fill;
         // One call of `run_rows` for both cases, so that the kernel under it is compiled once.
-        let mut out = vec![0.0; if record { self.len * steps * n } else { 0 }];
+        let len = if record {
+            limits::product(&[self.len, steps, n], "recorded states")?
+        } else {
+            0
+        };
+        let mut out = limits::zeros(len, "recorded states")?;
         let mut chunks: Vec<Option<&mut [f64]>> = if record {
             out.chunks_mut(LANES * steps * n).map(Some).collect()
         } else {

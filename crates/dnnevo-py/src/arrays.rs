@@ -155,3 +155,19 @@ impl AnyInt {
         })
     }
 }
+
+/// Pairs of integers (e.g. a trial's `(delay, gap)` timings) as `usize`, each checked like
+/// [`AnyInt::to`] and named `name[i][j]`.
+pub fn pairs(items: &[(AnyInt, AnyInt)], name: &str) -> PyResult<Vec<(usize, usize)>> {
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, (a, b))| {
+            let range = "[0, 2**64)";
+            Ok((
+                a.to(&format!("{name}[{i}][0]"), range)?,
+                b.to(&format!("{name}[{i}][1]"), range)?,
+            ))
+        })
+        .collect()
+}

@@ -280,7 +280,7 @@ impl PyBatch {
             .map_err(|e| arg_err(format!("out cannot be written: {e}")))?;
         let rates = rates.as_slice_mut()?;
         let integ = *self.inner.integrator();
-        let cost = (b * n * n.max(1) * integ.substeps) as f64;
+        let cost = b as f64 * (n * n.max(1)) as f64 * integ.substeps as f64;
         let batch = &mut self.inner;
         let active = active.as_ref().map(Mask::as_slice).transpose()?;
         match &x {

@@ -9,10 +9,11 @@ use ctrnn::genome::{self, Layout};
 use ctrnn::{Evolution, Task};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
+
 use pyo3::types::{PyAny, PyDict};
 use tasks::RunConfig;
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint};
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint, AnyInt};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FitnessError, IntoPy};
 use crate::network::PyNetwork;
@@ -184,8 +185,9 @@ impl PyEvolution {
     fn step<'py>(
         &mut self,
         py: Python<'py>,
-        threads: Option<usize>,
+        threads: Option<AnyInt>,
     ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyArrayDyn<f64>>)> {
+        let threads: Option<usize> = threads.map(|t| t.to("threads", "[1, 2**64)")).transpose()?;
         let pool = pool(threads)?;
         self.task()?;
         let (Some(task), inner) = (self.task.as_deref(), &mut self.inner) else {
@@ -333,7 +335,9 @@ pub fn task_names() -> Vec<&'static str> {
 
 /// Decodes one genome into a network.
 #[pyfunction]
-pub fn decode(size: usize, n_inputs: usize, genes: &Bound<'_, PyAny>) -> PyResult<PyNetwork> {
+pub fn decode(size: AnyInt, n_inputs: AnyInt, genes: &Bound<'_, PyAny>) -> PyResult<PyNetwork> {
+    let size: usize = size.to("size", "[0, 2**64)")?;
+    let n_inputs: usize = n_inputs.to("n_inputs", "[0, 2**64)")?;
     let g = dense(genes, "genes", arg_err)?;
     let net = genome::decode(Layout { size, n_inputs }, &g.data).py_err()?;
     Ok(PyNetwork::from_core(net))

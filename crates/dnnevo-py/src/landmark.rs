@@ -6,6 +6,7 @@ use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use tasks::landmark::LandmarkTask;
 
+use crate::arrays::AnyInt;
 use crate::detach::detached;
 use crate::errors::{ConfigError, IntoPy, InvalidArgumentError};
 use crate::json::{self, to_json};
@@ -23,11 +24,14 @@ pub fn landmark_record(
     py: Python<'_>,
     params: &str,
     net: &PyNetwork,
-    landmark: u8,
-    seed: u64,
-    trial: u64,
+    landmark: AnyInt,
+    seed: AnyInt,
+    trial: AnyInt,
     robot_like: bool,
 ) -> PyResult<String> {
+    let landmark: u8 = landmark.to("landmark", "[0, 256)")?;
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+    let trial: u64 = trial.to("trial", "[0, 2**64)")?;
     let task = task(params)?;
     let net = &net.inner;
     let record = py
@@ -46,10 +50,12 @@ pub fn landmark_assess(
     py: Python<'_>,
     params: &str,
     net: &PyNetwork,
-    per_landmark: usize,
-    seed: u64,
+    per_landmark: AnyInt,
+    seed: AnyInt,
     robot_like: bool,
 ) -> PyResult<String> {
+    let per_landmark: usize = per_landmark.to("per_landmark", "[0, 2**64)")?;
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
     let task = task(params)?;
     let net = &net.inner;
     let report = detached(py, f64::INFINITY, |cancel| {

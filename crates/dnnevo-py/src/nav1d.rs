@@ -5,6 +5,7 @@
 use pyo3::prelude::*;
 use tasks::nav1d::{Condition, Environment, Nav1dTask, Part, Side, System};
 
+use crate::arrays::AnyInt;
 use crate::detach::detached;
 use crate::errors::{IntoPy, InvalidArgumentError};
 use crate::json::{self, to_json};
@@ -21,7 +22,9 @@ fn chain(text: &str) -> PyResult<Vec<Condition>> {
 
 /// The chains of trials evolution ran in `generation`, as JSON.
 #[pyfunction]
-pub fn nav1d_chains(params: &str, seed: u64, generation: u64) -> PyResult<String> {
+pub fn nav1d_chains(params: &str, seed: AnyInt, generation: AnyInt) -> PyResult<String> {
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+    let generation: u64 = generation.to("generation", "[0, 2**64)")?;
     Ok(to_json(&task(params)?.chains(seed, generation)))
 }
 
@@ -36,10 +39,13 @@ pub fn nav1d_chain_len(params: &str) -> PyResult<usize> {
 #[pyfunction]
 pub fn nav1d_fresh_chains(
     params: &str,
-    count: usize,
-    trials: usize,
-    seed: u64,
+    count: AnyInt,
+    trials: AnyInt,
+    seed: AnyInt,
 ) -> PyResult<String> {
+    let count: usize = count.to("count", "[0, 2**64)")?;
+    let trials: usize = trials.to("trials", "[0, 2**64)")?;
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
     Ok(to_json(&task(params)?.fresh_chains(count, trials, seed)))
 }
 
@@ -66,9 +72,11 @@ pub fn nav1d_assess(
     py: Python<'_>,
     params: &str,
     net: &PyNetwork,
-    chains: usize,
-    seed: u64,
+    chains: AnyInt,
+    seed: AnyInt,
 ) -> PyResult<String> {
+    let chains: usize = chains.to("chains", "[0, 2**64)")?;
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
     let task = task(params)?;
     let net = &net.inner;
     let report = detached(py, f64::INFINITY, |cancel| {
@@ -102,11 +110,14 @@ pub fn nav1d_system_assess(
     classifier: PyPart<'_>,
     far: PyPart<'_>,
     near: PyPart<'_>,
-    environments: usize,
-    trials: usize,
-    seed: u64,
+    environments: AnyInt,
+    trials: AnyInt,
+    seed: AnyInt,
     persist_state: bool,
 ) -> PyResult<String> {
+    let environments: usize = environments.to("environments", "[0, 2**64)")?;
+    let trials: usize = trials.to("trials", "[0, 2**64)")?;
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
     let system = system([&classifier, &far, &near], persist_state)?;
     let report = detached(py, f64::INFINITY, |cancel| {
         system.assess_cancellable(environments, trials, seed, Some(cancel))

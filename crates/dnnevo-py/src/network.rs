@@ -2,6 +2,7 @@
 
 use ctrnn::genome::{self, Layout, Ranges};
 use ctrnn::io::NetworkFile;
+use ctrnn::limits::zeros;
 use ctrnn::{Integrator, Method, Purpose, Stream};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -269,19 +270,22 @@ impl PyNetwork {
                 )))
             }
         };
-        let cost = (steps * n * n.max(1) * integ.substeps) as f64;
+        let cost = steps as f64 * (n * n.max(1)) as f64 * integ.substeps as f64;
         let net = &mut self.inner;
         let states = detached(py, cost, |cancel| {
             net.run_cancellable(&x.data, steps, &integ, Some(cancel))
         })?;
         let theta = self.inner.theta();
-        let outputs: Vec<f64> = states
-            .iter()
-            .enumerate()
-            .map(|(k, v)| ctrnn::math::sigmoid(v - theta[k % n]))
-            .collect();
+        // Reserved, not assumed: a long run's arrays fail with an error, not an abort.
+        let mut outputs = zeros(states.len(), "recorded outputs").py_err()?;
+        for (k, (out, v)) in outputs.iter_mut().zip(&states).enumerate() {
+            *out = ctrnn::math::sigmoid(v - theta[k % n]);
+        }
         let row_time = dt * integ.substeps as f64;
-        let time: Vec<f64> = (1..=steps).map(|t| t as f64 * row_time).collect();
+        let mut time = zeros(steps, "recorded times").py_err()?;
+        for (t, out) in time.iter_mut().enumerate() {
+            *out = (t + 1) as f64 * row_time;
+        }
         Ok(PyTrace {
             states: to_numpy(py, states, &[steps, n])?.unbind(),
             outputs: to_numpy(py, outputs, &[steps, n])?.unbind(),

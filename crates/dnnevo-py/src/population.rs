@@ -160,7 +160,7 @@ pub fn run_population<'py>(
             )))
         }
     };
-    let cost = (p_len * steps * n * n * integ.substeps) as f64;
+    let cost = p_len as f64 * steps as f64 * (n * n) as f64 * integ.substeps as f64;
     let out = detached(py, cost, |cancel| {
         let inputs = if shared {
             Inputs::Shared(&x.data)

@@ -4,6 +4,7 @@
 use pyo3::prelude::*;
 use tasks::sequence::SequenceTask;
 
+use crate::arrays::{pairs, AnyInt};
 use crate::detach::detached;
 use crate::errors::IntoPy;
 use crate::json::{self, to_json};
@@ -17,10 +18,13 @@ fn task(params: &str) -> PyResult<SequenceTask> {
 #[pyfunction]
 pub fn sequence_timings(
     params: &str,
-    seed: u64,
-    generation: u64,
-    trial: usize,
+    seed: AnyInt,
+    generation: AnyInt,
+    trial: AnyInt,
 ) -> PyResult<Vec<(usize, usize)>> {
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+    let generation: u64 = generation.to("generation", "[0, 2**64)")?;
+    let trial: usize = trial.to("trial", "[0, 2**64)")?;
     Ok(task(params)?.timings(seed, generation, trial))
 }
 
@@ -28,16 +32,24 @@ pub fn sequence_timings(
 #[pyfunction]
 pub fn sequence_fresh_timings(
     params: &str,
-    seed: u64,
-    trial: usize,
+    seed: AnyInt,
+    trial: AnyInt,
 ) -> PyResult<Vec<(usize, usize)>> {
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+    let trial: usize = trial.to("trial", "[0, 2**64)")?;
     Ok(task(params)?.assessment_timings(seed, trial))
 }
 
 /// The order in which a generation's trials run (target-major trial numbers; shuffled when they
 /// are chained).
 #[pyfunction]
-pub fn sequence_trial_order(params: &str, seed: u64, generation: u64) -> PyResult<Vec<usize>> {
+pub fn sequence_trial_order(
+    params: &str,
+    seed: AnyInt,
+    generation: AnyInt,
+) -> PyResult<Vec<usize>> {
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+    let generation: u64 = generation.to("generation", "[0, 2**64)")?;
     Ok(task(params)?.trial_order(seed, generation))
 }
 
@@ -50,9 +62,10 @@ pub fn sequence_trial(
     params: &str,
     net: &PyNetwork,
     pattern: &str,
-    timing: Vec<(usize, usize)>,
+    timing: Vec<(AnyInt, AnyInt)>,
     reset: bool,
 ) -> PyResult<String> {
+    let timing = pairs(&timing, "timing")?;
     let task = task(params)?;
     let net = &net.inner;
     let record = py
@@ -68,9 +81,11 @@ pub fn sequence_assess(
     py: Python<'_>,
     params: &str,
     net: &PyNetwork,
-    trials_per_target: usize,
-    seed: u64,
+    trials_per_target: AnyInt,
+    seed: AnyInt,
 ) -> PyResult<String> {
+    let trials_per_target: usize = trials_per_target.to("trials_per_target", "[0, 2**64)")?;
+    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
     let task = task(params)?;
     let net = &net.inner;
     let report = detached(py, f64::INFINITY, |cancel| {

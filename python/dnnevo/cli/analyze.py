@@ -91,7 +91,7 @@ def analyze(args: argparse.Namespace) -> int:
     """``dnnevo analyze``."""
     started = time.perf_counter()
     run = RunDir(args.dir)
-    config, raw = run.read_config()
+    config, raw = run.read_run_config()
     net = run.read_best(config, raw)
     m = net.n_inputs
     task = tasks.find(config.task)

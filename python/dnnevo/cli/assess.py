@@ -46,7 +46,7 @@ EXIT_STATUS: dict[Verdict, int] = {"pass": 0, "fail": 1, "undecided": 3}
 def assess(args: argparse.Namespace) -> int:
     """``dnnevo assess``."""
     run = RunDir(args.dir)
-    config, table = run.read_config()
+    config, table = run.read_run_config()
     champion = run.read_best(config, table)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     task = tasks.get(config.task)

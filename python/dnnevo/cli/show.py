@@ -99,7 +99,7 @@ def show(args: argparse.Namespace) -> int:
     """``dnnevo show``: the run's size and time, its champion, the success rule, the last
     generation, and fitness.png."""
     run = RunDir(args.dir)
-    config, table = run.read_config()
+    config, table = run.read_run_config()
     history = run.read_log(config)
     champion = run.read_best(config, table)
     last = history[-1]

@@ -72,6 +72,8 @@ def sweep_command(args: argparse.Namespace) -> int:
                 "dt_check": args.dt_check, "seeding": how.info() if how else None,
                 "config": config.to_dict()}
     manifest = args.out / SETTINGS_FILE
+    if not (manifest.exists() or manifest.is_symlink()):
+        RunDir(args.out).refuse_unless_new(force=args.force)  # before the lock file is made
     with RunDir(args.out).writing(create=True) as folder:
         resuming = not args.force and (manifest.exists() or manifest.is_symlink())
         if resuming:

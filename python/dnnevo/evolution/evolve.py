@@ -155,6 +155,7 @@ def evolve(
     if out is None:
         return _loop(ga, task, [], None, progress=progress, callback=callback, threads=threads)
     run = RunDir(out)
+    run.refuse_unless_new(force=force)  # a refused folder is left as it was, lock file included
     table = {**_run_table(seed), **(run_info or {})}
     if callable(task) and (digest := _fitness_digest(task)) is not None:
         table["fitness_sha256"] = digest

@@ -44,7 +44,7 @@ from dnnevo.errors import ConfigError, DnnevoError, FormatError
 from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
 from dnnevo.runs.files import FILE_MODE, RunFileError, fail, load_json, read_text, short, write_atomic
 from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, log_cell, history_rows
-from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth
+from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth, first_difference
 
 __all__ = ["FIGURES", "LOCK_NAME", "RUN_FILES", "RunDir"]
 
@@ -96,8 +96,8 @@ class RunDir:
             raise DnnevoError(f"{self.path} exists and is not a folder")
         if create:
             self.path.mkdir(parents=True, exist_ok=True)
-        elif not self.path.is_dir():
-            raise RunFileError(f"{self.path} has no checkpoint.json; is it a dnnevo run folder?")
+        elif not self.path.exists():
+            raise RunFileError(f"{self.path} does not exist")
         flags = os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC
         try:
             fd = os.open(self.lock_file, flags, FILE_MODE)
@@ -138,6 +138,29 @@ class RunDir:
         """A file that holds no run: the lock file, or a temporary file of a killed write."""
         return p.name == LOCK_NAME or (_TEMP.match(p.name) is not None and p.is_file())
 
+    def refuse_unless_new(self, *, force: bool) -> None:
+        """Refuses, before anything is written (the lock file included), a folder that holds
+        more than a lock file and temporary files, unless ``force``; the message says what the
+        folder holds and what to do with it. :meth:`create` checks again under the lock."""
+        if force or not self.path.is_dir():
+            return
+        contents = [p for p in self.path.iterdir() if not self._leftover(p)]
+        if contents:
+            raise DnnevoError(self._occupied(contents))
+
+    def _occupied(self, contents: list[Path]) -> str:
+        names = sorted(p.name for p in contents)
+        if "checkpoint.json" in names or "config.toml" in names:
+            what = f"it holds a run: resume it with 'dnnevo resume {self.path}'"
+        elif "sweep.json" in names:
+            what = "it holds a sweep: continue it with the same 'dnnevo sweep' command"
+        elif "reproduce.json" in names:
+            what = "it holds a reproduction: continue it with the same 'dnnevo reproduce' command"
+        else:
+            shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+            what = f"it holds files that are not a dnnevo run ({shown})"
+        return f"{self.path} is not empty; {what}; or choose another --out, or pass --force to overwrite"
+
     def create(self, *, force: bool, extra: tuple[str, ...] = ()) -> None:
         """Readies the locked folder for a new run: one that holds more than a lock file and
         temporary files is refused unless ``force``, which removes the old run's files, figures
@@ -145,10 +168,7 @@ class RunDir:
         assert self._lock_fd is not None, "create() needs the lock"
         contents = [p for p in self.path.iterdir() if not self._leftover(p)]
         if contents and not force:
-            raise DnnevoError(
-                f"{self.path} is not empty; choose another --out, resume it with "
-                f"'dnnevo resume {self.path}', or pass --force to overwrite"
-            )
+            raise DnnevoError(self._occupied(contents))
         self.clear(extra)
 
     def clear(self, extra: tuple[str, ...] = ()) -> None:
@@ -216,6 +236,22 @@ class RunDir:
         except ConfigError as e:
             raise fail(path, str(e)) from None
         return config, run
+
+    def read_run_config(self) -> tuple[EvolutionConfig, dict[str, Any]]:
+        """``config.toml`` as a command that reads a run must take it: :meth:`read_config`,
+        refused when it disagrees with the checkpoint's config (it was edited after the run), as
+        ``resume`` refuses it. A folder without a checkpoint has only config.toml to go by."""
+        config, table = self.read_config()
+        if self.checkpoint.exists() or self.checkpoint.is_symlink():
+            cp = self.read_checkpoint()
+            saved = EvolutionConfig.from_dict(cp.state["config"])
+            diff = first_difference(config.to_dict(), saved.to_dict())
+            if diff is not None:
+                raise RunFileError(
+                    f"{self.config} was edited after the run: {diff[0]} is {short(diff[1])} in "
+                    f"config.toml and {short(diff[2])} in checkpoint.json, with which the run was "
+                    f"made; put it back (to run longer: 'dnnevo resume {self.path} --generations N')")
+        return config, table
 
     def read_checkpoint(self) -> Checkpoint:
         """The validated checkpoint: its structure, its history (the same rules as log.csv),

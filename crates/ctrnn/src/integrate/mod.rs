@@ -17,6 +17,7 @@
 use std::sync::atomic::AtomicBool;
 
 use crate::error::{Error, Result};
+use crate::limits;
 use crate::network::Network;
 
 pub(crate) mod kernel;
@@ -53,9 +54,14 @@ impl Network {
     ) -> Result<Vec<f64>> {
         integ.validate()?;
         let (n, m) = (self.size(), self.n_inputs());
-        check_inputs(inputs, steps * m, "steps x n_inputs")?;
+        limits::check_work(1, steps, integ.substeps)?;
+        check_inputs(
+            inputs,
+            limits::product(&[steps, m], "inputs")?,
+            "steps x n_inputs",
+        )?;
         let mut lanes = Lanes::<1>::new(&[self])?;
-        let mut states = vec![0.0; steps * n];
+        let mut states = limits::zeros(limits::product(&[steps, n], "states")?, "recorded states")?;
         lanes.run_rows(
             steps,
             integ,

@@ -151,13 +151,21 @@ fn bad_arguments_are_refused_and_leave_the_states_alone() {
 #[test]
 fn a_long_step_stops_when_cancelled_and_a_diverging_one_says_so() {
     let nets = random_networks(1, 2, 1, 1);
-    let mut batch = Batch::new(&nets, 1, integrator(false, 1 << 40)).unwrap();
+    let mut batch = Batch::new(&nets, 1, integrator(false, 1 << 30)).unwrap();
     let cancel = AtomicBool::new(true);
     let mut rates = vec![0.0; 2];
     let err = batch
         .step(&[0.0], None, &mut rates, Some(&cancel))
         .unwrap_err();
     assert!(matches!(err, Error::Interrupted));
+    // Past the work one call may take: refused before it starts.
+    let mut endless = Batch::new(&nets, 2, integrator(false, 1 << 40)).unwrap();
+    let mut rates = vec![0.0; 4];
+    let err = endless.step(&[0.0; 2], None, &mut rates, None).unwrap_err();
+    assert!(
+        err.to_string().contains("the limit is 68719476736"),
+        "{err}"
+    );
     // A diverging row beside one left out: the error names it, and the other keeps its state.
     let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
     let mut batch = Batch::new(&[fast], 2, integrator(false, 1000)).unwrap();

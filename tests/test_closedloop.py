@@ -4,6 +4,8 @@ every misuse a one-line error that names it."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -340,6 +342,8 @@ def test_a_run_started_as_a_script_resumes_from_a_module_that_imports_the_same_c
 
 
 SEEKER = '''
+import json
+
 import numpy as np
 
 
@@ -530,3 +534,21 @@ def test_the_digest_is_exact_and_ignores_what_changes_from_run_to_run() -> None:
     b.w = a.w.copy()
     assert digest(a) == digest(b)
     assert digest(Slotted()) == digest(Slotted())
+
+
+def test_a_sweep_over_a_task_class_judges_every_seed_by_its_rule(tmp_path) -> None:
+    (tmp_path / "seeker_sweep.py").write_text(SEEKER)
+    r = dnnevo_command(tmp_path, "sweep", "python:seeker_sweep.Seeker", "--seeds", "0-1", "--out",
+                       "sw", "--eval-trials", "20", *SETTINGS)
+    assert r.returncode == 0, r.stderr
+    summary = json.loads((tmp_path / "sw" / "summary.json").read_text())
+    assert summary["seeds"] == [0, 1] and summary["eval_unit"] == "episodes"
+    assert "final champions passing on fresh trials: " in r.stdout
+    # The run checked its champions by the class's rule as it went (log.csv's champion_success).
+    log = (tmp_path / "sw" / "seed-0" / "log.csv").read_text().splitlines()
+    column = log[0].split(",").index("champion_success")
+    assert {row.split(",")[column] for row in log[1:]} <= {"0", "1"}
+    ruleless = dnnevo_command(tmp_path, "sweep", "python:seeker_sweep.Ruleless", "--seeds", "0",
+                              "--out", "sw2", *SETTINGS)
+    assert ruleless.returncode == 2 and "has no success rule" in ruleless.stderr
+    assert not (tmp_path / "sw2").exists()

@@ -16,6 +16,7 @@ sys.path.insert(0, str(ROOT / "examples"))
 import incremental_plateau  # noqa: E402
 import nav1d_transfer  # noqa: E402
 import trigger_answers  # noqa: E402
+import cartpole_memory  # noqa: E402
 
 
 def test_incremental_plateau(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -66,3 +67,20 @@ def test_nav1d_transfer(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
                                                                         "trials_per_environment": 10}),
                           part.network, 6, 11)
     assert cells[1] == f"{100 * longer['rate']:.1f}%" + ("" if longer["success"] else " (fail)")
+
+
+def test_cartpole_memory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A row per seed, a solved count per kind, and the figure; the reactive networks are
+    reactive (their recurrent weights are zero to 1e-9)."""
+    from cli_helpers import assert_png
+
+    cartpole_memory.main(["--seeds", "1", "--population", "20", "--generations", "2",
+                          "--episodes", "5", "--out", str(tmp_path / "m.png")])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "| seed | CTRNN fresh mean return | reactive fresh mean return |"
+    assert lines[2].startswith("| 0 | ") and lines[-1].startswith("reactive: ")
+    assert_png(tmp_path / "m.png")
+    config = dnnevo.EvolutionConfig(size=5, n_inputs=2, ranges=cartpole_memory.REACTIVE)
+    net = dnnevo.GeneticAlgorithm(config, seed=0).ask().networks[0]
+    assert abs(net.weights).max() <= 1e-9
+

@@ -10,7 +10,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-from dnnevo.config import EvolutionConfig, apply_overrides
+from dnnevo.config import PYTHON_TASK, EvolutionConfig, apply_overrides
 from dnnevo.errors import ConfigError, did_you_mean
 
 __all__ = ["Preset", "get", "names", "PRESETS"]
@@ -209,8 +209,18 @@ def names() -> list[str]:
     return sorted(PRESETS)
 
 
+#: ``--quick`` for a task written in Python, which has no preset: a demo's population and
+#: generations.
+PYTHON_QUICK = {"population": 20, "generations": 5}
+
+
 def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -> EvolutionConfig:
-    """The config of preset ``name``, optionally its quick variant, with ``key=value`` overrides."""
+    """The config of preset ``name``, optionally its quick variant, with ``key=value`` overrides.
+    A task written in Python (``"python:module.Class"``) has no preset: its config is the
+    defaults with that task, and its settings come from the overrides alone."""
+    if name.startswith(PYTHON_TASK):
+        start = {"task": name, **(PYTHON_QUICK if quick else {})}
+        return apply_overrides(EvolutionConfig.from_dict(start), overrides or [])
     try:
         preset = PRESETS[name]
     except KeyError:

@@ -25,8 +25,7 @@ from dnnevo.cli import reproduce as _cli_reproduce
 from dnnevo.cli import show as _cli_show
 from dnnevo.cli import sweep as _cli_sweep
 from dnnevo import presets
-from dnnevo.closedloop import named
-from dnnevo.config import PYTHON_TASK, EvolutionConfig, apply_overrides
+from dnnevo.config import PYTHON_TASK
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
 from dnnevo.tasks import DEFAULT_TRIALS
@@ -51,9 +50,6 @@ EXAMPLES = """examples:
   dnnevo reproduce --quick --seeds 0-1 --out runs/repro   the whole paper in miniature, with a report
 """
 
-
-#: ``dnnevo run python:... --quick``: a demo's population and generations.
-PYTHON_QUICK = {"population": 20, "generations": 5}
 
 MAX_SEEDS = 10_000
 """The most seeds a sweep or reproduction takes."""
@@ -220,14 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    if named.is_python_task(args.preset):
-        # A task written in Python: its settings come from --set alone (docs/closed-loop.md).
-        quick = PYTHON_QUICK if args.quick else {}
-        config = apply_overrides(EvolutionConfig.from_dict({"task": args.preset, **quick}), args.set)
-        stem = args.preset.removeprefix(PYTHON_TASK)
-    else:
-        config = presets.get(args.preset, quick=args.quick, overrides=args.set)
-        stem = args.preset
+    config = presets.get(args.preset, quick=args.quick, overrides=args.set)
+    stem = args.preset.removeprefix(PYTHON_TASK)
     out = args.out or Path("runs") / f"{stem}{'-quick' if args.quick else ''}-seed{args.seed}"
     how = seeding.Seeding.from_args(args)
     seeds = how.networks(config.size, args.seed) if how else None

@@ -46,11 +46,9 @@ def champion_line(fitness: float | None, generation: int | None,
 def success_line(task: str, success: Sequence[float], *, closed_loop: bool = False) -> str:
     """Whether the champion met the task's success rule during the run, from log.csv's
     ``champion_success`` column (one value per generation: 1, 0 or nan). ``closed_loop``: the
-    run's task is a Python task class (:mod:`dnnevo.closedloop.named`)."""
-    if closed_loop:
-        return ("success rule: the task class's own, not checked during the run (dnnevo assess "
-                "judges the champion by it)")
-    if task.startswith(PYTHON_TASK):
+    run's task is a Python task class (:mod:`dnnevo.closedloop.named`), checked by its own rule
+    when it has one."""
+    if task.startswith(PYTHON_TASK) and not closed_loop:
         return "success rule: none (a Python fitness function has no success rule)"
     judged = [s for s in success if not math.isnan(s)]
     if not judged:

@@ -13,11 +13,13 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo import presets
+from dnnevo.closedloop import named
 from dnnevo.experiments import scheduler
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
 from dnnevo._checks import nonnegative
-from dnnevo.tasks import DEFAULT_TRIALS, UNITS
+from dnnevo.closedloop.fitness import success_rule
+from dnnevo.tasks import DEFAULT_TRIALS, registry
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.runs import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
@@ -60,11 +62,14 @@ The results are the same bits as in this process."""
 def sweep_command(args: argparse.Namespace) -> int:
     """``dnnevo sweep``."""
     config = presets.get(args.preset, quick=args.quick, overrides=args.set)
-    if config.task not in DEFAULT_TRIALS:
+    if named.is_python_task(config.task):
+        # A task class must have its success rule before any seed runs.
+        success_rule(named.closed_loop(config).env, config.task)
+    elif config.task not in DEFAULT_TRIALS:
         raise ConfigError(f"task {config.task!r} has no success rule, so a sweep cannot judge it")
     for seed in args.seeds:  # before any run, so a bad --eval-seed costs nothing
         nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
-    trials = args.eval_trials if args.eval_trials is not None else DEFAULT_TRIALS[config.task]
+    trials = args.eval_trials if args.eval_trials is not None else registry.get(config.task).DEFAULT_TRIALS
     if args.workers is not None or args.scheduler is not None:
         scheduler.check_options(workers=args.workers, scheduler=args.scheduler)
     how = seeding.Seeding.from_args(args)
@@ -153,9 +158,9 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
         summary = sweep.summarize(finished)
         info = {"preset": args.preset, "quick": args.quick, "overrides": list(args.set), "task": config.task,
                 "eval_seed": f"{args.eval_seed} + seed", "eval_trials": trials,
-                "eval_unit": UNITS[config.task], **(how.info() if how else {})}
+                "eval_unit": registry.get(config.task).UNIT, **(how.info() if how else {})}
         paths = summary.write(args.out, info)
-        print("\n".join(lines(summary, args.eval_seed, trials, UNITS[config.task])))
+        print("\n".join(lines(summary, args.eval_seed, trials, registry.get(config.task).UNIT)))
         print(f"wrote {', '.join(map(str, paths))}")
     if stopped:
         print(f"interrupted during seed {stopped[0]}, which the statistics leave out; they cover the "

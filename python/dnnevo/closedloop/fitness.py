@@ -26,11 +26,33 @@ from dnnevo import _core
 from dnnevo.closedloop.environment import Environment
 from dnnevo.closedloop.loop import rollout
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
+from dnnevo.errors import ConfigError, TaskError
 
 __all__ = ["ClosedLoop"]
 
 
 _INTEGRATOR = IntegratorConfig()
+
+#: Fresh episodes on which a run checks, at each change of champion, whether it meets the task
+#: class's success rule (``dnnevo assess`` judges on as many as asked, 200 by default).
+SUCCESS_EPISODES = 40
+
+
+def success_rule(env: Any, task: str) -> tuple[Any, float]:
+    """The environment's ``success`` method and ``success_rate``, checked; a
+    :class:`~dnnevo.ConfigError` says what is missing."""
+    kind = type(env).__name__
+    rule, threshold = getattr(env, "success", None), getattr(env, "success_rate", None)
+    if rule is None or threshold is None:
+        raise ConfigError(f"{task} has no success rule: give {kind} a success_rate (the fraction "
+                          "of episodes that must succeed) and a method success(returns, lengths) "
+                          "(docs/closed-loop.md#a-success-rule)")
+    if isinstance(threshold, bool) or not (isinstance(threshold, float | int) and 0 < threshold <= 1):
+        raise ConfigError(f"{kind}.success_rate is {threshold!r}; expected a number in (0, 1]")
+    return rule, float(threshold)
+
+
+
 
 
 class ClosedLoop:
@@ -83,6 +105,21 @@ class ClosedLoop:
             integrator=IntegratorConfig(method=s["method"], dt=s["dt"], substeps=s["substeps"]),
             task_params={"episodes": s["episodes"], "max_steps": s["max_steps"]},
         )
+
+    def succeeds(self, network: _core.Network, seed: int) -> float:
+        """1.0 when ``network`` meets the environment's success rule on
+        :data:`SUCCESS_EPISODES` fresh episodes drawn from ``seed``, 0.0 when not, NaN when the
+        environment has no rule."""
+        if getattr(self.env, "success", None) is None or getattr(self.env, "success_rate", None) is None:
+            return float("nan")
+        rule, threshold = success_rule(self.env, f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}")
+        settings = {**self.settings, "episodes": SUCCESS_EPISODES}
+        result = rollout([network], self.env, seed=seed, purpose="validate", **settings)
+        ok = np.asarray(rule(result.returns[0], result.lengths[0]))
+        if ok.dtype != np.bool_ or ok.shape != (SUCCESS_EPISODES,):
+            raise TaskError(f"{type(self.env).__name__}.success returned {ok.dtype} of shape "
+                            f"{ok.shape}; expected booleans of shape ({SUCCESS_EPISODES},)")
+        return float(ok.mean() >= threshold)
 
     def __call__(self, networks: Sequence[_core.Network], *, generation: int = 0,
                  seed: int = 0) -> npt.NDArray[np.float64]:

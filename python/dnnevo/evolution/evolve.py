@@ -453,7 +453,7 @@ def _loop(
                 validation = ga.best_validation or (float("nan"), float("nan"))
                 if _champion_key(ga) != seen:
                     seen = _champion_key(ga)
-                    success = _champion_success(ga, builtin=not callable(task))
+                    success = _champion_success(ga, task)
                     if run is not None:
                         _write_best(run, ga)
                 history.append({
@@ -512,11 +512,15 @@ def _champion_key(ga: GeneticAlgorithm) -> tuple[Any, ...] | None:
     return (ga.best_fitness, ga.best_generation, ga.best_validation)
 
 
-def _champion_success(ga: GeneticAlgorithm, *, builtin: bool) -> float:
-    """1.0 or 0.0 when the built-in task has a success criterion, else NaN."""
-    if not builtin:
-        return float("nan")
+def _champion_success(ga: GeneticAlgorithm, task: str | FitnessFn) -> float:
+    """1.0 or 0.0 when the task has a success rule (a built-in task, or a task class with one),
+    else NaN."""
     seed = (ga.seed ^ SUCCESS_SEED_SALT) & 0xFFFF_FFFF_FFFF_FFFF
+    if isinstance(task, ClosedLoop):
+        assert ga.best is not None, "a champion has just been found"
+        return task.succeeds(ga.best, seed)
+    if callable(task):
+        return float("nan")
     verdict = ga.best_succeeds(seed)
     return float("nan") if verdict is None else float(verdict)
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from dnnevo import _core
 from dnnevo.closedloop import named, rollout
+from dnnevo.closedloop.fitness import success_rule
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, TaskError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, rate
@@ -56,14 +57,7 @@ class UserTask:
         loop = named.closed_loop(config)
         env = loop.env
         kind = type(env).__name__
-        rule, threshold = getattr(env, "success", None), getattr(env, "success_rate", None)
-        if rule is None or threshold is None:
-            raise ConfigError(f"{config.task} has no success rule: give {kind} a success_rate (the "
-                              "fraction of episodes that must succeed) and a method success(returns, "
-                              "lengths) (docs/closed-loop.md#a-success-rule)")
-        if not (isinstance(threshold, float | int) and 0 < threshold <= 1):
-            raise ConfigError(f"{kind}.success_rate is {threshold!r}; expected a number in (0, 1]")
-        self.THRESHOLD = float(threshold)
+        rule, self.THRESHOLD = success_rule(env, config.task)
         settings = {**loop.settings, "episodes": trials}
         result = rollout([net], env, seed=seed, purpose="evaluate", **settings)
         try:

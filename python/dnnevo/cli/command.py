@@ -28,7 +28,7 @@ from dnnevo import presets
 from dnnevo.config import PYTHON_TASK
 from dnnevo.evolution import seeding
 from dnnevo.experiments import sweep
-from dnnevo.tasks import DEFAULT_TRIALS
+from dnnevo.tasks import DEFAULT_TRIALS, user
 from dnnevo.errors import DnnevoError
 from dnnevo.runs import RunDir
 
@@ -128,7 +128,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="run a preset, or a task written in Python",
                        epilog="examples:\n  dnnevo run sequence-1bit --quick --out runs/demo\n"
-                              "  dnnevo run python:light.Light --set n_inputs=1 --set size=3 "
+                              "  dnnevo run python:light.Light --set n_inputs=1 --set size=3 --set selection=rank "
                               "--set task_params.max_steps=300 --set task_params.episodes=4\n"
                               "    (the class Light of light.py in this folder: docs/closed-loop.md)",
                        formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -160,8 +160,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser("presets", help="list the presets")
 
     trials_help = (f"trials per target (sequence, default {DEFAULT_TRIALS['sequence']}), per landmark "
-                   f"(landmark, default {DEFAULT_TRIALS['landmark']}) or chains of trials (nav1d, "
-                   f"default {DEFAULT_TRIALS['nav1d']}); each default takes 2 s at most on one core")
+                   f"(landmark, default {DEFAULT_TRIALS['landmark']}), chains of trials (nav1d, "
+                   f"default {DEFAULT_TRIALS['nav1d']}; each default takes 2 s at most on one core) "
+                   f"or episodes (a Python task class, default {user.DEFAULT_TRIALS})")
     p = sub.add_parser("sweep", help="independent runs over seeds, with success statistics",
                        description="Independent runs of a preset over seeds; each final champion is "
                                    "judged on fresh conditions as 'dnnevo assess' judges it.",

@@ -55,7 +55,7 @@ fn sequence_validation_is_its_own_stream() {
         "the validation set is fixed for the run"
     );
     let nets = random_networks(task.layout(), 5);
-    let vs = check_batch_independent(&task, &nets);
+    check_batch_independent(&task, &nets);
     // The rate is the lowest target's: it never exceeds what assess finds on either target
     // over the same trials, so compare with a network stuck at 0, right on 0* and wrong on 1*.
     let mut theta = vec![0.0; 5];
@@ -66,7 +66,6 @@ fn sequence_validation_is_its_own_stream() {
         v.rate, 0.0,
         "right on every 0* trial, wrong on every 1* trial: {v:?}"
     );
-    assert!(vs.iter().all(|v| v.rate <= 1.0));
 }
 
 #[test]

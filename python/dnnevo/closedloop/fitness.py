@@ -24,7 +24,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo.closedloop.environment import Environment
-from dnnevo.closedloop.loop import rollout
+from dnnevo.closedloop.loop import Rollout, rollout
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
 from dnnevo.errors import ConfigError, TaskError
 
@@ -106,19 +106,32 @@ class ClosedLoop:
             task_params={"episodes": s["episodes"], "max_steps": s["max_steps"]},
         )
 
+    def judged(self, network: _core.Network, episodes: int, seed: int,
+               purpose: str) -> tuple[npt.NDArray[np.bool_], float, Rollout]:
+        """``network`` on ``episodes`` fresh episodes drawn from ``seed`` and ``purpose``, judged
+        by the environment's success rule: which episodes succeeded, the rate success needs,
+        and the rollout."""
+        name = f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}"
+        rule, threshold = success_rule(self.env, name)
+        run = {**self.settings, "episodes": episodes}
+        result = rollout([network], self.env, seed=seed, purpose=purpose, **run)
+        kind = type(self.env).__name__
+        try:
+            ok = np.asarray(rule(result.returns[0], result.lengths[0]))
+        except Exception as e:
+            raise TaskError(f"{kind}.success raised {type(e).__name__}: {e}") from e
+        if ok.dtype != np.bool_ or ok.shape != (episodes,):
+            raise TaskError(f"{kind}.success returned {ok.dtype} of shape {ok.shape}; expected "
+                            f"booleans of shape ({episodes},), one per episode")
+        return ok, threshold, result
+
     def succeeds(self, network: _core.Network, seed: int) -> float:
         """1.0 when ``network`` meets the environment's success rule on
         :data:`SUCCESS_EPISODES` fresh episodes drawn from ``seed``, 0.0 when not, NaN when the
         environment has no rule."""
         if getattr(self.env, "success", None) is None or getattr(self.env, "success_rate", None) is None:
             return float("nan")
-        rule, threshold = success_rule(self.env, f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}")
-        settings = {**self.settings, "episodes": SUCCESS_EPISODES}
-        result = rollout([network], self.env, seed=seed, purpose="validate", **settings)
-        ok = np.asarray(rule(result.returns[0], result.lengths[0]))
-        if ok.dtype != np.bool_ or ok.shape != (SUCCESS_EPISODES,):
-            raise TaskError(f"{type(self.env).__name__}.success returned {ok.dtype} of shape "
-                            f"{ok.shape}; expected booleans of shape ({SUCCESS_EPISODES},)")
+        ok, threshold, _ = self.judged(network, SUCCESS_EPISODES, seed, "validate")
         return float(ok.mean() >= threshold)
 
     def __call__(self, networks: Sequence[_core.Network], *, generation: int = 0,

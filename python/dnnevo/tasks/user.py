@@ -13,13 +13,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from dnnevo import _core
-from dnnevo.closedloop import named, rollout
-from dnnevo.closedloop.fitness import success_rule
+from dnnevo.closedloop import named
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError, TaskError
+from dnnevo.errors import ConfigError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, rate
 from dnnevo.runs import RunDir
 from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
@@ -54,20 +51,7 @@ class UserTask:
     def judge(self, config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *,
               robot_like: bool = False) -> Assessment:
         """``net`` on ``trials`` fresh episodes drawn from ``seed``, by the class's rule."""
-        loop = named.closed_loop(config)
-        env = loop.env
-        kind = type(env).__name__
-        rule, self.THRESHOLD = success_rule(env, config.task)
-        settings = {**loop.settings, "episodes": trials}
-        result = rollout([net], env, seed=seed, purpose="evaluate", **settings)
-        try:
-            ok = rule(result.returns[0], result.lengths[0])
-        except Exception as e:
-            raise TaskError(f"{kind}.success raised {type(e).__name__}: {e}") from e
-        ok = np.asarray(ok)
-        if ok.dtype != np.bool_ or ok.shape != (trials,):
-            raise TaskError(f"{kind}.success returned {ok.dtype} of shape {ok.shape}; expected "
-                            f"booleans of shape ({trials},), one per episode")
+        ok, self.THRESHOLD, result = named.closed_loop(config).judged(net, trials, seed, "evaluate")
         overall_rate = rate("episodes", int(ok.sum()), trials, threshold=self.THRESHOLD)
         return Assessment(
             task=config.task, trials=trials, unit=self.UNIT, seed=seed, rates=[overall_rate],

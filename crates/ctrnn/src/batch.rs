@@ -16,13 +16,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrate::{Integrator, LANES};
+use crate::integrate::{Integrator, CANCEL_CHECK_STEPS, LANES};
 use crate::limits::{check_work, MAX_BATCH_ROWS};
 use crate::network::Network;
 use crate::population::Block;
-
-/// Integration steps of one block between two looks at the cancel flag, as in the integrator.
-const CANCEL_CHECK_STEPS: usize = 1024;
 
 /// Block-steps (blocks x N x N x substeps) from which a step runs its blocks on all cores; below
 /// it, handing the blocks to the thread pool costs more than it saves.

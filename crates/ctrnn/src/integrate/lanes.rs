@@ -30,7 +30,7 @@ const _: () = assert!(
 
 /// Integration steps (rows times substeps) between two looks at the cancel flag, so that Ctrl-C
 /// is seen within milliseconds however many substeps a row has.
-const CANCEL_CHECK_STEPS: usize = 1024;
+pub(crate) const CANCEL_CHECK_STEPS: usize = 1024;
 
 /// Calls `self.method::<V>(args)` with `V` the lane vector type of `kernel` for `L` lanes:
 /// registers of the kernel for a block of [`LANES`], plain lanes for any other width (a single

@@ -24,6 +24,7 @@ pub(crate) mod kernel;
 mod lanes;
 mod settings;
 
+pub(crate) use lanes::CANCEL_CHECK_STEPS;
 pub use lanes::{copy_lane, Lanes, LANES};
 pub use settings::{Integrator, Method};
 

@@ -71,7 +71,7 @@ def _field(condition, name):
 def run_chain(params, tau, theta, weights, sensor_weights, conditions, state=None):
     """Runs one network through a chain of trials, written as plainly as possible.
 
-    ``params`` is the task's parameter dict (``config.task_json()``: ``integrator`` with ``dt``
+    ``params`` is the task's parameter dict (``nav1d.params(config)``: ``integrator`` with ``dt``
     and ``substeps``, and optionally the keys of :data:`DEFAULTS`). ``tau``, ``theta`` (N,),
     ``weights`` (N, N), ``sensor_weights`` (N, M) with M = 1 (landmark) or 2 (landmark,
     reinforcement). ``conditions`` are objects or dicts with ``goal``, ``start`` and

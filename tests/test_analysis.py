@@ -166,7 +166,7 @@ def without_outgoing(net: dnnevo.Network, k: int) -> dnnevo.Network:
 def test_lesioning_a_neuron_without_outgoing_weights_changes_no_score(preset: str, trials: int) -> None:
     config = presets.get(preset)
     seed = 11
-    size, n_inputs = _core.task_layout(config.to_json())
+    size, n_inputs = config.native.builtin().layout
     net = without_outgoing(dnnevo.Network.random(size, n_inputs, seed=7), size - 1)
     base = tasks.assess(config, net, trials, seed=seed)
     silent = tasks.assess(config, analysis.clamp(net, config.size - 1, 0.7), trials, seed=seed)

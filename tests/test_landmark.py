@@ -469,11 +469,11 @@ def reference_outputs(params, tau, theta, weights, sensor_weights, inputs):
 
 def check_reference(cfg, net, n, *, seed=0, trial=0, robot_like=False):
     rec = landmark.record(cfg, net, n, seed=seed, trial=trial, robot_like=robot_like)
-    want = reference_outputs(cfg.task_json(), net.tau, net.theta, net.weights, net.sensor_weights,
+    want = reference_outputs(landmark.params(cfg), net.tau, net.theta, net.weights, net.sensor_weights,
                              rec.input)
     assert rec.outputs.shape == want.shape
     np.testing.assert_allclose(rec.outputs, want, rtol=0, atol=1e-9)
-    classifier = cfg.task_json().get("classifier", 0)
+    classifier = landmark.params(cfg)["classifier"]
     assert rec.classification == pytest.approx(want[-1, classifier], abs=1e-9)
     return rec
 

@@ -53,7 +53,7 @@ def net_params(net):
 
 
 def reference(cfg, net, conditions, state=None):
-    return ref.run_chain(cfg.task_json(), *net_params(net), conditions, state=state)
+    return ref.run_chain(nav1d.params(cfg), *net_params(net), conditions, state=state)
 
 
 def hand_built(theta, n_inputs, size=5):

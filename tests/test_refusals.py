@@ -59,9 +59,9 @@ def test_a_missing_folder_is_called_missing(tmp_path: Path) -> None:
         dnnevo.resume(tmp_path / "nowhere")
 
 
-SEQUENCE = json.dumps(dnnevo.presets.get("sequence-1bit").task_json())
-NAV1D = json.dumps(dnnevo.presets.get("nav1d-far").task_json())
-LANDMARK = json.dumps(dnnevo.presets.get("landmark").task_json())
+SEQUENCE = dnnevo.presets.get("sequence-1bit").native.builtin()
+NAV1D = dnnevo.presets.get("nav1d-far").native.builtin()
+LANDMARK = dnnevo.presets.get("landmark").native.builtin()
 NET5 = dnnevo.Network.random(5, 2, seed=0)
 NET5_1 = dnnevo.Network.random(5, 1, seed=0)
 NET8 = dnnevo.Network.random(8, 7, seed=0)
@@ -69,15 +69,15 @@ NET8 = dnnevo.Network.random(8, 7, seed=0)
 #: Every integer argument of the native module's functions: (function, arguments, the one set
 #: to -1). A new integer argument belongs here.
 CALLS = [
-    (_core.sequence_timings, (SEQUENCE, 0, 0, 0), ["seed", "generation", "trial"]),
-    (_core.sequence_fresh_timings, (SEQUENCE, 0, 0), ["seed", "trial"]),
-    (_core.sequence_trial_order, (SEQUENCE, 0, 0), ["seed", "generation"]),
-    (_core.sequence_assess, (SEQUENCE, NET5, 1, 0), ["trials_per_target", "seed"]),
-    (_core.nav1d_chains, (NAV1D, 0, 0), ["seed", "generation"]),
-    (_core.nav1d_fresh_chains, (NAV1D, 1, 1, 0), ["count", "trials", "seed"]),
-    (_core.nav1d_assess, (NAV1D, NET5_1, 1, 0), ["chains", "seed"]),
-    (_core.landmark_record, (LANDMARK, NET8, 1, 0, 0, False), ["landmark", "seed", "trial"]),
-    (_core.landmark_assess, (LANDMARK, NET8, 1, 0, False), ["per_landmark", "seed"]),
+    (SEQUENCE.timings, (0, 0, 0), ["seed", "generation", "trial"]),
+    (SEQUENCE.fresh_timings, (0, 0), ["seed", "trial"]),
+    (SEQUENCE.trial_order, (0, 0), ["seed", "generation"]),
+    (SEQUENCE.assess, (NET5, 1, 0), ["trials_per_target", "seed"]),
+    (NAV1D.chains, (0, 0), ["seed", "generation"]),
+    (NAV1D.fresh_chains, (1, 1, 0), ["count", "trials", "seed"]),
+    (NAV1D.assess, (NET5_1, 1, 0), ["chains", "seed"]),
+    (LANDMARK.record, (NET8, 1, 0, 0, False), ["landmark", "seed", "trial"]),
+    (LANDMARK.assess, (NET8, 1, 0, False), ["per_landmark", "seed"]),
     (_core.decode, (2, 1, [1.0] * 12), ["size", "n_inputs"]),
     (_core.condition_seed, (0, 0), ["seed", "generation"]),
 ]
@@ -88,7 +88,7 @@ def _cases():
     for fn, args, names in CALLS:
         params = [p for p in inspect.signature(fn).parameters]
         for name in names:
-            yield pytest.param(fn, args, params.index(name), name, id=f"{fn.__name__}-{name}")
+            yield pytest.param(fn, args, params.index(name), name, id=f"{fn.__qualname__}-{name}")
 
 
 @pytest.mark.parametrize("fn, args, at, name", list(_cases()))
@@ -101,7 +101,7 @@ def test_a_negative_integer_argument_is_an_error_naming_it(fn, args, at: int, na
 
 def test_negative_timings_and_threads_are_named() -> None:
     with pytest.raises(InvalidArgumentError, match=r"timing\[1\]\[0\] is -3"):
-        _core.sequence_trial(SEQUENCE, NET5, "01", [(2, 2), (-3, 2)])
+        SEQUENCE.trial(NET5, "01", [(2, 2), (-3, 2)])
     evolution = dnnevo.GeneticAlgorithm(dnnevo.presets.get("sequence-1bit", quick=True), seed=0)
     with pytest.raises(InvalidArgumentError, match="threads is -1"):
         evolution.step(threads=-1)

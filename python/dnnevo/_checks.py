@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
-import json
+from typing import TypeVar
 
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
+
+T = TypeVar("T")
 
 
 def nonnegative(name: str, value: int) -> int:
@@ -27,8 +29,12 @@ def bounded_count(name: str, value: int) -> int:
     return value
 
 
-def task_params(config: EvolutionConfig, task: str) -> str:
-    """The JSON parameters of ``config``'s task, which must be ``task``."""
+def builtin(config: EvolutionConfig, task: str, kind: type[T]) -> T:
+    """``config``'s built-in task object (a ``_core`` class of type ``kind``), built once per
+    config; ``config.task`` must be ``task``."""
     if config.task != task:
         raise ConfigError(f"config.task is {config.task!r}; expected {task!r}")
-    return json.dumps(config.task_json())
+    built = config.native.builtin()
+    if not isinstance(built, kind):  # pragma: no cover - the core maps each name to its class
+        raise ConfigError(f"the {task} task was built as a {type(built).__name__}")
+    return built

@@ -20,6 +20,11 @@ __all__ = [
     "Batch",
     "Evolution",
     "Network",
+    "RunConfig",
+    "SequenceTask",
+    "SequenceTrial",
+    "Nav1dTask",
+    "LandmarkTask",
     "Trace",
     "__version__",
     "apply_simd_env",
@@ -28,31 +33,16 @@ __all__ = [
     "analysis_bifurcation",
     "analysis_cycles",
     "analysis_equilibria",
-    "check_config",
     "condition_seed",
     "compose",
     "decode",
     "encode",
     "evaluate",
     "run_population",
-    "landmark_assess",
-    "landmark_record",
-    "nav1d_assess",
-    "nav1d_chains",
-    "nav1d_exact",
-    "nav1d_chain_len",
-    "nav1d_fresh_chains",
-    "nav1d_record",
     "nav1d_system_assess",
     "nav1d_system_record",
-    "sequence_assess",
-    "sequence_fresh_timings",
-    "sequence_timings",
-    "sequence_trial",
-    "sequence_trial_order",
     "sim2d_cast_rays",
     "sim2d_landmark_world",
-    "task_layout",
     "task_names",
 ]
 
@@ -218,13 +208,26 @@ def condition_seed(seed: int, generation: int, purpose: Literal["trial", "valida
     """The first word of dnnevo's random stream (seed, generation, purpose): the seed of a
     Python task's conditions."""
 
+# -- a run's settings and the GA ------------------------------------------------------------
+
+@final
+class RunConfig:
+    """A run's settings, parsed and validated once by the core (``EvolutionConfig.native``)."""
+
+    def __new__(cls, config: str) -> RunConfig: ...
+    @property
+    def task(self) -> str: ...
+    def to_json(self) -> str: ...
+    def builtin(self) -> SequenceTask | Nav1dTask | LandmarkTask: ...
+    def __reduce__(self) -> tuple[Any, ...]: ...
+
 @final
 class Evolution:
     """The GA state behind ``dnnevo.GeneticAlgorithm``."""
 
     def __new__(
         cls,
-        config: str,
+        config: RunConfig,
         seed: int,
         seeds: Sequence[Network] | None = None,
     ) -> Evolution: ...
@@ -245,66 +248,121 @@ class Evolution:
     def champion_validation(self) -> tuple[float, float] | None: ...
     def to_json(self) -> str: ...
     @staticmethod
-    def from_json(text: str, config: str) -> Evolution: ...
+    def from_json(text: str, config: RunConfig) -> Evolution: ...
 
-def check_config(config: str) -> None: ...
 def evaluate(
-    config: str,
+    config: RunConfig,
     population: npt.ArrayLike | Sequence[Network],
     *,
     generation: int,
     seed: int,
     threads: int | None = None,
 ) -> _Array: ...
-def task_layout(config: str) -> tuple[int, int]: ...
 def task_names() -> list[str]: ...
 def decode(size: int, n_inputs: int, genes: npt.ArrayLike) -> Network: ...
 def encode(net: Network) -> _Array: ...
-def sequence_timings(
-    params: str, seed: int, generation: int, trial: int
-) -> list[tuple[int, int]]: ...
-def sequence_fresh_timings(params: str, seed: int, trial: int) -> list[tuple[int, int]]: ...
-def sequence_trial_order(params: str, seed: int, generation: int) -> list[int]: ...
-def sequence_trial(
-    params: str,
-    net: Network,
-    pattern: str,
-    timing: Sequence[tuple[int, int]],
-    reset: bool = True,
-) -> str: ...
-def sequence_assess(params: str, net: Network, trials_per_target: int, seed: int) -> str: ...
-def nav1d_chains(params: str, seed: int, generation: int) -> str: ...
-def nav1d_chain_len(params: str) -> int: ...
-def nav1d_fresh_chains(params: str, count: int, trials: int, seed: int) -> str: ...
-def nav1d_exact(params: str, environment: str, goal: str) -> str: ...
-def nav1d_record(params: str, net: Network, conditions: str, reset: bool = True) -> str: ...
-def nav1d_assess(params: str, net: Network, chains: int, seed: int) -> str: ...
+
+# -- the sequence-learning task ---------------------------------------------------------------
+
+@final
+class SequenceTask:
+    """The sequence-learning task of a ``RunConfig`` (``RunConfig.builtin()``)."""
+
+    def params(self) -> dict[str, Any]: ...
+    @property
+    def layout(self) -> tuple[int, int]: ...
+    def timings(self, seed: int, generation: int, trial: int) -> list[tuple[int, int]]: ...
+    def fresh_timings(self, seed: int, trial: int) -> list[tuple[int, int]]: ...
+    def trial_order(self, seed: int, generation: int) -> list[int]: ...
+    def trial(
+        self, net: Network, pattern: str, timing: Sequence[tuple[int, int]], reset: bool = True
+    ) -> SequenceTrial: ...
+    def assess(self, net: Network, trials_per_target: int, seed: int) -> dict[str, Any]: ...
+
+@final
+class SequenceTrial:
+    """One sequence trial, step by step (length T) and trigger by trigger."""
+
+    @property
+    def target(self) -> str: ...
+    @property
+    def trigger(self) -> _Array: ...
+    @property
+    def reinforcement(self) -> _Array: ...
+    @property
+    def output(self) -> _Array: ...
+    @property
+    def outputs(self) -> _Array: ...
+    @property
+    def targets(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def r(self) -> _Array: ...
+    @property
+    def mean_output(self) -> _Array: ...
+    @property
+    def trigger_correct(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def final_state(self) -> _Array: ...
+
+# -- the one-dimensional navigation task ------------------------------------------------------
+
+@final
+class Nav1dTask:
+    """The one-dimensional navigation task of a ``RunConfig`` (``RunConfig.builtin()``)."""
+
+    def params(self) -> dict[str, Any]: ...
+    @property
+    def layout(self) -> tuple[int, int]: ...
+    @property
+    def chain_len(self) -> int: ...
+    def chains(self, seed: int, generation: int) -> list[list[dict[str, Any]]]: ...
+    def fresh_chains(self, count: int, trials: int, seed: int) -> list[list[dict[str, Any]]]: ...
+    def exact(self, environment: str, goal: str) -> dict[str, Any]: ...
+    def record(
+        self, net: Network, conditions: Sequence[dict[str, Any]], reset: bool = True
+    ) -> dict[str, Any]: ...
+    def assess(self, net: Network, chains: int, seed: int) -> dict[str, Any]: ...
+
 def nav1d_system_assess(
-    classifier: tuple[str, Network],
-    far: tuple[str, Network],
-    near: tuple[str, Network],
+    classifier: tuple[Nav1dTask, Network],
+    far: tuple[Nav1dTask, Network],
+    near: tuple[Nav1dTask, Network],
     environments: int,
     trials: int,
     seed: int,
     persist_state: bool = True,
-) -> str: ...
+) -> dict[str, Any]: ...
 def nav1d_system_record(
-    classifier: tuple[str, Network],
-    far: tuple[str, Network],
-    near: tuple[str, Network],
-    conditions: str,
+    classifier: tuple[Nav1dTask, Network],
+    far: tuple[Nav1dTask, Network],
+    near: tuple[Nav1dTask, Network],
+    conditions: Sequence[dict[str, Any]],
     persist_state: bool = True,
-) -> str: ...
-def landmark_record(
-    params: str, net: Network, landmark: int, seed: int, trial: int, robot_like: bool = False
-) -> str: ...
-def landmark_assess(
-    params: str, net: Network, per_landmark: int, seed: int, robot_like: bool = False
-) -> str: ...
+) -> dict[str, Any]: ...
+
+# -- the landmark-recognition task and its 2-D world -------------------------------------------
+
+@final
+class LandmarkTask:
+    """The landmark-recognition task of a ``RunConfig`` (``RunConfig.builtin()``)."""
+
+    def params(self) -> dict[str, Any]: ...
+    @property
+    def layout(self) -> tuple[int, int]: ...
+    def record(
+        self, net: Network, landmark: int, seed: int, trial: int, robot_like: bool = False
+    ) -> dict[str, Any]: ...
+    def assess(
+        self, net: Network, per_landmark: int, seed: int, robot_like: bool = False
+    ) -> dict[str, Any]: ...
+
 def sim2d_cast_rays(
-    world: str, origins: npt.ArrayLike, directions: npt.ArrayLike, max_distance: float
+    world: Mapping[str, Any], origins: npt.ArrayLike, directions: npt.ArrayLike, max_distance: float
 ) -> npt.NDArray[np.float64]: ...
-def sim2d_landmark_world(n: int) -> str: ...
+def sim2d_landmark_world(n: int) -> dict[str, Any]: ...
+
+# -- dynamical analysis -----------------------------------------------------------------------
+
 def analysis_equilibria(
     net: Network,
     input: Sequence[float],
@@ -315,7 +373,7 @@ def analysis_equilibria(
     max_iterations: int = 100,
     seed: int = 0,
     retry_starts: int | None = None,
-) -> str: ...
+) -> list[dict[str, Any]]: ...
 def analysis_cycles(
     net: Network,
     input: Sequence[float],
@@ -328,7 +386,7 @@ def analysis_cycles(
     tolerance: float = 1e-05,
     orbit_points: int = 200,
     seed: int = 1,
-) -> str: ...
+) -> list[dict[str, Any]]: ...
 def analysis_bifurcation(
     net: Network,
     input: Sequence[float],
@@ -344,4 +402,4 @@ def analysis_bifurcation(
     seed: int = 0,
     cycle_starts: int = 0,
     retry_starts: int | None = None,
-) -> str: ...
+) -> dict[str, Any]: ...

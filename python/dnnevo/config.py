@@ -148,7 +148,14 @@ class EvolutionConfig:
         d = self.to_dict()
         _check_finite(d, "")
         _check_negative(d)
-        _core.check_config(json.dumps(d))
+        object.__setattr__(self, "_native", _core.RunConfig(json.dumps(d)))
+
+    @property
+    def native(self) -> _core.RunConfig:
+        """The settings as the Rust core parsed and validated them, once, when this config was
+        made; ``Evolution``, ``evaluate`` and the built-in task (``native.builtin()``) take it."""
+        native: _core.RunConfig = self.__dict__["_native"]
+        return native
 
     # -- conversions -------------------------------------------------------------------------
 
@@ -184,13 +191,6 @@ class EvolutionConfig:
         """The config as JSON text, the form the Rust core reads."""
         return json.dumps(self.to_dict())
 
-    def task_json(self) -> dict[str, Any]:
-        """The built-in task's parameters: size and integrator, then ``task_params``."""
-        return {
-            "size": self.size,
-            "integrator": dataclasses.asdict(self.integrator),
-            **self.task_params,
-        }
 
 
 _TYPES: dict[str, type] = {
@@ -233,7 +233,7 @@ def _check_negative(d: dict[str, Any]) -> None:
         probe = {**d, name: 0 if sub is None else {**d[name], sub: 0}}
         rule = "it must be at least 0"
         try:
-            _core.check_config(json.dumps(probe))
+            _core.RunConfig(json.dumps(probe))
         except ConfigError as e:
             said = str(e)
             if said.startswith(f"{key} is 0; "):

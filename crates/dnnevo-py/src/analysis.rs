@@ -1,13 +1,13 @@
 //! Dynamical analysis for `dnnevo.analysis`: equilibria, limit cycles and bifurcation sweeps of a
-//! network under a constant input. Results cross as JSON, decoded into dataclasses by the Python
-//! wrapper. Each call runs with the GIL released and stops on Ctrl-C.
+//! network under a constant input. Results cross as Python values, read into dataclasses by
+//! the Python wrapper. Each call runs with the GIL released and stops on Ctrl-C.
 
 use ctrnn::analysis::{self, CycleSearch, EquilibriumSearch, Sweep};
 use pyo3::prelude::*;
 
 use crate::arrays::{arg_err, AnyInt};
 use crate::detach::detached;
-use crate::json::to_json;
+use crate::json::to_py;
 use crate::network::PyNetwork;
 
 /// A count argument in `[min, MAX_COUNT]` as `usize`, or `InvalidArgumentError` naming it.
@@ -34,13 +34,13 @@ fn retry(value: Option<&AnyInt>) -> PyResult<usize> {
     }
 }
 
-/// Every equilibrium Newton's method reaches, with eigenvalues and stability, as JSON; searched
+/// Every equilibrium Newton's method reaches, with eigenvalues and stability, as a dict; searched
 /// again with `retry_starts` starts (None: the core's default) when the count is even.
 #[pyfunction]
 #[pyo3(signature = (net, input, *, starts=AnyInt::from(512), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, retry_starts=None)")]
 #[allow(clippy::too_many_arguments)]
-pub fn analysis_equilibria(
-    py: Python<'_>,
+pub fn analysis_equilibria<'py>(
+    py: Python<'py>,
     net: &PyNetwork,
     input: Vec<f64>,
     starts: AnyInt,
@@ -49,7 +49,7 @@ pub fn analysis_equilibria(
     max_iterations: AnyInt,
     seed: AnyInt,
     retry_starts: Option<AnyInt>,
-) -> PyResult<String> {
+) -> PyResult<Bound<'py, PyAny>> {
     let settings = EquilibriumSearch {
         starts: count("starts", &starts, 1)?,
         tolerance,
@@ -63,15 +63,15 @@ pub fn analysis_equilibria(
     let cost = starts as f64 * settings.max_iterations as f64 * n * n * n;
     let net = &net.inner;
     let found = detached(py, cost, |_| analysis::equilibria(net, &input, &settings))?;
-    Ok(to_json(&found))
+    to_py(py, &found)
 }
 
-/// The attracting limit cycles reached from the search's starts, as JSON.
+/// The attracting limit cycles reached from the search's starts, as a dict.
 #[pyfunction]
 #[pyo3(signature = (net, input, *, starts=AnyInt::from(8), steps_per_tau=AnyInt::from(20), transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=AnyInt::from(200), seed=AnyInt::from(1)), text_signature = "(net, input, *, starts=8, steps_per_tau=20, transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=200, seed=1)")]
 #[allow(clippy::too_many_arguments)]
-pub fn analysis_cycles(
-    py: Python<'_>,
+pub fn analysis_cycles<'py>(
+    py: Python<'py>,
     net: &PyNetwork,
     input: Vec<f64>,
     starts: AnyInt,
@@ -82,7 +82,7 @@ pub fn analysis_cycles(
     tolerance: f64,
     orbit_points: AnyInt,
     seed: AnyInt,
-) -> PyResult<String> {
+) -> PyResult<Bound<'py, PyAny>> {
     let settings = CycleSearch {
         starts: count("starts", &starts, 1)?,
         steps_per_tau: count("steps_per_tau", &steps_per_tau, 1)?,
@@ -97,17 +97,17 @@ pub fn analysis_cycles(
     let found = detached(py, f64::INFINITY, |cancel| {
         analysis::limit_cycles(net, &input, &settings, Some(cancel))
     })?;
-    Ok(to_json(&found))
+    to_py(py, &found)
 }
 
-/// A sweep of input `index` from `start` to `stop` with the others held at `input`, as JSON;
+/// A sweep of input `index` from `start` to `stop` with the others held at `input`, as a dict;
 /// with `cycle_starts > 0` it also searches for limit cycles at each value from that many starts
 /// and follows them as branches. `retry_starts` as for `analysis_equilibria`.
 #[pyfunction]
 #[pyo3(signature = (net, input, index, start, stop, *, steps=AnyInt::from(101), starts=AnyInt::from(128), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), cycle_starts=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0, retry_starts=None)")]
 #[allow(clippy::too_many_arguments)]
-pub fn analysis_bifurcation(
-    py: Python<'_>,
+pub fn analysis_bifurcation<'py>(
+    py: Python<'py>,
     net: &PyNetwork,
     input: Vec<f64>,
     index: AnyInt,
@@ -121,7 +121,7 @@ pub fn analysis_bifurcation(
     seed: AnyInt,
     cycle_starts: AnyInt,
     retry_starts: Option<AnyInt>,
-) -> PyResult<String> {
+) -> PyResult<Bound<'py, PyAny>> {
     let cycle_starts = count("cycle_starts", &cycle_starts, 0)?;
     let sweep = Sweep {
         input: count("index", &index, 0)?,
@@ -145,5 +145,5 @@ pub fn analysis_bifurcation(
     let found = detached(py, f64::INFINITY, |cancel| {
         analysis::bifurcation(net, &input, &sweep, Some(cancel))
     })?;
-    Ok(to_json(&found))
+    to_py(py, &found)
 }

@@ -18,6 +18,7 @@ use crate::detach::detached;
 use crate::errors::{ConfigError, FitnessError, IntoPy};
 use crate::network::PyNetwork;
 use crate::population::networks_from;
+use crate::run_config::PyRunConfig;
 
 /// The GA's state: population, generation and champion, with the run's settings. See
 /// `dnnevo.GeneticAlgorithm`.
@@ -29,11 +30,6 @@ pub struct PyEvolution {
     /// The built-in task, built at the first `step` or `champion_success` and kept: a run builds
     /// its task once, so that what the task computes once per run (its validation set) is kept.
     task: Option<Box<dyn Task>>,
-}
-
-/// Reads and validates a run's settings (`dnnevo.EvolutionConfig.to_dict()` as JSON).
-fn run_config(text: &str) -> PyResult<RunConfig> {
-    RunConfig::from_json(text).py_err()
 }
 
 /// The first field where `found` (the GA state's) differs from `expected` (the config's).
@@ -103,17 +99,17 @@ impl PyEvolution {
 
 #[pymethods]
 impl PyEvolution {
-    /// A new run. `config` is the run's settings as JSON (`EvolutionConfig.to_dict()`), checked
-    /// here; `seeds` are networks placed first in the initial population.
+    /// A new run with the settings `config` (`EvolutionConfig.native`); `seeds` are networks
+    /// placed first in the initial population.
     #[new]
     #[pyo3(signature = (config, seed, seeds=None))]
     fn new(
-        config: &str,
+        config: &PyRunConfig,
         seed: &Bound<'_, PyAny>,
         seeds: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
-        let run = run_config(config)?;
+        let run = config.run.clone();
         let seeds = match seeds.filter(|s| !s.is_none()) {
             Some(s) if s.len()? > 0 => networks_from(s)?,
             _ => Vec::new(),
@@ -245,9 +241,9 @@ impl PyEvolution {
     /// Restores a state written by `to_json`, with the run's settings (`config`, as for `new`),
     /// which must agree with the state's own GA settings and layout.
     #[staticmethod]
-    fn from_json(text: &str, config: &str) -> PyResult<Self> {
+    fn from_json(text: &str, config: &PyRunConfig) -> PyResult<Self> {
         let inner = Evolution::from_json(text).py_err()?;
-        let run = run_config(config)?;
+        let run = config.run.clone();
         let difference = first_difference(&inner.config, &run.ga())
             .or_else(|| first_difference(&inner.layout, &run.layout()));
         if let Some(d) = difference {
@@ -263,20 +259,13 @@ impl PyEvolution {
     }
 }
 
-/// Checks a run's settings (`EvolutionConfig.to_dict()` as JSON); the first problem is a
-/// `ConfigError` that names its field.
-#[pyfunction]
-pub fn check_config(config: &str) -> PyResult<()> {
-    run_config(config).map(|_| ())
-}
-
 /// Scores networks or genomes with a run's built-in task: a pure function of (config,
 /// genomes, generation, seed), bit-identical to the scores inside a run.
 #[pyfunction]
 #[pyo3(signature = (config, population, *, generation, seed, threads=None))]
 pub fn evaluate<'py>(
     py: Python<'py>,
-    config: &str,
+    config: &PyRunConfig,
     population: &Bound<'py, PyAny>,
     generation: &Bound<'py, PyAny>,
     seed: &Bound<'py, PyAny>,
@@ -288,7 +277,7 @@ pub fn evaluate<'py>(
         Some(t) => Some(uint(t, "threads", "[1, 2**64)")?),
         None => None,
     };
-    let task = run_config(config)?.build_task().py_err()?;
+    let task = config.run.build_task().py_err()?;
     let layout = task.layout();
     let nets = if population.cast::<PyDict>().is_err() && population.hasattr("shape")? {
         let g = dense(population, "genomes", arg_err)?;
@@ -318,13 +307,6 @@ pub fn evaluate<'py>(
     })?;
     let n = fitness.len();
     to_numpy(py, fitness, &[n])
-}
-
-/// (size, n_inputs) of the networks a run's built-in task drives.
-#[pyfunction]
-pub fn task_layout(config: &str) -> PyResult<(usize, usize)> {
-    let layout = run_config(config)?.build_task().py_err()?.layout();
-    Ok((layout.size, layout.n_inputs))
 }
 
 /// The names of the built-in tasks.

@@ -1,15 +1,12 @@
-//! Task parameters arrive, and detailed results leave, as JSON text.
+//! Detailed task results leave as Python values (dicts, lists, numbers), built in Rust from the
+//! records' serde form: no JSON text crosses the border.
 
 use pyo3::prelude::*;
 
-use crate::errors::ConfigError;
+use crate::pyjson::value_to_py;
 
-/// Parses a task's JSON parameters; bad JSON is a `ConfigError`.
-pub fn params(text: &str) -> PyResult<serde_json::Value> {
-    serde_json::from_str(text).map_err(|e| ConfigError::new_err(format!("task parameters: {e}")))
-}
-
-/// JSON text of a task record.
-pub fn to_json<T: serde::Serialize>(value: &T) -> String {
-    serde_json::to_string(value).expect("task records always serialise")
+/// A task record or report as the Python value `json.loads` of its JSON would be.
+pub fn to_py<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    let value = serde_json::to_value(value).expect("task records always serialise");
+    value_to_py(py, &value)
 }

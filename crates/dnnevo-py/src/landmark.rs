@@ -1,81 +1,107 @@
-//! The landmark-recognition task's detailed API for `dnnevo.landmark`: a recorded robot trial,
-//! the (robot-like) assessment, and the sonar world's ray casts. Results cross as JSON.
+//! `dnnevo._core.LandmarkTask`, the landmark-recognition task built once from a run's settings
+//! (`RunConfig.builtin()`): a recorded robot trial and the (robot-like) assessment; and the sonar
+//! world's ray casts. Results cross as Python values.
 
 use ctrnn::{Purpose, Stream};
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use tasks::landmark::LandmarkTask;
 
 use crate::arrays::AnyInt;
 use crate::detach::detached;
 use crate::errors::{ConfigError, IntoPy, InvalidArgumentError};
-use crate::json::{self, to_json};
+use crate::json::to_py;
 use crate::network::PyNetwork;
+use crate::pyjson::dict_to_map;
 
-fn task(params: &str) -> PyResult<LandmarkTask> {
-    LandmarkTask::from_params(&json::params(params)?).py_err()
+/// The landmark-recognition task of a run's settings. Made by `RunConfig.builtin()`.
+#[pyclass(module = "dnnevo._core", name = "LandmarkTask", frozen)]
+pub struct PyLandmarkTask {
+    inner: LandmarkTask,
 }
 
-/// One fresh trial (`Purpose::Evaluate` stream `trial` of `seed`) with `landmark`, recorded step
-/// by step, as JSON.
-#[pyfunction]
-#[pyo3(signature = (params, net, landmark, seed, trial, robot_like=false))]
-pub fn landmark_record(
-    py: Python<'_>,
-    params: &str,
-    net: &PyNetwork,
-    landmark: AnyInt,
-    seed: AnyInt,
-    trial: AnyInt,
-    robot_like: bool,
-) -> PyResult<String> {
-    let landmark: u8 = landmark.to("landmark", "[0, 256)")?;
-    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
-    let trial: u64 = trial.to("trial", "[0, 2**64)")?;
-    let task = task(params)?;
-    let net = &net.inner;
-    let record = py
-        .detach(|| {
-            let stream = Stream::new(seed, 0, Purpose::Evaluate, 0, trial);
-            task.record(net, task.sense(landmark, stream, robot_like)?)
+impl PyLandmarkTask {
+    pub(crate) fn from_params(params: &serde_json::Value) -> PyResult<Self> {
+        Ok(PyLandmarkTask {
+            inner: LandmarkTask::from_params(params).py_err()?,
         })
-        .py_err()?;
-    Ok(to_json(&record))
+    }
 }
 
-/// Assesses a network on fresh trials, as JSON. Releases the GIL; Ctrl-C interrupts.
-#[pyfunction]
-#[pyo3(signature = (params, net, per_landmark, seed, robot_like=false))]
-pub fn landmark_assess(
-    py: Python<'_>,
-    params: &str,
-    net: &PyNetwork,
-    per_landmark: AnyInt,
-    seed: AnyInt,
-    robot_like: bool,
-) -> PyResult<String> {
-    let per_landmark: usize = per_landmark.to("per_landmark", "[0, 2**64)")?;
-    let seed: u64 = seed.to("seed", "[0, 2**64)")?;
-    let task = task(params)?;
-    let net = &net.inner;
-    let report = detached(py, f64::INFINITY, |cancel| {
-        task.assess_cancellable(net, per_landmark, seed, robot_like, Some(cancel))
-    })?;
-    Ok(to_json(&report))
+#[pymethods]
+impl PyLandmarkTask {
+    /// The task's settings, every default filled in, as a dict.
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, self.inner.config())
+    }
+
+    /// (size, n_inputs) of the networks the task drives.
+    #[getter]
+    fn layout(&self) -> (usize, usize) {
+        use ctrnn::Task;
+        let layout = self.inner.layout();
+        (layout.size, layout.n_inputs)
+    }
+
+    /// One fresh trial (`Purpose::Evaluate` stream `trial` of `seed`) with `landmark`, recorded
+    /// step by step, as a dict.
+    #[pyo3(signature = (net, landmark, seed, trial, robot_like=false))]
+    fn record<'py>(
+        &self,
+        py: Python<'py>,
+        net: &PyNetwork,
+        landmark: AnyInt,
+        seed: AnyInt,
+        trial: AnyInt,
+        robot_like: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let landmark: u8 = landmark.to("landmark", "[0, 256)")?;
+        let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+        let trial: u64 = trial.to("trial", "[0, 2**64)")?;
+        let (task, net) = (&self.inner, &net.inner);
+        let record = py
+            .detach(|| {
+                let stream = Stream::new(seed, 0, Purpose::Evaluate, 0, trial);
+                task.record(net, task.sense(landmark, stream, robot_like)?)
+            })
+            .py_err()?;
+        to_py(py, &record)
+    }
+
+    /// Assesses a network on fresh trials, as a dict. Releases the GIL; Ctrl-C interrupts.
+    #[pyo3(signature = (net, per_landmark, seed, robot_like=false))]
+    fn assess<'py>(
+        &self,
+        py: Python<'py>,
+        net: &PyNetwork,
+        per_landmark: AnyInt,
+        seed: AnyInt,
+        robot_like: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let per_landmark: usize = per_landmark.to("per_landmark", "[0, 2**64)")?;
+        let seed: u64 = seed.to("seed", "[0, 2**64)")?;
+        let (task, net) = (&self.inner, &net.inner);
+        let report = detached(py, f64::INFINITY, |cancel| {
+            task.assess_cancellable(net, per_landmark, seed, robot_like, Some(cancel))
+        })?;
+        to_py(py, &report)
+    }
 }
 
 /// The distance along each ray (rows of `origins` and `directions`, K x 2) to the nearest wall
-/// or box of the world `world` (a JSON `WorldSpec`), or `max_distance` when nothing is nearer.
+/// or box of `world` (a `WorldSpec` as a dict), or `max_distance` when nothing is nearer.
 #[pyfunction]
 pub fn sim2d_cast_rays<'py>(
     py: Python<'py>,
-    world: &str,
+    world: &Bound<'py, PyDict>,
     origins: PyReadonlyArray2<'py, f64>,
     directions: PyReadonlyArray2<'py, f64>,
     max_distance: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let spec: sim2d::WorldSpec =
-        serde_json::from_str(world).map_err(|e| ConfigError::new_err(format!("world: {e}")))?;
+    let world = dict_to_map(world.as_any(), "world")?;
+    let spec: sim2d::WorldSpec = serde_json::from_value(serde_json::Value::Object(world))
+        .map_err(|e| ConfigError::new_err(format!("world: {e}")))?;
     let world = sim2d::World::new(&spec).map_err(|e| ConfigError::new_err(e.to_string()))?;
     let (o, d) = (origins.as_array(), directions.as_array());
     if o.ncols() != 2 || o.shape() != d.shape() {
@@ -105,10 +131,10 @@ pub fn sim2d_cast_rays<'py>(
     Ok(PyArray1::from_vec(py, out))
 }
 
-/// The default world of landmark `n` (1 or 2), as JSON.
+/// The default world of landmark `n` (1 or 2), as a dict.
 #[pyfunction]
-pub fn sim2d_landmark_world(n: u32) -> PyResult<String> {
+pub fn sim2d_landmark_world(py: Python<'_>, n: u32) -> PyResult<Bound<'_, PyAny>> {
     let spec =
         sim2d::WorldSpec::landmark(n).map_err(|e| InvalidArgumentError::new_err(e.to_string()))?;
-    Ok(to_json(&spec))
+    to_py(py, &spec)
 }

@@ -15,6 +15,7 @@ mod nav1d;
 mod network;
 mod population;
 mod pyjson;
+mod run_config;
 mod sequence;
 mod simd;
 mod streams;
@@ -36,27 +37,19 @@ mod _core {
     #[pymodule_export]
     use super::batch::PyBatch;
     #[pymodule_export]
-    use super::evolution::{
-        check_config, decode, encode, evaluate, task_layout, task_names, PyEvolution,
-    };
+    use super::evolution::{decode, encode, evaluate, task_names, PyEvolution};
     #[pymodule_export]
-    use super::landmark::{
-        landmark_assess, landmark_record, sim2d_cast_rays, sim2d_landmark_world,
-    };
+    use super::landmark::{sim2d_cast_rays, sim2d_landmark_world, PyLandmarkTask};
     #[pymodule_export]
-    use super::nav1d::{
-        nav1d_assess, nav1d_chain_len, nav1d_chains, nav1d_exact, nav1d_fresh_chains, nav1d_record,
-        nav1d_system_assess, nav1d_system_record,
-    };
+    use super::nav1d::{nav1d_system_assess, nav1d_system_record, PyNav1dTask};
     #[pymodule_export]
     use super::network::{compose, PyNetwork, PyTrace};
     #[pymodule_export]
     use super::population::run_population;
     #[pymodule_export]
-    use super::sequence::{
-        sequence_assess, sequence_fresh_timings, sequence_timings, sequence_trial,
-        sequence_trial_order,
-    };
+    use super::run_config::PyRunConfig;
+    #[pymodule_export]
+    use super::sequence::{PySequenceTask, PySequenceTrial};
     #[pymodule_export]
     use super::simd::{apply_simd_env, build_info, use_kernel};
     #[pymodule_export]

@@ -26,7 +26,6 @@ dataclasses. The analysis is of the continuous-time system; tasks integrate it w
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -281,10 +280,10 @@ def equilibria(
     one. None is guaranteed for large N: a generic network has an odd number of equilibria, so
     when the count is even the search is repeated with ``retry_starts`` starts (default
     :data:`RETRY_STARTS`; 0 never). A count that is still even means some were missed."""
-    text = _core.analysis_equilibria(net, _input(net, input), starts=starts, tolerance=tolerance,
+    found = _core.analysis_equilibria(net, _input(net, input), starts=starts, tolerance=tolerance,
                                      distinct=distinct, max_iterations=max_iterations, seed=seed,
                                      retry_starts=retry_starts)
-    return [Equilibrium.from_dict(d) for d in json.loads(text)]
+    return [Equilibrium.from_dict(d) for d in found]
 
 
 def limit_cycles(
@@ -299,10 +298,10 @@ def limit_cycles(
     more while watching the upward crossings of the level halfway between the extremes of the
     neuron that moves most. The orbit is closed when a crossing comes within ``tolerance`` of one
     of the 4 before it. Forward integration finds attracting cycles only."""
-    text = _core.analysis_cycles(net, _input(net, input), starts=starts, steps_per_tau=steps_per_tau,
+    found = _core.analysis_cycles(net, _input(net, input), starts=starts, steps_per_tau=steps_per_tau,
                                  transient=transient, window=window, tolerance=tolerance,
                                  orbit_points=orbit_points, seed=seed)
-    return [Cycle.from_dict(d) for d in json.loads(text)]
+    return [Cycle.from_dict(d) for d in found]
 
 
 def bifurcation(
@@ -319,8 +318,8 @@ def bifurcation(
     count of equilibria is even is searched again with ``retry_starts`` starts (as
     :func:`equilibria`); those values are in ``retried``, and those still even in ``even``."""
     base = _input(net, input)
-    d = json.loads(_core.analysis_bifurcation(net, base, index, start, stop, steps=steps, starts=starts,
-                                              seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts))
+    d = _core.analysis_bifurcation(net, base, index, start, stop, steps=steps, starts=starts,
+                                   seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts)
     events = [Event(e["kind"], float(e["value"]), np.array(e["state"], dtype=float),
                     complex(*(math.nan if x is None else x for x in e["eigenvalue"])),
                     np.array(e["outputs"], dtype=float))

@@ -88,7 +88,7 @@ def evaluate(
     genomes, generation, seed), bit-identical to the scores inside :func:`evolve`."""
     config = _task_config(task, config)
     return _core.evaluate(
-        config.to_json(),
+        config.native,
         genomes,
         generation=generation,
         seed=seed,
@@ -369,7 +369,7 @@ def _check_layout(config: EvolutionConfig) -> None:
     if config.task not in names:
         raise ConfigError(f"unknown task {config.task!r}{did_you_mean(config.task, names)}; "
                           f"built-in tasks: {', '.join(names)}")
-    size, n_inputs = _core.task_layout(config.to_json())
+    size, n_inputs = config.native.builtin().layout
     if (size, n_inputs) != (config.size, config.n_inputs):
         raise ConfigError(
             f"the {config.task} task drives networks with {n_inputs} inputs; "

@@ -59,7 +59,7 @@ class GeneticAlgorithm:
         self.config = config or EvolutionConfig()
         if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not 0 <= seed < 2**64:
             raise ConfigError(f"seed is {seed!r}; it must be an integer in [0, 2**64)")
-        self._evo = _core.Evolution(self.config.to_json(), int(seed), list(founders or []))
+        self._evo = _core.Evolution(self.config.native, int(seed), list(founders or []))
 
     @property
     def seed(self) -> int:
@@ -129,7 +129,7 @@ class GeneticAlgorithm:
         if not isinstance(state["evolution"], str):
             raise ConfigError("the GA state's 'evolution' must be JSON text from state_dict()")
         config = EvolutionConfig.from_dict(state["config"])
-        self._evo = _core.Evolution.from_json(state["evolution"], config.to_json())
+        self._evo = _core.Evolution.from_json(state["evolution"], config.native)
         self.config = config
 
     @classmethod

@@ -18,7 +18,6 @@ noise, specular misses and a jittered room: our stand-in for the paper's real-ro
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -27,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core, plot
-from dnnevo._checks import bounded_count, nonnegative, task_params
+from dnnevo._checks import bounded_count, builtin, nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, combine, rate
@@ -38,7 +37,7 @@ from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_col
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT", "OUTPUT_NEURON", "FRAME_STEPS", "NAME", "ROBOT_LIKE", "THRESHOLD", "UNIT", "Record",
+__all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT", "OUTPUT_NEURON", "FRAME_STEPS", "NAME", "ROBOT_LIKE", "THRESHOLD", "UNIT", "Record", "params",
            "assess", "cast_rays", "default_world", "draw", "evaluate_extra", "extra_lines", "judge",
            "overall", "preface", "rate_column", "record", "recorded_trials"]
 
@@ -88,8 +87,13 @@ class Record:
     classification: float
 
 
-def _params(config: EvolutionConfig) -> str:
-    return task_params(config, "landmark")
+def _task(config: EvolutionConfig) -> _core.LandmarkTask:
+    return builtin(config, NAME, _core.LandmarkTask)
+
+
+def params(config: EvolutionConfig) -> dict[str, Any]:
+    """The config's task settings with every default filled in, as the core reads them."""
+    return _task(config).params()
 
 
 def _landmark(n: int) -> int:
@@ -104,8 +108,8 @@ def record(
 ) -> Record:
     """Runs ``net`` through fresh trial ``trial`` of ``seed`` with ``landmark`` (1 or 2)."""
     _landmark(landmark)
-    d = json.loads(_core.landmark_record(_params(config), net, nonnegative("landmark", landmark),
-                                         nonnegative("seed", seed), nonnegative("trial", trial), robot_like))
+    d = _task(config).record(net, nonnegative("landmark", landmark), nonnegative("seed", seed),
+                             nonnegative("trial", trial), robot_like)
     s = d["sensing"]
     echoes = np.array([[np.nan, np.nan] if p is None else p for p in s["echoes"]], dtype=float)
     return Record(
@@ -126,14 +130,14 @@ def assess(
 ) -> dict[str, Any]:
     """Judges ``net`` on ``per_landmark`` fresh trials of each landmark: ``{"confusion"
     (rows: true landmark 1, 2; columns: answer 1, 2), "rate", "success", "trials"}``."""
-    return json.loads(_core.landmark_assess(_params(config), net, bounded_count("per_landmark", per_landmark),
-                                            nonnegative("seed", seed), robot_like))
+    return _task(config).assess(net, bounded_count("per_landmark", per_landmark), nonnegative("seed", seed),
+                                robot_like)
 
 
 def default_world(n: int) -> dict[str, Any]:
     """The shipped world of landmark ``n`` (1 or 2) as a dict (room, boxes, start region); pass
     a changed copy as ``task_params["landmark1"]`` or ``["landmark2"]``."""
-    result: dict[str, Any] = json.loads(_core.sim2d_landmark_world(_landmark(n)))
+    result: dict[str, Any] = _core.sim2d_landmark_world(_landmark(n))
     return result
 
 
@@ -147,7 +151,7 @@ def cast_rays(
     if o.ndim != 2 or o.shape[1:] != (2,) or o.shape != d.shape:
         raise InvalidArgumentError(
             f"origins has shape {o.shape} and directions {d.shape}; both must be (K, 2)")
-    return _core.sim2d_cast_rays(json.dumps(world), o, d, float(max_distance))
+    return _core.sim2d_cast_rays(dict(world), o, d, float(max_distance))
 
 
 def judge(config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *,
@@ -185,7 +189,7 @@ def draw(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = Fal
     landmark-1 and a landmark-2 trial), a top-down view of both trials and, with ``animate``, a
     GIF of the landmark-2 trial."""
     champion = run.read_best(config, run.read_config()[1])
-    classifier = int(config.task_json().get("classifier", 0))
+    classifier = int(params(config)["classifier"])
     records = [record(config, champion, n, seed=seed, trial=n) for n in (1, 2)]
     fig, axes = plot.subplots(1, 2, figsize=(12, 5.5), layout="constrained")
     for ax, rec in zip(axes, records, strict=True):

@@ -23,7 +23,6 @@ reached, or the environment classified right: ``f(v_C) >= 0.5`` means landmark-n
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
@@ -34,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core, plot
-from dnnevo._checks import bounded_count, nonnegative, task_params
+from dnnevo._checks import bounded_count, builtin, nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.evaluation import assessment
@@ -72,6 +71,7 @@ __all__ = [
     "judge",
     "load_part",
     "overall",
+    "params",
     "preface",
     "rate_column",
     "record",
@@ -156,43 +156,47 @@ class Part:
     network: _core.Network
 
 
-def _params(config: EvolutionConfig) -> str:
-    return task_params(config, "nav1d")
+def _task(config: EvolutionConfig) -> _core.Nav1dTask:
+    return builtin(config, NAME, _core.Nav1dTask)
+
+
+def params(config: EvolutionConfig) -> dict[str, Any]:
+    """The config's task settings with every default filled in, as the core reads them."""
+    return _task(config).params()
 
 
 def _conditions(items: list[dict[str, Any]]) -> list[Condition]:
     return [Condition(**c) for c in items]
 
 
-def _to_json(conditions: Sequence[Condition]) -> str:
-    return json.dumps([asdict(c) for c in conditions])
+def _dicts(conditions: Sequence[Condition]) -> list[dict[str, Any]]:
+    return [asdict(c) for c in conditions]
 
 
 def cases(config: EvolutionConfig) -> list[Condition]:
     """The four exact environment and goal cases of Fig. 2 (A: far/left, B: far/right, C:
     near/left, D: near/right), with the config's geometry."""
-    params = _params(config)
-    return [Condition(**json.loads(_core.nav1d_exact(params, e, g))) for e, g in CASES]
+    task = _task(config)
+    return [Condition(**task.exact(e, g)) for e, g in CASES]
 
 
 def chain_len(config: EvolutionConfig) -> int:
     """Trials per chain of the config's success check: ``trials_per_environment`` for a
     ``single`` (or chained ``goal``) task, whose state carries from trial to trial, else 1."""
-    return _core.nav1d_chain_len(_params(config))
+    return _task(config).chain_len
 
 
 def chains(config: EvolutionConfig, seed: int, generation: int) -> list[list[Condition]]:
     """The chains of trials every individual of ``generation`` ran."""
-    return [_conditions(c) for c in json.loads(
-        _core.nav1d_chains(_params(config), nonnegative("seed", seed), nonnegative("generation", generation)))]
+    return [_conditions(c) for c in _task(config).chains(nonnegative("seed", seed),
+                                                         nonnegative("generation", generation))]
 
 
 def fresh_chains(config: EvolutionConfig, count: int, trials: int, seed: int) -> list[list[Condition]]:
     """``count`` fresh chains of ``trials`` trials, each in a random environment of the config's
     ``environments``, each trial with a random goal side."""
-    return [_conditions(c) for c in json.loads(
-        _core.nav1d_fresh_chains(_params(config), bounded_count("count", count), bounded_count("trials", trials),
-                                 nonnegative("seed", seed)))]
+    return [_conditions(c) for c in _task(config).fresh_chains(
+        bounded_count("count", count), bounded_count("trials", trials), nonnegative("seed", seed))]
 
 
 def _record(d: dict[str, Any]) -> Record:
@@ -215,12 +219,12 @@ def record(
 ) -> Record:
     """Runs ``net`` through a chain of trials (its state persisting between them), recorded;
     with ``reset=False`` it starts from ``net.state``."""
-    return _record(json.loads(_core.nav1d_record(_params(config), net, _to_json(conditions), reset)))
+    return _record(_task(config).record(net, _dicts(conditions), reset))
 
 
 def assess(config: EvolutionConfig, net: _core.Network, count: int, seed: int) -> dict[str, Any]:
     """Judges ``net`` on ``count`` fresh chains: ``{"rate", "success", "episodes", ...}``."""
-    return json.loads(_core.nav1d_assess(_params(config), net, bounded_count("count", count), nonnegative("seed", seed)))
+    return _task(config).assess(net, bounded_count("count", count), nonnegative("seed", seed))
 
 
 def goal_rates(episodes: Sequence[dict[str, Any]]) -> dict[str, npt.NDArray[np.float64]]:
@@ -254,14 +258,14 @@ def load_part(run_dir: str | Path, role: str | None = None) -> Part:
     run = RunDir(Path(run_dir))
     config, table = run.read_config()
     try:
-        _params(config)
+        _task(config)
     except ConfigError as e:
         raise ConfigError(f"{where}: {e}") from None
     return Part(config, run.read_best(config, table))
 
 
-def _parts(classifier: Part, far: Part, near: Part) -> list[tuple[str, _core.Network]]:
-    return [(_params(p.config), p.network) for p in (classifier, far, near)]
+def _parts(classifier: Part, far: Part, near: Part) -> list[tuple[_core.Nav1dTask, _core.Network]]:
+    return [(_task(p.config), p.network) for p in (classifier, far, near)]
 
 
 def system_assess(
@@ -273,9 +277,9 @@ def system_assess(
     trial (reset each trial with ``persist_state=False``). Returns ``{"goal_rate",
     "classification_rate", "episodes"}``; see :func:`goal_rates` for the breakdown."""
     c, f, n = _parts(classifier, far, near)
-    return json.loads(_core.nav1d_system_assess(
+    return _core.nav1d_system_assess(
         c, f, n, bounded_count("environments", environments), bounded_count("trials", trials),
-        nonnegative("seed", seed), persist_state))
+        nonnegative("seed", seed), persist_state)
 
 
 def system_record(
@@ -285,7 +289,7 @@ def system_record(
     """One environment of the integrated system, recorded: the classifier's trial, the picked
     network's trials, and which it picked (``"far"`` or ``"near"``)."""
     c, f, n = _parts(classifier, far, near)
-    d = json.loads(_core.nav1d_system_record(c, f, n, _to_json(conditions), persist_state))
+    d = _core.nav1d_system_record(c, f, n, _dicts(conditions), persist_state)
     return _record(d["first"]), _record(d["rest"]), d["chosen"]
 
 
@@ -342,7 +346,7 @@ def judge(config: EvolutionConfig, net: _core.Network, trials: int, seed: int, *
         task="nav1d", trials=trials, unit=UNIT, seed=seed, rates=[*rates, overall_rate],
         verdict=combine([r.verdict for r in [overall_rate] if r.verdict is not None]), method=method,
         details={"objective": objective, "scored_per_chain": per_chain,
-                 "classify_weight": float(config.task_json().get("classify_weight", 0.0))}, report=report,
+                 "classify_weight": float(params(config)["classify_weight"])}, report=report,
     )
 
 
@@ -396,14 +400,14 @@ def draw(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = Fal
     a classifier, Fig. 3 (its traces in a landmark-near and a landmark-far trial)."""
 
     champion = run.read_best(config, run.read_config()[1])
-    params = config.task_json()
-    k = params.get("trials_per_environment", 5) if params.get("objective") == "single" else 1
+    settings = params(config)
+    k = settings["trials_per_environment"] if settings["objective"] == "single" else 1
     records = [record(config, champion, [c] * k) for c in cases(config)]
-    _fig2(records, params, f"{run.path.name}: the champion in environments A-D", run.path / "fig2-paths.png")
+    _fig2(records, settings, f"{run.path.name}: the champion in environments A-D", run.path / "fig2-paths.png")
     written = ["fig2-paths.png"]
-    if params.get("objective") in ("classify", "single"):
-        classifier = int(params.get("classifier", 2))
-        motors = (int(params.get("left_motor", 0)), int(params.get("right_motor", 1)))
+    if settings["objective"] in ("classify", "single"):
+        classifier = int(settings["classifier"])
+        motors = (int(settings["left_motor"]), int(settings["right_motor"]))
         fig, axes = plot.subplots(1, 2, figsize=(12, 4.5), layout="constrained")
         for ax, (env, goal) in zip(axes, [("near", "left"), ("far", "right")], strict=True):
             cond = next(c for c in cases(config) if (c.environment, c.goal) == (env, goal))
@@ -417,13 +421,13 @@ def draw(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = Fal
     return written
 
 
-def _fig2(records: Sequence[Record], params: dict[str, Any], title: str, path: Path) -> None:
+def _fig2(records: Sequence[Record], settings: dict[str, Any], title: str, path: Path) -> None:
 
     fig, axes = plot.subplots(2, 2, figsize=(11, 6.5), layout="constrained", sharey=True)
     for ax, rec, letter in zip(axes.T.flat, records, "ABCD", strict=True):
         c = rec.conditions[0]
-        plot_path(rec, ax, half_length=float(params.get("half_length", 20.0)),
-                        landmark_width=float(params.get("landmark_width", 4.0)),
+        plot_path(rec, ax, half_length=float(settings["half_length"]),
+                        landmark_width=float(settings["landmark_width"]),
                         title=f"{letter}: landmark-{c.environment}, goal {c.goal}")
     fig.suptitle(title)
     save_figure(fig, path)
@@ -438,7 +442,7 @@ def draw_system(parts: Sequence[Part], trials: int, path: Path, *, persist_state
         first, rest, _ = system_record(parts[0], parts[1], parts[2], [c] * trials,
                                              persist_state=persist_state)
         records.append(_join(first, rest))
-    _fig2(records, parts[0].config.task_json(), "integrated system, one environment per case "
+    _fig2(records, params(parts[0].config), "integrated system, one environment per case "
           f"({trials} trials, goal on the same side)", path)
 
 

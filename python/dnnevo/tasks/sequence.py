@@ -9,7 +9,6 @@ succeeds on B when it learns every target in B.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -18,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core, plot
-from dnnevo._checks import bounded_count, nonnegative, task_params
+from dnnevo._checks import bounded_count, builtin, nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, combine, rate
 from dnnevo.runs import RunDir, save_figure
@@ -62,44 +61,30 @@ OUTPUT_NEURON = 0
 """The neuron whose firing rate is the task's answer (``task_params.classifier`` overrides it)."""
 
 
-@dataclass(frozen=True)
-class TrialRecord:
-    """One trial, time step by time step (arrays of length T, ``outputs`` is (T, N))."""
-
-    target: str
-    trigger: npt.NDArray[np.float64]
-    reinforcement: npt.NDArray[np.float64]
-    output: npt.NDArray[np.float64]
-    outputs: npt.NDArray[np.float64]
-    targets: npt.NDArray[np.int64]
-    """The expected bit of each trigger."""
-    r: npt.NDArray[np.float64]
-    """The reinforcement earned by each trigger."""
-    mean_output: npt.NDArray[np.float64]
-    trigger_correct: npt.NDArray[np.bool_]
-    final_state: npt.NDArray[np.float64]
+TrialRecord = _core.SequenceTrial
+"""One trial, time step by time step, as the core records it (arrays of length T, ``outputs``
+is (T, N); ``targets``, ``r``, ``mean_output``, ``trigger_correct`` per trigger;
+``final_state``)."""
 
 
-def _params(config: EvolutionConfig) -> str:
-    return task_params(config, "sequence")
+def _task(config: EvolutionConfig) -> _core.SequenceTask:
+    return builtin(config, NAME, _core.SequenceTask)
 
 
 def timings(config: EvolutionConfig, seed: int, generation: int, trial: int) -> list[tuple[int, int]]:
     """The (delay, gap) of each trigger of ``trial`` in ``generation``, as evolution drew them."""
-    return _core.sequence_timings(_params(config), seed, generation, trial)
+    return _task(config).timings(seed, generation, trial)
 
 
 def target_list(config: EvolutionConfig) -> list[str]:
     """The config's targets, such as ``["0", "1"]`` (the task's default when not set)."""
-    task_params(config, "sequence")
-    return list(config.task_params.get("targets", ["0", "1"]))
+    return list(_task(config).params()["targets"])
 
 
 def fresh_timings(config: EvolutionConfig, seed: int, trial: int) -> list[tuple[int, int]]:
     """The (delay, gap) of each trigger of fresh trial ``trial``, as :func:`assess` draws them
     for ``seed`` (never those of evolution)."""
-    return _core.sequence_fresh_timings(_params(config), nonnegative("seed", seed),
-                                        nonnegative("trial", trial))
+    return _task(config).fresh_timings(nonnegative("seed", seed), nonnegative("trial", trial))
 
 
 def trial_order(config: EvolutionConfig, seed: int, generation: int) -> list[int]:
@@ -107,7 +92,7 @@ def trial_order(config: EvolutionConfig, seed: int, generation: int) -> list[int
     is of target ``t // trials_per_target``). In order, unless ``task_params.chain`` is true:
     then the trials run as one chain without a reset between them, in an order drawn per
     generation."""
-    return _core.sequence_trial_order(_params(config), seed, generation)
+    return _task(config).trial_order(seed, generation)
 
 
 def run_trial(
@@ -120,29 +105,15 @@ def run_trial(
 ) -> TrialRecord:
     """Runs one trial of ``pattern`` (e.g. ``"01"``); with ``reset=False`` it continues from
     ``net.state``."""
-    d: dict[str, Any] = json.loads(
-        _core.sequence_trial(_params(config), net, pattern, list(timing), reset)
-    )
-    return TrialRecord(
-        target=d["target"],
-        trigger=np.array(d["trigger"]),
-        reinforcement=np.array(d["reinforcement"]),
-        output=np.array(d["output"]),
-        outputs=np.array(d["outputs"]),
-        targets=np.array(d["targets"], dtype=np.int64),
-        r=np.array(d["r"]),
-        mean_output=np.array(d["mean_output"]),
-        trigger_correct=np.array(d["trigger_correct"], dtype=bool),
-        final_state=np.array(d["final_state"]),
-    )
+    return _task(config).trial(net, pattern, list(timing), reset)
 
 
 def assess(
     config: EvolutionConfig, net: _core.Network, trials_per_target: int, seed: int
 ) -> dict[str, Any]:
     """Mean performance and success fraction per target on fresh timings, and the verdict."""
-    return json.loads(_core.sequence_assess(_params(config), net, bounded_count("trials_per_target", trials_per_target),
-                                            nonnegative("seed", seed)))
+    return _task(config).assess(net, bounded_count("trials_per_target", trials_per_target),
+                                nonnegative("seed", seed))
 
 
 SWITCH_AFTER = 8

@@ -3,10 +3,11 @@
 //! world's ray casts. Results cross as Python values.
 
 use ctrnn::{Purpose, Stream};
+use numpy::PyArrayDyn;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use tasks::landmark::LandmarkTask;
+use tasks::landmark::{LandmarkTask, Record};
 
 use crate::arrays::AnyInt;
 use crate::detach::detached;
@@ -14,6 +15,7 @@ use crate::errors::{ConfigError, IntoPy, InvalidArgumentError};
 use crate::json::to_py;
 use crate::network::PyNetwork;
 use crate::pyjson::dict_to_map;
+use crate::records::{matrix, vector};
 
 /// The landmark-recognition task of a run's settings. Made by `RunConfig.builtin()`.
 #[pyclass(module = "dnnevo._core", name = "LandmarkTask", frozen)]
@@ -45,17 +47,17 @@ impl PyLandmarkTask {
     }
 
     /// One fresh trial (`Purpose::Evaluate` stream `trial` of `seed`) with `landmark`, recorded
-    /// step by step, as a dict.
+    /// step by step.
     #[pyo3(signature = (net, landmark, seed, trial, robot_like=false))]
-    fn record<'py>(
+    fn record(
         &self,
-        py: Python<'py>,
+        py: Python<'_>,
         net: &PyNetwork,
         landmark: AnyInt,
         seed: AnyInt,
         trial: AnyInt,
         robot_like: bool,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    ) -> PyResult<PyLandmarkRecord> {
         let landmark: u8 = landmark.to("landmark", "[0, 256)")?;
         let seed: u64 = seed.to("seed", "[0, 2**64)")?;
         let trial: u64 = trial.to("trial", "[0, 2**64)")?;
@@ -66,7 +68,7 @@ impl PyLandmarkTask {
                 task.record(net, task.sense(landmark, stream, robot_like)?)
             })
             .py_err()?;
-        to_py(py, &record)
+        PyLandmarkRecord::new(py, record)
     }
 
     /// Assesses a network on fresh trials, as a dict. Releases the GIL; Ctrl-C interrupts.
@@ -86,6 +88,69 @@ impl PyLandmarkTask {
             task.assess_cancellable(net, per_landmark, seed, robot_like, Some(cancel))
         })?;
         to_py(py, &report)
+    }
+}
+
+/// One landmark trial, step by step: arrays of length T (`poses` is (T, 3) as x, y, heading;
+/// `echoes` (T, 2), NaN where nothing echoed; `outputs` (T, N)), the trial's `world` and the
+/// classifier's final output.
+#[pyclass(module = "dnnevo._core", name = "LandmarkRecord", frozen)]
+pub struct PyLandmarkRecord {
+    /// The landmark, 1 or 2.
+    #[pyo3(get)]
+    landmark: u8,
+    /// The trial's world (jittered under robot-like conditions), as a dict.
+    #[pyo3(get)]
+    world: Py<PyAny>,
+    /// The network's input at each step, `min(1, d0 / range)`.
+    #[pyo3(get)]
+    input: Py<PyArrayDyn<f64>>,
+    /// The sonar's range at each step, in metres.
+    #[pyo3(get)]
+    range: Py<PyArrayDyn<f64>>,
+    /// The robot's pose (x, y, heading) at each step, before it moves.
+    #[pyo3(get)]
+    poses: Py<PyArrayDyn<f64>>,
+    /// Where the echo came from at each step (NaN: nothing within range).
+    #[pyo3(get)]
+    echoes: Py<PyArrayDyn<f64>>,
+    /// Every neuron's firing rate after each step, (T, N).
+    #[pyo3(get)]
+    outputs: Py<PyArrayDyn<f64>>,
+    /// The classifier's output at the end: below 0.5 means landmark 1.
+    #[pyo3(get)]
+    classification: f64,
+}
+
+impl PyLandmarkRecord {
+    fn new(py: Python<'_>, record: Record) -> PyResult<Self> {
+        let s = record.sensing;
+        let size = record.outputs.first().map_or(0, Vec::len);
+        let echoes: Vec<[f64; 2]> = s
+            .echoes
+            .iter()
+            .map(|e| e.unwrap_or([f64::NAN, f64::NAN]))
+            .collect();
+        Ok(PyLandmarkRecord {
+            landmark: s.landmark,
+            world: to_py(py, &s.world)?.unbind(),
+            input: vector(py, s.input)?,
+            range: vector(py, s.range)?,
+            poses: matrix(py, s.poses, 3)?,
+            echoes: matrix(py, echoes, 2)?,
+            outputs: matrix(py, record.outputs, size)?,
+            classification: record.classification,
+        })
+    }
+}
+
+#[pymethods]
+impl PyLandmarkRecord {
+    fn __repr__(&self) -> String {
+        format!(
+            "LandmarkRecord(landmark={}, classification={})",
+            self.landmark, self.classification
+        )
     }
 }
 

@@ -15,6 +15,7 @@ mod nav1d;
 mod network;
 mod population;
 mod pyjson;
+mod records;
 mod run_config;
 mod sequence;
 mod simd;
@@ -39,9 +40,13 @@ mod _core {
     #[pymodule_export]
     use super::evolution::{decode, encode, evaluate, task_names, PyEvolution};
     #[pymodule_export]
-    use super::landmark::{sim2d_cast_rays, sim2d_landmark_world, PyLandmarkTask};
+    use super::landmark::{
+        sim2d_cast_rays, sim2d_landmark_world, PyLandmarkRecord, PyLandmarkTask,
+    };
     #[pymodule_export]
-    use super::nav1d::{nav1d_system_assess, nav1d_system_record, PyNav1dTask};
+    use super::nav1d::{
+        nav1d_system_assess, nav1d_system_record, PyNav1dCondition, PyNav1dRecord, PyNav1dTask,
+    };
     #[pymodule_export]
     use super::network::{compose, PyNetwork, PyTrace};
     #[pymodule_export]
@@ -49,7 +54,7 @@ mod _core {
     #[pymodule_export]
     use super::run_config::PyRunConfig;
     #[pymodule_export]
-    use super::sequence::{PySequenceTask, PySequenceTrial};
+    use super::sequence::{PySequenceRecord, PySequenceTask};
     #[pymodule_export]
     use super::simd::{apply_simd_env, build_info, use_kernel};
     #[pymodule_export]

@@ -1,16 +1,17 @@
 //! `dnnevo._core.SequenceTask`, the sequence-learning task built once from a run's settings
-//! (`RunConfig.builtin()`): trial timings, one recorded trial (`SequenceTrial`), and the success
+//! (`RunConfig.builtin()`): trial timings, one recorded trial (`SequenceRecord`), and the success
 //! assessment.
 
 use numpy::{PyArray1, PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use tasks::sequence::{SequenceTask, TrialRecord};
 
-use crate::arrays::{pairs, to_numpy, AnyInt};
+use crate::arrays::{pairs, AnyInt};
 use crate::detach::detached;
 use crate::errors::IntoPy;
 use crate::json::to_py;
 use crate::network::PyNetwork;
+use crate::records::{flags, integers, matrix, vector};
 
 /// The sequence-learning task of a run's settings. Made by `RunConfig.builtin()`.
 #[pyclass(module = "dnnevo._core", name = "SequenceTask", frozen)]
@@ -79,13 +80,13 @@ impl PySequenceTask {
         pattern: &str,
         timing: Vec<(AnyInt, AnyInt)>,
         reset: bool,
-    ) -> PyResult<PySequenceTrial> {
+    ) -> PyResult<PySequenceRecord> {
         let timing = pairs(&timing, "timing")?;
         let (task, net) = (&self.inner, &net.inner);
         let record = py
             .detach(|| task.run_pattern(net, pattern, &timing, reset))
             .py_err()?;
-        PySequenceTrial::new(py, record)
+        PySequenceRecord::new(py, record)
     }
 
     /// Assesses a network on fresh timings, `trials_per_target` trials per target: a dict.
@@ -109,8 +110,8 @@ impl PySequenceTask {
 
 /// One sequence trial, time step by time step: arrays of length T (`outputs` is (T, N)), and
 /// per trigger (`targets`, `r`, `mean_output`, `trigger_correct`).
-#[pyclass(module = "dnnevo._core", name = "SequenceTrial", frozen)]
-pub struct PySequenceTrial {
+#[pyclass(module = "dnnevo._core", name = "SequenceRecord", frozen)]
+pub struct PySequenceRecord {
     /// The target sequence, such as "01".
     #[pyo3(get)]
     target: String,
@@ -143,36 +144,29 @@ pub struct PySequenceTrial {
     final_state: Py<PyArrayDyn<f64>>,
 }
 
-impl PySequenceTrial {
+impl PySequenceRecord {
     fn new(py: Python<'_>, record: TrialRecord) -> PyResult<Self> {
-        let vector = |v: Vec<f64>| {
-            let n = v.len();
-            to_numpy(py, v, &[n]).map(Bound::unbind)
-        };
-        let steps = record.outputs.len();
         let size = record.final_state.len();
-        let outputs: Vec<f64> = record.outputs.into_iter().flatten().collect();
-        let targets: Vec<i64> = record.targets.iter().map(|&b| i64::from(b)).collect();
-        Ok(PySequenceTrial {
+        Ok(PySequenceRecord {
             target: record.target,
-            trigger: vector(record.trigger)?,
-            reinforcement: vector(record.reinforcement)?,
-            output: vector(record.output)?,
-            outputs: to_numpy(py, outputs, &[steps, size])?.unbind(),
-            targets: PyArray1::from_vec(py, targets).unbind(),
-            r: vector(record.r)?,
-            mean_output: vector(record.mean_output)?,
-            trigger_correct: PyArray1::from_vec(py, record.trigger_correct).unbind(),
-            final_state: vector(record.final_state)?,
+            trigger: vector(py, record.trigger)?,
+            reinforcement: vector(py, record.reinforcement)?,
+            output: vector(py, record.output)?,
+            outputs: matrix(py, record.outputs, size)?,
+            targets: integers(py, &record.targets),
+            r: vector(py, record.r)?,
+            mean_output: vector(py, record.mean_output)?,
+            trigger_correct: flags(py, record.trigger_correct),
+            final_state: vector(py, record.final_state)?,
         })
     }
 }
 
 #[pymethods]
-impl PySequenceTrial {
+impl PySequenceRecord {
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
-            "SequenceTrial(target={:?}, steps={}, triggers={})",
+            "SequenceRecord(target={:?}, steps={}, triggers={})",
             self.target,
             self.output.bind(py).len(),
             self.targets.bind(py).len()

@@ -18,7 +18,6 @@ noise, specular misses and a jittered room: our stand-in for the paper's real-ro
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -72,19 +71,10 @@ OUTPUT_NEURON = 0
 """The neuron whose firing rate is the task's answer (``task_params.classifier`` overrides it)."""
 
 
-@dataclass(frozen=True)
-class Record:
-    """One trial, step by step (arrays of length T; ``outputs`` is (T, N), ``poses`` (T, 3) as
-    x, y, heading, ``echoes`` (T, 2) with NaN where nothing echoed)."""
-
-    landmark: int
-    world: dict[str, Any]
-    input: npt.NDArray[np.float64]
-    range: npt.NDArray[np.float64]
-    poses: npt.NDArray[np.float64]
-    echoes: npt.NDArray[np.float64]
-    outputs: npt.NDArray[np.float64]
-    classification: float
+Record = _core.LandmarkRecord
+"""One trial, step by step, as the core records it (arrays of length T; ``outputs`` is (T, N),
+``poses`` (T, 3) as x, y, heading, ``echoes`` (T, 2) with NaN where nothing echoed; the trial's
+``world`` and the classifier's final output ``classification``)."""
 
 
 def _task(config: EvolutionConfig) -> _core.LandmarkTask:
@@ -108,20 +98,8 @@ def record(
 ) -> Record:
     """Runs ``net`` through fresh trial ``trial`` of ``seed`` with ``landmark`` (1 or 2)."""
     _landmark(landmark)
-    d = _task(config).record(net, nonnegative("landmark", landmark), nonnegative("seed", seed),
-                             nonnegative("trial", trial), robot_like)
-    s = d["sensing"]
-    echoes = np.array([[np.nan, np.nan] if p is None else p for p in s["echoes"]], dtype=float)
-    return Record(
-        landmark=s["landmark"],
-        world=s["world"],
-        input=np.array(s["input"], dtype=float),
-        range=np.array(s["range"], dtype=float),
-        poses=np.array(s["poses"], dtype=float).reshape(-1, 3),
-        echoes=echoes.reshape(-1, 2),
-        outputs=np.array(d["outputs"], dtype=float).reshape(len(s["input"]), -1),
-        classification=d["classification"],
-    )
+    return _task(config).record(net, nonnegative("landmark", landmark), nonnegative("seed", seed),
+                                nonnegative("trial", trial), robot_like)
 
 
 def assess(

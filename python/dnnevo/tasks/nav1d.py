@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -115,37 +115,20 @@ CASES = (("far", "left"), ("far", "right"), ("near", "left"), ("near", "right"))
 """The paper's Fig. 2 environments A, B, C and D, in that order."""
 
 
-@dataclass(frozen=True)
-class Condition:
-    """One trial's world: environment ``"far"``/``"near"``, goal ``"left"``/``"right"``, the
-    agent's start and the landmark's centre."""
+Condition = _core.Nav1dCondition
+"""One trial's world: ``Condition(environment, goal, start, landmark)`` with environment
+``"far"``/``"near"``, goal ``"left"``/``"right"``, the agent's start and the landmark's centre."""
 
-    environment: str
-    goal: str
-    start: float
-    landmark: float
+Record = _core.Nav1dRecord
+"""A chain of trials, time step by time step, as the core records it (arrays of length T;
+``outputs`` is (T, N); per trial ``conditions``, ``reached`` and ``classification``).
 
-
-@dataclass(frozen=True)
-class Record:
-    """A chain of trials, time step by time step (arrays of length T; ``outputs`` is (T, N)).
-
-    Time steps are counted from the start of each trial's moving phase and of its reinforcement
-    period; a moving phase that ends inside a time step ends with that partial time step. ``x``
-    and ``outputs`` are taken at the end of each time step, ``landmark`` is the fraction of its
-    Euler steps on the landmark (0 or 1 in the stepped world). Outcomes (``reached``,
-    ``classification``) come from every Euler step, not from these samples."""
-
-    conditions: list[Condition]
-    x: npt.NDArray[np.float64]
-    landmark: npt.NDArray[np.float64]
-    reinforcement: npt.NDArray[np.float64]
-    outputs: npt.NDArray[np.float64]
-    trial: npt.NDArray[np.int64]
-    moving: npt.NDArray[np.bool_]
-    reached: list[bool]
-    classification: list[float]
-    final_state: npt.NDArray[np.float64]
+Time steps are counted from the start of each trial's moving phase and of its reinforcement
+period; a moving phase that ends inside a time step ends with that partial time step. ``x`` and
+``outputs`` are taken at the end of each time step, ``landmark`` is the fraction of its Euler
+steps on the landmark (0 or 1 in the stepped world). Outcomes (``reached``, ``classification``)
+come from every Euler step, not from these samples; ``classification`` is NaN for a network
+without a classifier."""
 
 
 @dataclass(frozen=True)
@@ -165,19 +148,11 @@ def params(config: EvolutionConfig) -> dict[str, Any]:
     return _task(config).params()
 
 
-def _conditions(items: list[dict[str, Any]]) -> list[Condition]:
-    return [Condition(**c) for c in items]
-
-
-def _dicts(conditions: Sequence[Condition]) -> list[dict[str, Any]]:
-    return [asdict(c) for c in conditions]
-
-
 def cases(config: EvolutionConfig) -> list[Condition]:
     """The four exact environment and goal cases of Fig. 2 (A: far/left, B: far/right, C:
     near/left, D: near/right), with the config's geometry."""
     task = _task(config)
-    return [Condition(**task.exact(e, g)) for e, g in CASES]
+    return [task.exact(e, g) for e, g in CASES]
 
 
 def chain_len(config: EvolutionConfig) -> int:
@@ -188,30 +163,14 @@ def chain_len(config: EvolutionConfig) -> int:
 
 def chains(config: EvolutionConfig, seed: int, generation: int) -> list[list[Condition]]:
     """The chains of trials every individual of ``generation`` ran."""
-    return [_conditions(c) for c in _task(config).chains(nonnegative("seed", seed),
-                                                         nonnegative("generation", generation))]
+    return _task(config).chains(nonnegative("seed", seed), nonnegative("generation", generation))
 
 
 def fresh_chains(config: EvolutionConfig, count: int, trials: int, seed: int) -> list[list[Condition]]:
     """``count`` fresh chains of ``trials`` trials, each in a random environment of the config's
     ``environments``, each trial with a random goal side."""
-    return [_conditions(c) for c in _task(config).fresh_chains(
-        bounded_count("count", count), bounded_count("trials", trials), nonnegative("seed", seed))]
-
-
-def _record(d: dict[str, Any]) -> Record:
-    return Record(
-        conditions=_conditions(d["conditions"]),
-        x=np.array(d["x"], dtype=float),
-        landmark=np.array(d["landmark"], dtype=float),
-        reinforcement=np.array(d["reinforcement"], dtype=float),
-        outputs=np.array(d["outputs"], dtype=float).reshape(len(d["x"]), len(d["final_state"])),
-        trial=np.array(d["trial"], dtype=np.int64),
-        moving=np.array(d["moving"], dtype=bool),
-        reached=list(d["reached"]),
-        classification=[float("nan") if c is None else c for c in d["classification"]],
-        final_state=np.array(d["final_state"], dtype=float),
-    )
+    return _task(config).fresh_chains(bounded_count("count", count), bounded_count("trials", trials),
+                                      nonnegative("seed", seed))
 
 
 def record(
@@ -219,7 +178,7 @@ def record(
 ) -> Record:
     """Runs ``net`` through a chain of trials (its state persisting between them), recorded;
     with ``reset=False`` it starts from ``net.state``."""
-    return _record(_task(config).record(net, _dicts(conditions), reset))
+    return _task(config).record(net, list(conditions), reset)
 
 
 def assess(config: EvolutionConfig, net: _core.Network, count: int, seed: int) -> dict[str, Any]:
@@ -289,8 +248,7 @@ def system_record(
     """One environment of the integrated system, recorded: the classifier's trial, the picked
     network's trials, and which it picked (``"far"`` or ``"near"``)."""
     c, f, n = _parts(classifier, far, near)
-    d = _core.nav1d_system_record(c, f, n, _dicts(conditions), persist_state)
-    return _record(d["first"]), _record(d["rest"]), d["chosen"]
+    return _core.nav1d_system_record(c, f, n, list(conditions), persist_state)
 
 
 def scored_trials(objective: str, episode: dict[str, Any]) -> list[bool]:
@@ -421,11 +379,11 @@ def draw(run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = Fal
     return written
 
 
-def _fig2(records: Sequence[Record], settings: dict[str, Any], title: str, path: Path) -> None:
+def _fig2(records: Sequence[Record | Sequence[Record]], settings: dict[str, Any], title: str, path: Path) -> None:
 
     fig, axes = plot.subplots(2, 2, figsize=(11, 6.5), layout="constrained", sharey=True)
     for ax, rec, letter in zip(axes.T.flat, records, "ABCD", strict=True):
-        c = rec.conditions[0]
+        c = (rec if isinstance(rec, Record) else rec[0]).conditions[0]
         plot_path(rec, ax, half_length=float(settings["half_length"]),
                         landmark_width=float(settings["landmark_width"]),
                         title=f"{letter}: landmark-{c.environment}, goal {c.goal}")
@@ -441,26 +399,9 @@ def draw_system(parts: Sequence[Part], trials: int, path: Path, *, persist_state
     for c in cases(parts[0].config):
         first, rest, _ = system_record(parts[0], parts[1], parts[2], [c] * trials,
                                              persist_state=persist_state)
-        records.append(_join(first, rest))
+        records.append([first, rest])
     _fig2(records, params(parts[0].config), "integrated system, one environment per case "
           f"({trials} trials, goal on the same side)", path)
-
-
-def _join(first: Record, rest: Record) -> Record:
-    """The classifier's trial followed by the picked network's, as one record for plotting
-    (outputs are left out: the two networks' neurons differ)."""
-    return Record(
-        conditions=first.conditions + rest.conditions,
-        x=np.concatenate([first.x, rest.x]),
-        landmark=np.concatenate([first.landmark, rest.landmark]),
-        reinforcement=np.concatenate([first.reinforcement, rest.reinforcement]),
-        outputs=np.zeros((len(first.x) + len(rest.x), 0)),
-        trial=np.concatenate([first.trial, rest.trial + 1]),
-        moving=np.concatenate([first.moving, rest.moving]),
-        reached=first.reached + rest.reached,
-        classification=first.classification + rest.classification,
-        final_state=rest.final_state,
-    )
 
 
 def recorded_trials(config: EvolutionConfig, net: _core.Network, *,
@@ -475,7 +416,7 @@ def recorded_trials(config: EvolutionConfig, net: _core.Network, *,
 
 
 def plot_path(
-    record: Record,
+    record: Record | Sequence[Record],
     ax: Axes | None = None,
     *,
     half_length: float = 20.0,
@@ -483,21 +424,29 @@ def plot_path(
     title: str | None = None,
 ) -> Axes:
     """The paper's Fig. 2: the agent's position over time in a chain of trials, with each
-    trial's landmark (shaded) and goal (a star at its end) marked, and trial boundaries dashed."""
+    trial's landmark (shaded) and goal (a star at its end) marked, and trial boundaries dashed.
+    ``record`` may be a list of records that follow one another (the integrated system's
+    classifier trial, then the picked network's)."""
+    parts = [record] if isinstance(record, Record) else list(record)
     ax = plot.axes(ax)
-    t = np.arange(1, len(record.x) + 1)
-    x = np.where(record.moving, record.x, np.nan)
+    moving = np.concatenate([p.moving for p in parts])
+    x = np.where(moving, np.concatenate([p.x for p in parts]), np.nan)
+    offsets = np.cumsum([0] + [len(p.conditions) for p in parts[:-1]])
+    trial = np.concatenate([p.trial + k for p, k in zip(parts, offsets, strict=True)])
+    conditions = [c for p in parts for c in p.conditions]
+    reached_all = [r for p in parts for r in p.reached]
+    t = np.arange(1, len(x) + 1)
     ax.plot(t, x, color="tab:blue", lw=1.4, label="agent x(t)")
-    bounds = np.flatnonzero(np.diff(record.trial)) + 1
+    bounds = np.flatnonzero(np.diff(trial)) + 1
     edges = np.concatenate([[0], bounds, [len(t)]])
     for k, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-        if k >= len(record.conditions):
+        if k >= len(conditions):
             break
-        c = record.conditions[k]
+        c = conditions[k]
         ax.fill_between([a, b], c.landmark - landmark_width / 2, c.landmark + landmark_width / 2,
                         color="tab:orange", alpha=0.3, lw=0, label="landmark" if k == 0 else None)
         goal = half_length if c.goal == "right" else -half_length
-        reached = k < len(record.reached) and record.reached[k]
+        reached = k < len(reached_all) and reached_all[k]
         ax.plot([b if reached else a], [goal], marker="*", ms=11, ls="none",
                 color="tab:green" if reached else "tab:red",
                 label=("goal" if k == 0 else None))

@@ -61,7 +61,7 @@ OUTPUT_NEURON = 0
 """The neuron whose firing rate is the task's answer (``task_params.classifier`` overrides it)."""
 
 
-TrialRecord = _core.SequenceTrial
+TrialRecord = _core.SequenceRecord
 """One trial, time step by time step, as the core records it (arrays of length T, ``outputs``
 is (T, N); ``targets``, ``r``, ``mean_output``, ``trigger_correct`` per trigger;
 ``final_state``)."""

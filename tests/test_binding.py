@@ -57,6 +57,7 @@ def test_a_condition_is_typed_and_checked() -> None:
     assert c == nav1d.Condition(environment="far", goal="left", start=0.0, landmark=10.0)
     assert c != nav1d.Condition("near", "left", 0.0, 10.0)
     assert pickle.loads(pickle.dumps(c)) == c
+    assert len({c, nav1d.Condition("far", "left", -0.0, 10.0)}) == 1  # hashable, -0.0 == 0.0
     with pytest.raises(InvalidArgumentError, match="start is NaN; it must be a finite number"):
         nav1d.Condition("far", "left", math.nan, 10.0)
     with pytest.raises(InvalidArgumentError, match='goal is "up"; expected "left" or "right"'):
@@ -89,3 +90,12 @@ def test_records_are_typed_arrays() -> None:
     assert rec.classification == rec.outputs[-1, 0]
     silent = np.isnan(rec.echoes[:, 0])
     assert np.array_equal(silent, np.isnan(rec.echoes[:, 1]))
+
+
+def test_task_params_changed_in_place_are_refused_not_ignored() -> None:
+    config = presets.get("sequence-1bit")
+    config.task_params["targets"] = ["01", "10"]
+    with pytest.raises(ConfigError, match="task_params was changed in place"):
+        sequence.target_list(config)
+    fresh = dataclasses.replace(config, task_params=dict(config.task_params))
+    assert sequence.target_list(fresh) == ["01", "10"]

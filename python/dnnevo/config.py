@@ -7,6 +7,7 @@ so a run can always be repeated from its folder.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import math
@@ -149,11 +150,17 @@ class EvolutionConfig:
         _check_finite(d, "")
         _check_negative(d)
         object.__setattr__(self, "_native", _core.RunConfig(json.dumps(d)))
+        object.__setattr__(self, "_task_params", copy.deepcopy(self.task_params))
 
     @property
     def native(self) -> _core.RunConfig:
         """The settings as the Rust core parsed and validated them, once, when this config was
-        made; ``Evolution``, ``evaluate`` and the built-in task (``native.builtin()``) take it."""
+        made: ``Evolution`` and ``evaluate`` take it, and ``native.builtin()`` is the built-in
+        task built from it. ``task_params`` changed in place afterwards is refused here, since
+        the core would not see it: make a new config with ``dataclasses.replace``."""
+        if self.task_params != self.__dict__["_task_params"]:
+            raise ConfigError("config.task_params was changed in place after the config was made; "
+                              "make a new config with dataclasses.replace(config, task_params=...)")
         native: _core.RunConfig = self.__dict__["_native"]
         return native
 

@@ -1,5 +1,6 @@
-//! Detailed task results leave as Python values (dicts, lists, numbers), built in Rust from the
-//! records' serde form: no JSON text crosses the border.
+//! Task reports (`assess`), task settings (`params()`), worlds and analysis results leave as Python
+//! values (dicts, lists, numbers), built in Rust from their serde form: no JSON text crosses the
+//! border. Records are typed objects of their own (`records.rs`).
 
 use pyo3::prelude::*;
 

@@ -164,7 +164,8 @@ pub fn sim2d_cast_rays<'py>(
     directions: PyReadonlyArray2<'py, f64>,
     max_distance: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let world = dict_to_map(world.as_any(), "world")?;
+    let world = dict_to_map(world.as_any(), "world")
+        .map_err(|e| ConfigError::new_err(e.value(py).to_string()))?;
     let spec: sim2d::WorldSpec = serde_json::from_value(serde_json::Value::Object(world))
         .map_err(|e| ConfigError::new_err(format!("world: {e}")))?;
     let world = sim2d::World::new(&spec).map_err(|e| ConfigError::new_err(e.to_string()))?;

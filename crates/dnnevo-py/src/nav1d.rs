@@ -255,6 +255,21 @@ impl PyNav1dCondition {
         self.inner.landmark
     }
 
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        // Equal conditions hash alike: -0.0 == 0.0, so both hash as 0.0.
+        let bits = |v: f64| (v + 0.0).to_bits();
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (
+            self.environment(),
+            self.goal(),
+            bits(self.inner.start),
+            bits(self.inner.landmark),
+        )
+            .hash(&mut h);
+        h.finish()
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Nav1dCondition(environment={:?}, goal={:?}, start={:?}, landmark={:?})",

@@ -6,7 +6,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::PyTuple;
 use tasks::RunConfig;
 
-use crate::errors::IntoPy;
+use crate::errors::{ConfigError, IntoPy};
 use crate::landmark::PyLandmarkTask;
 use crate::nav1d::PyNav1dTask;
 use crate::sequence::PySequenceTask;
@@ -71,12 +71,13 @@ fn build(py: Python<'_>, run: &RunConfig) -> PyResult<Py<PyAny>> {
         "nav1d" => Py::new(py, PyNav1dTask::from_params(&params)?)?.into_any(),
         "landmark" => Py::new(py, PyLandmarkTask::from_params(&params)?)?.into_any(),
         // The registry's own message names the built-in tasks.
-        _ => {
-            return Err(run
-                .build_task()
-                .err()
-                .map(crate::errors::to_py)
-                .expect("a name the binding does not know is not a built-in task"))
+        other => {
+            return Err(match run.build_task() {
+                Err(e) => crate::errors::to_py(e),
+                Ok(_) => {
+                    ConfigError::new_err(format!("task {other:?} has no object in the binding"))
+                }
+            })
         }
     })
 }

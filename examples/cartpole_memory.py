@@ -49,6 +49,8 @@ def champion_return(seed: int, reactive: bool, population: int, generations: int
                                     ranges=REACTIVE if reactive else {})
     fitness = ClosedLoop(cartpole(), episodes=5, max_steps=500, substeps=2)
     result = dnnevo.evolve(fitness, config, seed=seed, progress=False)
+    if result.interrupted:  # Ctrl-C or SIGTERM stops evolve after a generation; stop here too
+        raise KeyboardInterrupt
     fresh = rollout([result.best], cartpole("sync"), episodes=episodes, max_steps=500, substeps=2,
                     seed=FRESH_SEED + seed, purpose="evaluate")
     return float(fresh.returns.mean())

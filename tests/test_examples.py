@@ -17,6 +17,7 @@ import incremental_plateau  # noqa: E402
 import nav1d_transfer  # noqa: E402
 import trigger_answers  # noqa: E402
 import cartpole_memory  # noqa: E402
+import double_pole  # noqa: E402
 
 
 def test_incremental_plateau(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -84,3 +85,16 @@ def test_cartpole_memory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     net = dnnevo.GeneticAlgorithm(config, seed=0).ask().networks[0]
     assert abs(net.weights).max() <= 1e-9
 
+
+
+def test_double_pole(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A row per seed, the solved count with its interval, and the figure."""
+    from cli_helpers import assert_png
+
+    double_pole.main(["--seeds", "2", "--population", "10", "--budget", "30",
+                      "--out", str(tmp_path / "d.png")])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("seed  evaluations  generalisation") and len(lines) == 4
+    assert lines[1].split()[:2] == ["0", ">30"]
+    assert lines[-1].startswith("solved 0 of 2 seeds within 30 evaluations (95% interval 0%-")
+    assert_png(tmp_path / "d.png")

@@ -1,0 +1,106 @@
+"""The classic benchmarks: double-pole balancing's physics against hand-computed cases, its
+fitness and success rule, and the generalisation grid."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dnnevo
+from dnnevo.classic import DoublePole
+from dnnevo.classic import double_pole as dp
+from dnnevo.closedloop import rollout
+from dnnevo.errors import InvalidArgumentError
+
+
+def test_at_rest_upright_only_the_push_accelerates() -> None:
+    # Upright and at rest, each pole's effective mass is m (1 - 3/4) and every pole force is 0:
+    # x'' = F / (M + m1/4 + m2/4), and theta_i'' = -3/4 x'' / l_i.
+    force = np.array([10.0])
+    d = dp._derivatives(np.zeros((6, 1)), force)
+    a = 10.0 / (1.0 + 0.1 / 4 + 0.01 / 4)
+    assert d[1, 0] == pytest.approx(a, rel=1e-15)
+    assert d[3, 0] == pytest.approx(-0.75 * a / 0.5, rel=1e-15)
+    assert d[5, 0] == pytest.approx(-0.75 * a / 0.05, rel=1e-15)
+    assert d[0, 0] == d[2, 0] == d[4, 0] == 0.0
+
+
+def test_a_tilted_pole_falls_under_gravity_alone() -> None:
+    # Long pole at angle q, all at rest, no push: its force term is 3/4 m cos q (g sin q), and
+    # theta_1'' = -3/4 (x'' cos q + g sin q) / l_1 with g = -9.8 (the benchmark's convention).
+    q = 0.07
+    s = np.zeros((6, 1))
+    s[2] = q
+    d = dp._derivatives(s, np.zeros(1))
+    g = -9.8
+    pole = 0.75 * 0.1 * np.cos(q) * g * np.sin(q)
+    mass = 1.0 + 0.1 * (1 - 0.75 * np.cos(q) ** 2) + 0.01 * 0.25
+    a = pole / mass
+    assert d[1, 0] == pytest.approx(a, rel=1e-14)
+    assert d[3, 0] == pytest.approx(-0.75 * (a * np.cos(q) + g * np.sin(q)) / 0.5, rel=1e-14)
+    assert d[3, 0] > 0  # it falls further the way it leans
+
+
+def test_the_dynamics_are_mirror_symmetric() -> None:
+    rng = np.random.default_rng(0)
+    s = rng.normal(scale=0.1, size=(6, 8))
+    f = rng.normal(size=8)
+    np.testing.assert_allclose(dp._advance(-s, -f), -dp._advance(s, f), rtol=0, atol=1e-15)
+
+
+def test_the_grid_is_the_625_generalisation_starts() -> None:
+    assert dp.GRID.shape == (625, 4)
+    assert dp.GRID[0] == pytest.approx([-1.944, -1.215, -np.deg2rad(3.24), -np.deg2rad(7.74)])
+    assert len({tuple(row) for row in dp.GRID}) == 625
+    np.testing.assert_allclose(dp.GRID.mean(axis=0), 0.0, atol=1e-15)
+
+
+class Steady:
+    """A fake controller's rates: neuron 0 at ``level`` in every row."""
+
+    def __init__(self, rows: int, level: float) -> None:
+        self.rates = np.full((rows, 5), level)
+
+
+def test_a_fall_ends_the_episode_and_pays_the_balanced_part_only() -> None:
+    env = DoublePole()
+    env.reset(np.zeros(2, dtype=np.int64), np.random.default_rng(0))
+    active = np.ones(2, dtype=bool)
+    for t in range(1, 1000):
+        _, reward, done = env.step(Steady(2, 0.5).rates, active)
+        if done.any():
+            break
+    assert done.all() and t < 100
+    # Fewer than 100 balanced steps: no damping term.
+    assert reward == pytest.approx(0.1 * (t - 1) / 1000)
+    assert not env.success(reward, np.full(2, t)).any()
+
+
+def test_a_balanced_episode_earns_the_damping_term(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Freeze the physics: the cart stays at the standard start, balanced throughout, and each of
+    # the last 100 steps adds |theta_1| = 0.07 to the jiggle.
+    monkeypatch.setattr(dp, "_advance", lambda s, force: s)
+    env = DoublePole(steps=150)
+    env.reset(np.zeros(1, dtype=np.int64), np.random.default_rng(0))
+    total = 0.0
+    for _ in range(150):
+        _, reward, done = env.step(Steady(1, 0.5).rates, np.ones(1, dtype=bool))
+        total += reward[0]
+    assert done[0]
+    assert total == pytest.approx(0.1 * 150 / 1000 + 0.9 * 0.75 / (100 * 0.07), rel=1e-12)
+    assert env.success(np.array([total]), np.array([150])).tolist() == [True]
+
+
+def test_a_random_network_does_not_solve_it() -> None:
+    net = dnnevo.Network.random(5, 3, seed=1)
+    solved, long, score = dp.solves(net)
+    assert not solved and long < 1000 and score == 0
+    result = rollout([net], DoublePole(start="grid"), episodes=625, max_steps=1000)
+    assert result.returns.shape == (1, 625) and (result.lengths < 1000).all()
+
+
+def test_bad_settings_are_named() -> None:
+    with pytest.raises(InvalidArgumentError, match="start is 'random'"):
+        DoublePole(start="random")
+    with pytest.raises(InvalidArgumentError, match="steps is 0"):
+        DoublePole(steps=0)

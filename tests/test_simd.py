@@ -4,6 +4,7 @@ bits, and a bad choice is a clear error."""
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import os
 import subprocess
 import sys
@@ -98,6 +99,34 @@ def test_an_evolution_run_is_the_same_on_every_kernel() -> None:
         assert history.keys() == first_history.keys()
         for key, column in history.items():
             assert np.array_equal(column, first_history[key]), f"{name}: {key} differs from {KERNELS[0]}"
+
+
+#: The kernels dnnevo has for each architecture; a CPU runs those its features allow.
+ARCH_KERNELS = {"x86_64": ("portable", "avx2", "avx512"), "aarch64": ("portable", "neon")}
+
+#: The evolution run below, pinned: its whole history (wall times aside) and champion, hashed.
+#: Every kernel must give it; a change here changes every published result (CHANGELOG.md).
+EVOLUTION_FINGERPRINT = "30226182fd8b36e1"
+
+
+def evolution_fingerprint() -> str:
+    config = dataclasses.replace(presets.get("sequence-1bit"), population=40, generations=3)
+    result = dnnevo.evolve("sequence-1bit", config, seed=3, progress=False, threads=2)
+    digest = hashlib.sha256()
+    for key in sorted(result.history):
+        if key not in TIMINGS:
+            digest.update(key.encode() + bits(np.asarray(result.history[key])).tobytes())
+    digest.update(result.best.to_json().encode())
+    return digest.hexdigest()[:16]
+
+
+@pytest.mark.parametrize("name", ARCH_KERNELS.get(dnnevo.build_info()["arch"], ("portable",)))
+def test_every_kernel_gives_the_pinned_evolution(name: str) -> None:
+    """A kernel this CPU lacks is a skip that says so in the test summary, not a silent pass."""
+    if name not in KERNELS:
+        pytest.skip(f"this CPU cannot run the {name} kernel, so its bits were not proven here")
+    dnnevo.use_kernel(name)
+    assert evolution_fingerprint() == EVOLUTION_FINGERPRINT
 
 
 def run_with_simd(value: str, code: str) -> subprocess.CompletedProcess[str]:

@@ -41,9 +41,7 @@ impl PyLandmarkTask {
     /// (size, n_inputs) of the networks the task drives.
     #[getter]
     fn layout(&self) -> (usize, usize) {
-        use ctrnn::Task;
-        let layout = self.inner.layout();
-        (layout.size, layout.n_inputs)
+        crate::run_config::layout(&self.inner)
     }
 
     /// One fresh trial (`Purpose::Evaluate` stream `trial` of `seed`) with `landmark`, recorded

@@ -59,9 +59,7 @@ impl PyNav1dTask {
     /// (size, n_inputs) of the networks the task drives.
     #[getter]
     fn layout(&self) -> (usize, usize) {
-        use ctrnn::Task;
-        let layout = self.inner.layout();
-        (layout.size, layout.n_inputs)
+        crate::run_config::layout(&self.inner)
     }
 
     /// Trials per chain of the task's success check: `trials_per_environment` for a `single`

@@ -37,9 +37,7 @@ impl PySequenceTask {
     /// (size, n_inputs) of the networks the task drives.
     #[getter]
     fn layout(&self) -> (usize, usize) {
-        use ctrnn::Task;
-        let layout = self.inner.layout();
-        (layout.size, layout.n_inputs)
+        crate::run_config::layout(&self.inner)
     }
 
     /// The (delay, gap) of every trigger of a trial, as evolution drew them.

@@ -186,8 +186,8 @@ def long_test(net: _core.Network, *, steps: int = LONG_STEPS, velocities: bool =
               dt: float = 0.1, substeps: int = 10, method: str = "euler") -> int:
     """Control steps ``net`` balances from the standard start, up to ``steps``."""
     env = DoublePole(velocities=velocities, steps=steps)
-    result = rollout([net], env, max_steps=steps, dt=dt, substeps=substeps, method=method)
-    return int(env.balanced[0]) if result.lengths[0, 0] else 0
+    rollout([net], env, max_steps=steps, dt=dt, substeps=substeps, method=method)
+    return int(env.balanced[0])
 
 
 def generalization(net: _core.Network, *, velocities: bool = False, dt: float = 0.1,

@@ -228,6 +228,10 @@ class Broken(Drift):
             obs[0] = np.nan
         if fault == "nan reward":
             reward[1] = np.nan
+        if fault == "nan once" and self.t == 2:
+            reward[3] = np.nan
+        if fault == "overflow":
+            reward[:] = 1e308
         if fault == "text obs":
             obs = np.array([["a"]] * len(obs))
         if fault == "int done":
@@ -241,6 +245,10 @@ class Broken(Drift):
     ("raises", r"Broken.step raised KeyError: 'velocity'"),
     ("nan obs", r"Broken.step returned observations that are not finite \(inputs\[0, 0\] is NaN"),
     ("nan reward", r"Broken.step returned rewards\[1\] = nan"),
+    # Returns are checked when an episode ends: an earlier reward is named by its row.
+    ("nan once", r"Broken.step returned rewards that made row 3's return nan; every reward"),
+    pytest.param("overflow", r"made row 0's return inf; .* below 1.8e308 \(scale the rewards down",
+                 marks=pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")),
     ("text obs", r"observations from step of dtype <U1; expected numbers"),
     ("int done", r"Broken.step returned done of type ndarray, dtype int64"),
     ("pair", r"Broken.step returned tuple; expected a tuple \(observations, rewards, done\)"),

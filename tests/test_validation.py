@@ -3,6 +3,7 @@ is fixed for the run; evolution itself unchanged, runs deterministic and resume-
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -119,3 +120,99 @@ def test_bad_validation_candidates_is_a_config_error(value: object) -> None:
 def test_empty_validation_set_is_a_config_error(task: str, param: str) -> None:
     with pytest.raises(ConfigError, match=f"{param} is 0"):
         dnnevo.evolve(task, config(task, f"task_params.{param}=0"), seed=0, progress=False)
+
+
+# ---------------------------------------------------------------------------------------------
+# Fitness from Python: ask/tell with a validate callable, and a closed-loop task's own validation
+
+
+def _square_fitness(networks: list[dnnevo.Network]) -> np.ndarray:
+    """A noisy fitness: each network's tau[0], plus luck from its own weights."""
+    return np.array([n.tau[0] + 5 * (abs(n.weights[0][0]) % 1.0) for n in networks])
+
+
+def _true_quality(networks: list[dnnevo.Network]) -> tuple[np.ndarray, np.ndarray]:
+    taus = np.array([n.tau[0] for n in networks])
+    return taus / 10.0, np.zeros(len(networks))
+
+
+def test_tell_with_validate_chooses_the_champion_and_leaves_evolution_unchanged() -> None:
+    cfg = EvolutionConfig(population=30, size=2, n_inputs=1, validation_candidates=5, elitism=3)
+    a, b = dnnevo.GeneticAlgorithm(cfg, seed=7), dnnevo.GeneticAlgorithm(cfg, seed=7)
+    seen: list[int] = []
+
+    def validate(networks: list[dnnevo.Network]) -> tuple[np.ndarray, np.ndarray]:
+        seen.append(len(networks))
+        return _true_quality(networks)
+
+    for _ in range(6):
+        a.tell(_square_fitness(a.ask().networks), validate=validate)
+        b.tell(_square_fitness(b.ask().networks))
+        np.testing.assert_array_equal(a.ask().genomes, b.ask().genomes)
+    assert a.best_validation is not None and b.best_validation is None
+    assert a.best_validation[0] == a.best.tau[0] / 10.0
+    assert a.best.tau[0] >= b.best.tau[0]  # the lucky one by fitness is no better by tau
+    assert seen[0] == 5 and sum(seen) < 6 * 5  # elites carried over are validated once
+
+
+@pytest.mark.parametrize("returned, message", [
+    ((np.zeros(5),), r"validate returned tuple; expected \(rates, scores\), two arrays of shape \(5,\)"),
+    ((np.zeros(4), np.zeros(5)), r"validate returned rates of shape \(4,\); expected \(5,\)"),
+    ((np.full(5, 2.0), np.zeros(5)), r"a validation gave rate 2 and score 0; a rate lies in \[0, 1\]"),
+    ((np.zeros(5), np.full(5, np.nan)), r"a validation gave rate 0 and score NaN"),
+])
+def test_a_bad_validation_is_a_fitness_error(returned: tuple, message: str) -> None:
+    ga = dnnevo.GeneticAlgorithm(EvolutionConfig(population=10, size=2, n_inputs=1,
+                                                 validation_candidates=5), seed=0)
+    with pytest.raises(dnnevo.FitnessError, match=message):
+        ga.tell(np.ones(10), validate=lambda networks: returned)
+    assert ga.generation == 0
+
+
+def test_an_error_inside_validate_is_raised_as_it_was() -> None:
+    ga = dnnevo.GeneticAlgorithm(EvolutionConfig(population=10, size=2, n_inputs=1), seed=0)
+
+    def validate(networks: list[dnnevo.Network]) -> tuple[np.ndarray, np.ndarray]:
+        raise KeyError("episode")
+
+    with pytest.raises(KeyError, match="episode"):
+        ga.tell(np.ones(10), validate=validate)
+    assert ga.generation == 0
+
+
+class _Reach:
+    """A 1-D world: an episode succeeds when neuron 0's rate, integrated, passes a target drawn
+    per episode; the return is the distance covered (training rewards speed, success needs
+    the target)."""
+
+    observation_size = 1
+    success_rate = 0.5
+
+    def reset(self, episodes: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        self.target = rng.uniform(0.5, 2.0, episodes.max() + 1)[episodes]
+        self.x = np.zeros(len(episodes))
+        return self.target[:, None].copy()
+
+    def step(self, rates: np.ndarray, active: np.ndarray):
+        self.x = self.x + 0.1 * rates[:, 0]
+        return self.target[:, None].copy(), 0.1 * rates[:, 0], np.zeros(len(self.x), dtype=bool)
+
+    def success(self, returns: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+        return self.x >= self.target
+
+
+def test_a_closed_loop_champion_is_chosen_on_its_validation_set() -> None:
+    from dnnevo.closedloop import ClosedLoop
+    from dnnevo.closedloop.fitness import VALIDATION_EPISODES
+
+    fitness = ClosedLoop(_Reach(), episodes=2, max_steps=20, substeps=1)
+    cfg = EvolutionConfig(population=16, generations=4, size=2, n_inputs=1, selection="rank")
+    validated = dnnevo.evolve(fitness, cfg, seed=3, progress=False)
+    plain = dnnevo.evolve(fitness, dataclasses.replace(cfg, validation_candidates=0), seed=3,
+                          progress=False)
+    np.testing.assert_array_equal(validated.history["best"], plain.history["best"])
+    assert plain.best_validation is None and np.isnan(plain.history["validation_rate"]).all()
+    rates, scores = fitness.validate([validated.best], seed=3)
+    assert validated.best_validation == (rates[0], scores[0])
+    assert (rates[0] * VALIDATION_EPISODES) % 1 == 0
+    np.testing.assert_array_equal(validated.history["validation_rate"][-1:], rates)

@@ -273,6 +273,35 @@ impl Evolution {
         self.tell_validated(fitness, None)
     }
 
+    /// [`tell`](Self::tell) for fitness scored outside, with the champion chosen by validation
+    /// as [`step`](Self::step) chooses it: `validate` scores the networks it is given (of the
+    /// top `config.validation_candidates` by fitness, those the last generation did not already
+    /// validate) on the caller's validation set, which must be the same at every generation.
+    /// Each rate must lie in [0, 1] and each score be finite.
+    pub fn tell_validating(
+        &mut self,
+        fitness: &[f64],
+        mut validate: impl FnMut(&[Network]) -> Result<Vec<Validation>>,
+    ) -> Result<Stats> {
+        self.check(fitness)?;
+        let nets = self.networks()?;
+        let validated = self.validate_with(&nets, fitness, |batch| {
+            let scores = validate(batch)?;
+            if let Some(bad) = scores
+                .iter()
+                .find(|v| !(0.0..=1.0).contains(&v.rate) || !v.score.is_finite())
+            {
+                return Err(Error::Fitness(format!(
+                    "a validation gave rate {} and score {}; a rate lies in [0, 1] and a score \
+                     is finite",
+                    bad.rate, bad.score
+                )));
+            }
+            Ok(Some(scores))
+        })?;
+        self.tell_validated(fitness, validated.as_deref())
+    }
+
     /// Checks that `fitness` fits the population and can be selected on.
     fn check(&self, fitness: &[f64]) -> Result<()> {
         if fitness.len() != self.config.population {
@@ -378,6 +407,18 @@ impl Evolution {
         fitness: &[f64],
         cancel: Option<&AtomicBool>,
     ) -> Result<Option<Vec<(usize, Validation)>>> {
+        let seed = self.seed;
+        self.validate_with(nets, fitness, |batch| task.validate(batch, seed, cancel))
+    }
+
+    /// [`validate`](Self::validate) with the validation set behind `scores`, which validates the
+    /// networks it is given (None: there is no validation set).
+    fn validate_with(
+        &mut self,
+        nets: &[Network],
+        fitness: &[f64],
+        mut scores: impl FnMut(&[Network]) -> Result<Option<Vec<Validation>>>,
+    ) -> Result<Option<Vec<(usize, Validation)>>> {
         let chosen = candidates(fitness, self.config.validation_candidates);
         if chosen.is_empty() {
             return Ok(None);
@@ -394,7 +435,7 @@ impl Evolution {
         let scores = if batch.is_empty() {
             Vec::new()
         } else {
-            match task.validate(&batch, self.seed, cancel)? {
+            match scores(&batch)? {
                 Some(v) if v.len() == batch.len() => v,
                 Some(v) => {
                     return Err(Error::Fitness(format!(

@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex};
 
 use ctrnn::evolve::Stats;
 use ctrnn::genome::{self, Layout};
-use ctrnn::{Evolution, Task};
+use ctrnn::{Evolution, Network, Task, Validation};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 
@@ -44,6 +44,40 @@ fn first_difference<T: serde::Serialize>(found: &T, expected: &T) -> Option<Stri
         let got = f.get(key).unwrap_or(&serde_json::Value::Null);
         (got != want).then(|| format!("{key} ({got} in the GA state, {want} in the config)"))
     })
+}
+
+/// `validate(networks)` for the networks of `batch`, read back as one `Validation` each.
+fn validations(validate: &Bound<'_, PyAny>, batch: &[Network]) -> PyResult<Vec<Validation>> {
+    let nets: Vec<PyNetwork> = batch.iter().cloned().map(PyNetwork::from_core).collect();
+    let out = validate.call1((nets,))?;
+    let n = batch.len();
+    let pair = || {
+        FitnessError::new_err(format!(
+            "validate returned {}; expected (rates, scores), two arrays of shape ({n},)",
+            out.get_type()
+                .name()
+                .map(|t| t.to_string())
+                .unwrap_or_default()
+        ))
+    };
+    let (rates, scores): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
+        out.extract().map_err(|_| pair())?;
+    let rates = dense(&rates, "validate's rates", FitnessError::new_err)?;
+    let scores = dense(&scores, "validate's scores", FitnessError::new_err)?;
+    for (what, a) in [("rates", &rates), ("scores", &scores)] {
+        if a.shape != [n] {
+            return Err(FitnessError::new_err(format!(
+                "validate returned {what} of shape {}; expected ({n},), one per network",
+                shape_str(&a.shape)
+            )));
+        }
+    }
+    Ok(rates
+        .data
+        .iter()
+        .zip(&scores.data)
+        .map(|(&rate, &score)| Validation { rate, score })
+        .collect())
 }
 
 fn stats_dict<'py>(py: Python<'py>, s: &Stats) -> PyResult<Bound<'py, PyDict>> {
@@ -155,11 +189,15 @@ impl PyEvolution {
             .collect())
     }
 
-    /// Takes the current population's fitness and breeds the next generation.
+    /// Takes the current population's fitness and breeds the next generation. With `validate`,
+    /// a callable `validate(networks) -> (rates, scores)`, the champion is chosen by validation
+    /// among the top `validation_candidates`, as for a built-in task.
+    #[pyo3(signature = (fitness, validate=None))]
     fn tell<'py>(
         &mut self,
         py: Python<'py>,
         fitness: &Bound<'py, PyAny>,
+        validate: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let f = dense(fitness, "fitness", FitnessError::new_err)?;
         if f.shape.len() != 1 {
@@ -170,7 +208,24 @@ impl PyEvolution {
             )));
         }
         let inner = &mut self.inner;
-        let stats = py.detach(|| inner.tell(&f.data)).py_err()?;
+        let stats = match validate.filter(|v| !v.is_none()) {
+            None => py.detach(|| inner.tell(&f.data)).py_err()?,
+            Some(validate) => {
+                // A Python error inside `validate` is kept whole and raised as it was.
+                let mut raised: Option<PyErr> = None;
+                let told = inner.tell_validating(&f.data, |batch| {
+                    validations(validate, batch).map_err(|e| {
+                        let text = e.to_string();
+                        raised = Some(e);
+                        ctrnn::Error::Fitness(text)
+                    })
+                });
+                match (raised, told) {
+                    (Some(e), _) => return Err(e),
+                    (None, told) => told.py_err()?,
+                }
+            }
+        };
         stats_dict(py, &stats)
     }
 

@@ -37,6 +37,10 @@ _INTEGRATOR = IntegratorConfig()
 #: class's success rule (``dnnevo assess`` judges on as many as asked, 200 by default).
 SUCCESS_EPISODES = 40
 
+#: Episodes of the validation set on which a run chooses its champion (see
+#: :meth:`ClosedLoop.validate`).
+VALIDATION_EPISODES = 40
+
 
 def success_rule(env: Any, task: str) -> tuple[Any, float]:
     """The environment's ``success`` method and ``success_rate``, checked; a
@@ -115,15 +119,39 @@ class ClosedLoop:
         rule, threshold = success_rule(self.env, name)
         run = {**self.settings, "episodes": episodes}
         result = rollout([network], self.env, seed=seed, purpose=purpose, **run)
+        return self._rule(rule, result.returns[0], result.lengths[0]), threshold, result
+
+    def validate(self, networks: Sequence[_core.Network], *, seed: int
+                 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """Each network's ``(rate, score)`` on the run's validation set: the same
+        :data:`VALIDATION_EPISODES` episodes at every generation, drawn from ``seed`` with
+        ``purpose="validate"`` (never a training episode). The rate is the fraction of episodes
+        that meet the environment's success rule (0 for an environment without one), the score
+        the mean return. :func:`dnnevo.evolve` chooses the champion by them among the top
+        ``config.validation_candidates`` by fitness; set it to 0 to choose by fitness alone."""
+        run = {**self.settings, "episodes": VALIDATION_EPISODES}
+        result = rollout(networks, self.env, seed=seed, purpose="validate", **run)
+        shape = result.returns.shape
+        rule = getattr(self.env, "success", None)
+        if rule is None or getattr(self.env, "success_rate", None) is None:
+            rates = np.zeros(shape[0])
+        else:
+            ok = self._rule(rule, result.returns.ravel(), result.lengths.ravel())
+            rates = ok.reshape(shape).mean(axis=1)
+        return rates, result.returns.mean(axis=1)
+
+    def _rule(self, rule: Any, returns: npt.NDArray[np.float64],
+              lengths: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
+        """The success rule's verdict on the rows of the last rollout, checked."""
         kind = type(self.env).__name__
         try:
-            ok = np.asarray(rule(result.returns[0], result.lengths[0]))
+            ok = np.asarray(rule(returns, lengths))
         except Exception as e:
             raise TaskError(f"{kind}.success raised {type(e).__name__}: {e}") from e
-        if ok.dtype != np.bool_ or ok.shape != (episodes,):
+        if ok.dtype != np.bool_ or ok.shape != returns.shape:
             raise TaskError(f"{kind}.success returned {ok.dtype} of shape {ok.shape}; expected "
-                            f"booleans of shape ({episodes},), one per episode")
-        return ok, threshold, result
+                            f"booleans of shape {returns.shape}, one per episode")
+        return ok
 
     def succeeds(self, network: _core.Network, seed: int) -> float:
         """1.0 when ``network`` meets the environment's success rule on

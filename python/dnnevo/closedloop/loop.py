@@ -31,9 +31,6 @@ from dnnevo.errors import InvalidArgumentError, TaskError
 
 __all__ = ["Rollout", "rollout"]
 
-#: The observation dtypes the batch reads without a copy.
-_FLOATS = (np.dtype(np.float64), np.dtype(np.float32))
-
 
 @dataclass(frozen=True)
 class Rollout:
@@ -84,15 +81,16 @@ def rollout(
     labels = np.tile(np.arange(episodes, dtype=np.int64), batch.networks)
     obs = _observations(_call(env, "reset", labels, rng), env, "reset", rows, m)
     active = np.ones(rows, dtype=bool)
+    ended = np.empty(rows, dtype=bool)
     returns = np.zeros(rows)
-    lengths = np.zeros(rows, dtype=np.int64)
+    lengths = np.full(rows, max_steps, dtype=np.int64)  # rows still running at the limit
     rates = np.empty((rows, batch.size))
     # The environment sees read-only views: it can neither change what the loop keeps nor
     # hand the rates back as the next observations to be written over.
     seen_rates, seen_active = _read_only(rates), _read_only(active)
     step = env.step
     # The loop is the hot path: one call of the batch and one of the environment per time step,
-    # and five whole-array operations. The checks cost nothing while the environment keeps to
+    # and three whole-array operations. The checks cost nothing while the environment keeps to
     # the protocol; when it does not, the slow path finds what is wrong and says so.
     for t in range(max_steps):
         try:
@@ -111,7 +109,7 @@ def rollout(
         except (TypeError, ValueError):
             raise TaskError(f"{_name(env)}.step returned {type(out).__name__}; expected a tuple "
                             "(observations, rewards, done)") from None
-        if type(obs) is not np.ndarray or obs.shape != (rows, m) or obs.dtype not in _FLOATS:
+        if type(obs) is not np.ndarray or obs.shape != (rows, m) or obs.dtype.char not in "df":
             obs = _observations(obs, env, "step", rows, m)
         if np.may_share_memory(obs, rates):
             obs = obs.copy()  # the batch writes the rates while it reads the observations
@@ -119,17 +117,21 @@ def rollout(
             reward = _row_values(reward, env, rows)
         if type(done) is not np.ndarray:
             done = np.asarray(done)
-        if done.shape != (rows,) or done.dtype != np.bool_:
+        if done.shape != (rows,) or done.dtype.char != "?":
             raise TaskError(f"{_name(env)}.step returned done of type {type(done).__name__}, dtype "
                             f"{getattr(done, 'dtype', '?')} and shape {np.shape(done)}; expected a "
                             f"bool array of shape (B,) = ({rows},)")
         np.add(returns, reward, out=returns, where=active)
-        if not math.isfinite(returns.sum()):
-            _check_rewards(reward, env, active)
-        np.add(lengths, 1, out=lengths, where=active)
-        np.greater(active, done, out=active)  # active and not done, in one operation
-        if not active.any():
-            break
+        np.logical_and(active, done, out=ended)
+        if ended.any():  # rare: most steps end no episode
+            if not math.isfinite(returns.sum()):
+                _check_rewards(reward, returns, env, active)
+            lengths[ended] = t + 1
+            np.logical_xor(active, ended, out=active)
+            if not active.any():
+                break
+    if not math.isfinite(returns.sum()):
+        _check_rewards(reward, returns, env, active)
     shape = (batch.networks, episodes)
     return Rollout(returns=returns.reshape(shape), lengths=lengths.reshape(shape))
 
@@ -173,15 +175,20 @@ def _row_values(value: Any, env: Any, rows: int) -> npt.NDArray[Any]:
     return arr
 
 
-def _check_rewards(reward: npt.NDArray[Any], env: Any, active: npt.NDArray[np.bool_]) -> None:
-    """Names a running row's reward that is not finite, or says that the returns overflowed."""
+def _check_rewards(reward: npt.NDArray[Any], returns: npt.NDArray[np.float64], env: Any,
+                   active: npt.NDArray[np.bool_]) -> None:
+    """Names a running row's reward that is not finite in the last step, or else the first row
+    whose return is not finite (an earlier reward, or a sum that overflowed). The returns are
+    checked when an episode ends and when the rollout does, not at every step."""
     bad = ~np.isfinite(reward) & active
     if bad.any():
         r = int(np.flatnonzero(bad)[0])
         raise TaskError(f"{_name(env)}.step returned rewards[{r}] = {reward[r]}; every reward of a "
                         "running episode must be finite")
-    raise TaskError(f"the returns of {_name(env)}'s episodes overflowed (their sum exceeds "
-                    "1.8e308); scale its rewards down")
+    r = int(np.flatnonzero(~np.isfinite(returns))[0])
+    raise TaskError(f"{_name(env)}.step returned rewards that made row {r}'s return "
+                    f"{returns[r]}; every reward of a running episode must be finite, and their "
+                    "sum below 1.8e308 (scale the rewards down if it overflowed)")
 
 
 def _read_only(array: npt.NDArray[Any]) -> npt.NDArray[Any]:

@@ -29,7 +29,7 @@ from dnnevo.closedloop import named
 from dnnevo.closedloop.fitness import ClosedLoop
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError, did_you_mean
-from dnnevo.evolution.ga import GeneticAlgorithm, founders_argument
+from dnnevo.evolution.ga import GeneticAlgorithm, Validate, founders_argument
 from dnnevo.evolution.progress import Progress
 from dnnevo.runs import RunDir, RunFileError, first_difference, short
 
@@ -133,7 +133,9 @@ def evolve(
     ``task`` is a built-in task or preset name, or a Python callable ``fitness(networks) ->
     array`` (slower, but works with everything else, checkpoints included). A callable that
     takes ``generation`` and ``seed`` keywords gets them, to draw each generation's conditions
-    from (see :class:`dnnevo.closedloop.ClosedLoop` for a task in closed loop). With ``out`` the run
+    from (see :class:`dnnevo.closedloop.ClosedLoop` for a task in closed loop); one with a
+    method ``validate(networks, *, seed) -> (rates, scores)`` has its champion chosen on that
+    validation set, as a built-in task has (``config.validation_candidates``). With ``out`` the run
     writes a run folder (see :mod:`dnnevo.runs.rundir`); an existing non-empty folder is refused unless
     ``force``. ``callback(stats, ga)`` runs after every generation; returning True stops the run.
     ``founders`` are networks placed first in the initial population (e.g. from :func:`compose`;
@@ -345,6 +347,18 @@ def _takes_conditions(task: FitnessFn) -> bool:
     return named or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
 
 
+def _validation(task: str | FitnessFn, ga: GeneticAlgorithm) -> Validate | None:
+    """A fitness function's own validation, when it has one (a method ``validate(networks, *,
+    seed) -> (rates, scores)``, as :class:`~dnnevo.closedloop.ClosedLoop` has) and the config
+    asks for candidates; the GA then chooses the champion by it (see
+    :meth:`GeneticAlgorithm.tell`)."""
+    method = getattr(task, "validate", None)
+    if not callable(task) or not callable(method) or ga.config.validation_candidates == 0:
+        return None
+    seed = ga.seed
+    return lambda networks: method(networks, seed=seed)
+
+
 def _fitness_digest(task: FitnessFn) -> str | None:
     """SHA-256 of a Python fitness function's source, so that resume can tell an edited function
     from the run's own; None when Python cannot find the source (e.g. typed at a prompt). A
@@ -423,6 +437,7 @@ def _loop(
     interrupted = False
     saved = ""
     conditions = callable(task) and _takes_conditions(task)
+    validate = _validation(task, ga)
 
     def save_state() -> None:
         if run is not None:
@@ -446,7 +461,7 @@ def _loop(
                             f"the fitness function returned shape {fitness.shape}; "
                             f"expected ({config.population},)"
                         )
-                    stats = ga.tell(fitness)
+                    stats = ga.tell(fitness, validate=validate)
                 else:
                     stats = ga.step(threads=threads).stats
                 seconds = time.perf_counter() - t0

@@ -13,7 +13,7 @@
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -23,7 +23,11 @@ from dnnevo import _core
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 
-__all__ = ["Ask", "GeneticAlgorithm", "Scored"]
+__all__ = ["Ask", "GeneticAlgorithm", "Scored", "Validate"]
+
+Validate = Callable[[list[_core.Network]], tuple[npt.ArrayLike, npt.ArrayLike]]
+"""``validate(networks) -> (rates, scores)``: each network's rate in [0, 1] and finite score on a
+validation set that stays the same for the whole run."""
 
 
 class Ask(NamedTuple):
@@ -75,10 +79,18 @@ class GeneticAlgorithm:
         """The current population."""
         return Ask(self._evo.genomes(), self._evo.networks())
 
-    def tell(self, fitness: npt.ArrayLike) -> dict[str, float]:
+    def tell(self, fitness: npt.ArrayLike, *, validate: Validate | None = None) -> dict[str, float]:
         """Scores the current population (one finite fitness each; >= 0 under proportional
-        selection) and breeds the next. Returns best, mean, std and min of the scored generation."""
-        return self._evo.tell(fitness)
+        selection) and breeds the next. Returns best, mean, std and min of the scored generation.
+
+        The champion is the best network by fitness, or, with ``validate``, by validation as
+        for a built-in task: ``validate(networks) -> (rates, scores)`` judges the networks it is
+        given (of the top ``config.validation_candidates`` by fitness, those not validated in
+        the generation before) on a validation set that stays the same for the whole run; a
+        higher rate in [0, 1] wins, then a higher finite score. It never changes evolution,
+        only which network is the champion.
+        """
+        return self._evo.tell(fitness, validate)
 
     def step(self, *, threads: int | None = None) -> Scored:
         """Scores the current population with the built-in task ``config.task`` and breeds the

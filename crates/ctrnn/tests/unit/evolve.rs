@@ -195,6 +195,71 @@ fn validated_runs_resume_identically_and_elites_are_validated_once() {
 }
 
 #[test]
+fn fitness_told_from_outside_is_validated_as_a_task_validates_it() {
+    // tell_validating with Lucky's own validation runs the same generations, champions and
+    // validations as step with Lucky, elites validated once.
+    let task = Lucky::default();
+    let elitist = GaConfig {
+        elitism: 5,
+        ..config()
+    };
+    let mut a = Evolution::new(task.layout(), elitist.clone(), 4, &[], Fill::Mutants).unwrap();
+    let mut b = Evolution::new(task.layout(), elitist, 4, &[], Fill::Mutants).unwrap();
+    let mut told = 0;
+    for _ in 0..6 {
+        a.step(&task, None).unwrap();
+        let nets = b.networks().unwrap();
+        let fitness = task.evaluate(&nets, b.generation, 4, None).unwrap();
+        b.tell_validating(&fitness, |batch| {
+            told += batch.len();
+            Ok(task.validate(batch, 4, None)?.unwrap())
+        })
+        .unwrap();
+        assert_eq!(a.champion, b.champion);
+        assert_eq!(a.population, b.population);
+    }
+    assert!(
+        told < 6 * 10,
+        "elites carried over are validated once: {told}"
+    );
+}
+
+#[test]
+fn a_validation_told_from_outside_is_checked() {
+    let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
+    let fitness = vec![0.5; 40];
+    for (rate, score) in [(1.5, 0.0), (f64::NAN, 0.0), (0.5, f64::INFINITY)] {
+        let e = evo
+            .tell_validating(&fitness, |batch| {
+                Ok(vec![Validation { rate, score }; batch.len()])
+            })
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a validation gave rate"), "{e}");
+    }
+    let e = evo
+        .tell_validating(&fitness, |_| Ok(vec![]))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("validated 0 networks; it was given 10"), "{e}");
+    assert_eq!(
+        evo.generation, 0,
+        "a refused tell leaves the generation as it was"
+    );
+    evo.tell_validating(&fitness, |batch| {
+        Ok(vec![
+            Validation {
+                rate: 0.5,
+                score: -3.0
+            };
+            batch.len()
+        ])
+    })
+    .unwrap();
+    assert_eq!(evo.champion.unwrap().validation.unwrap().score, -3.0);
+}
+
+#[test]
 fn tasks_without_validation_and_old_checkpoints_choose_by_fitness() {
     let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
     evo.step(&Excite, None).unwrap();

@@ -42,17 +42,27 @@ class FarSeeker:
         self.goal_right = episodes % 2 == 1
         self.landmark = np.where(self.goal_right, -self.landmark_offset, self.landmark_offset)
         self.x = np.zeros(len(episodes))
+        # The goal's end as a signed limit: seeking the right end, x >= 20 reaches it; seeking the
+        # left one, -x >= 20. Steps then work in place on these buffers.
+        self.sign = np.where(self.goal_right, 1.0, -1.0)
+        self._a, self._b = np.empty(len(episodes)), np.empty(len(episodes))
+        self._on = np.empty((len(episodes), 1))
         return self._sense()
 
     def step(self, rates: npt.NDArray[np.float64], active: npt.NDArray[np.bool_]
              ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
         """Moves every agent by ``dt * (f(v_R) - f(v_L))``; an end ends the episode. Agents whose
         episode has ended move too: nothing reads them any more."""
-        self.x += self.dt * (rates[:, self.right_motor] - rates[:, self.left_motor])
-        right, left = self.x >= self.half_length, self.x <= -self.half_length
-        reached = np.where(self.goal_right, right, left)
-        return self._sense(), reached, right | left
+        a, b = self._a, self._b
+        np.subtract(rates[:, self.right_motor], rates[:, self.left_motor], out=a)
+        a *= self.dt
+        self.x += a
+        np.multiply(self.x, self.sign, out=b)  # how far towards the goal's end
+        reached = b >= self.half_length
+        done = np.abs(self.x, out=a) >= self.half_length
+        return self._sense(), reached, done
 
     def _sense(self) -> npt.NDArray[np.float64]:
-        on = np.abs(self.x - self.landmark) <= self.half_width
-        return on.astype(np.float64)[:, None]
+        a = np.subtract(self.x, self.landmark, out=self._a)
+        np.less_equal(np.abs(a, out=a), self.half_width, out=self._on[:, 0])
+        return self._on

@@ -16,6 +16,7 @@ __all__ = [
     "ConfigError",
     "FitnessError",
     "TaskError",
+    "WriteError",
 ]
 
 
@@ -41,6 +42,11 @@ class ConfigError(DnnevoError, ValueError):
 
 class FitnessError(DnnevoError, ValueError):
     """A fitness value cannot be selected on (NaN, or negative under proportional selection)."""
+
+
+class WriteError(DnnevoError, OSError):
+    """A file could not be written: the disk is full, a file-size limit was reached, or the
+    folder is read-only. Files are written whole or not at all, so the file is as it was."""
 
 
 class TaskError(DnnevoError, ValueError):

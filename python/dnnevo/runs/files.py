@@ -4,6 +4,7 @@ file."""
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import tempfile
@@ -11,9 +12,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from dnnevo.errors import DnnevoError
+from dnnevo.errors import DnnevoError, WriteError
 
-__all__ = ['FILE_MODE', 'RunFileError', 'fail', 'load_json', 'number', 'read_text', 'save_figure', 'short', 'write_atomic', 'write_atomic_with']
+__all__ = ['FILE_MODE', 'RunFileError', 'fail', 'load_json', 'number', 'read_text', 'save_figure', 'short', 'write_atomic', 'write_atomic_with', 'write_error']
 
 def _umask() -> int:
     mask = os.umask(0o022)
@@ -33,11 +34,33 @@ def fail(path: Path, problem: str) -> RunFileError:
     return RunFileError(f"{path}: {problem}")
 
 
+#: What a failed write means, by errno; any other is said in the system's words.
+_WRITE_FAILURES = {
+    errno.ENOSPC: "no space is left on the device",
+    errno.EDQUOT: "the disk quota is used up",
+    errno.EFBIG: "it would pass the file-size limit (ulimit -f)",
+    errno.EROFS: "the file system is read-only",
+    errno.EACCES: "permission denied: the folder is read-only to this user",
+    errno.EPERM: "permission denied: the folder is read-only to this user",
+}
+
+
+def write_error(path: Path, error: OSError) -> WriteError:
+    """One line naming the file that could not be written, and why."""
+    why = _WRITE_FAILURES.get(error.errno or 0, error.strerror or str(error))
+    return WriteError(f"{path} could not be written: {why}; what it held before is kept")
+
+
 def write_atomic_with(path: Path, write: Callable[[str], None], *, suffix: str = "") -> None:
     """Calls ``write(tmp)`` on a new, exclusively created temporary file beside ``path`` (named
     ``.NAME.RANDOM.tmp`` + ``suffix``), syncs it and renames it over ``path``. The rename replaces
-    a symlink at ``path``; it never writes through one."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{suffix}")
+    a symlink at ``path``; it never writes through one. A full disk, a file-size limit or a
+    read-only folder is a :class:`~dnnevo.errors.WriteError` naming ``path``; the file is then as
+    it was."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{suffix}")
+    except OSError as e:
+        raise write_error(path, e) from e
     try:
         os.fchmod(fd, FILE_MODE)
         os.close(fd)
@@ -45,8 +68,10 @@ def write_atomic_with(path: Path, write: Callable[[str], None], *, suffix: str =
         with open(tmp, "rb+") as f:
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as e:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(e, OSError) and not isinstance(e, DnnevoError):
+            raise write_error(path, e) from e
         raise
 
 

@@ -14,7 +14,9 @@ from pathlib import Path
 import pytest
 from cli_helpers import run_cli
 
+from dnnevo.cli.command import main
 from dnnevo.errors import WriteError
+from dnnevo.runs import files as files_module
 from dnnevo.runs.files import write_atomic, write_error
 
 QUICK = ("sequence-1bit", "--quick", "--seed", "2")
@@ -75,3 +77,49 @@ def test_each_failure_is_named(tmp_path: Path, code: int, why: str) -> None:
 def test_a_folder_that_cannot_take_the_temporary_file_is_a_write_error(tmp_path: Path) -> None:
     with pytest.raises(WriteError, match="missing/x.json could not be written: No such file"):
         write_atomic(tmp_path / "missing" / "x.json", "{}")
+
+
+@pytest.fixture
+def read_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every file dnnevo writes fails as on a read-only file system (root ignores permissions,
+    so a chmod would not do)."""
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+
+    monkeypatch.setattr(files_module.tempfile, "mkstemp", refuse)
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    run = tmp_path_factory.mktemp("disk") / "run"
+    assert run_cli("run", *QUICK, "--set", "generations=3", "--out", run).returncode == 0
+    return run
+
+
+def snapshot(run: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(run.iterdir())}
+
+
+@pytest.mark.parametrize("command, written", [
+    (["show"], "fitness.png"),
+    (["analyze", "--no-lesions", "--steps", "11"], "analysis.json"),
+])
+def test_reading_commands_answer_on_a_read_only_folder(
+        finished_run: Path, read_only: None, command: list[str], written: str,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    before = snapshot(finished_run)
+    assert main([command[0], str(finished_run), *command[1:]]) == 0
+    out, err = capsys.readouterr()
+    assert "last generation" in out or "analysed in" in out
+    assert (f"dnnevo: note: {finished_run / written} could not be written: the file system is "
+            "read-only; what it held before is kept") in err.splitlines()
+    assert snapshot(finished_run) == before
+
+
+def test_plot_on_a_read_only_folder_is_one_line(finished_run: Path, read_only: None,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["plot", str(finished_run)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith("could not be written: the file system is read-only; "
+                                             "what it held before is kept")

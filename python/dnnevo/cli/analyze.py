@@ -16,6 +16,7 @@ from dnnevo import _core, analysis, plot, tasks
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, InvalidArgumentError
+from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure, write_atomic
 
 EXAMPLE = """examples:
@@ -143,11 +144,13 @@ def analyze(args: argparse.Namespace) -> int:
                          "every": basins[0], "basins": basins[1].tolist()},
         "elapsed_s": elapsed,
     }
-    write_atomic(run.path / "analysis.json", json.dumps(doc, indent=1) + "\n")
-    written = ["analysis.json", *_figures(run, net, found, bif, table, outputs, neurons, name)]
-    written.append(_basin_figure(run, config, trials, basins, found[0], bif, name))
+    text = json.dumps(doc, indent=1) + "\n"
+    written = ["analysis.json"] if try_write(lambda: write_atomic(run.path / "analysis.json", text)) else []
+    written += _figures(run, net, found, bif, table, outputs, neurons, name)
+    written += _basin_figure(run, config, trials, basins, found[0], bif, name)
     print("\n".join(summary(found, bif, table, name, basins, output=output_neuron(config))))
-    print(f"analysed in {elapsed:.1f} s; wrote {', '.join(str(run.path / w) for w in written)}")
+    wrote = ", ".join(str(run.path / w) for w in written) if written else "nothing"
+    print(f"analysed in {elapsed:.1f} s; wrote {wrote}")
     return 0
 
 
@@ -168,9 +171,9 @@ def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifu
                              title=f"{run.path.name}: equilibria as {label} varies")
         elif table is not None:
             analysis.plot_lesions(table, ax, title=f"{run.path.name}: lesions")
-        save_figure(fig, run.path / name)
+        if try_write(lambda: save_figure(fig, run.path / name)):
+            written.append(name)
         plot.close(fig)
-        written.append(name)
     return written
 
 
@@ -194,7 +197,7 @@ def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.n
 
 
 def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.ndarray, np.ndarray]],
-                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str) -> str:
+                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str) -> list[str]:
     every, which = basins
     outputs = np.vstack([o for o, _ in trials])[::every]
     inputs = np.vstack([i for _, i in trials])[::every]
@@ -209,9 +212,9 @@ def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.nd
                 level_label=f"folds of the {name} sweep",
                 title=f"{run.path.name}: recorded trials; background: where the state would settle "
                       f"with input {off.label}")
-    save_figure(fig, run.path / "analysis-basins.png")
+    saved = try_write(lambda: save_figure(fig, run.path / "analysis-basins.png"))
     plot.close(fig)
-    return "analysis-basins.png"
+    return ["analysis-basins.png"] if saved else []
 
 
 def _moving_neuron(bif: Bifurcation) -> int:

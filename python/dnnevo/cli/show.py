@@ -27,6 +27,7 @@ from dnnevo import plot
 from dnnevo.config import EvolutionConfig
 from dnnevo.closedloop import named
 from dnnevo.config import PYTHON_TASK
+from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure
 
 __all__ = ["champion_line", "next_line", "outcome", "show", "success_line"]
@@ -109,8 +110,8 @@ def show(args: argparse.Namespace) -> int:
           f"gen mean {last['mean']:.4f}")
     arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
     ax = plot.plot_fitness(arrays, title=f"{config.task}: {args.dir.name}")
-    save_figure(ax.figure, run.path / "fitness.png")
-    print(f"wrote {run.path / 'fitness.png'}")
+    if try_write(lambda: save_figure(ax.figure, run.path / "fitness.png")):
+        print(f"wrote {run.path / 'fitness.png'}")
     for line in lines[2:]:
         print(line)
     return 0

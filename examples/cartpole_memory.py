@@ -6,7 +6,9 @@ evolves two populations with the same GA and budget: CTRNNs of 5 neurons, and re
 (the same 5 neurons with no recurrent weights and time constants equal to the step, so that
 each step's output depends on that step's input alone). Each champion is then judged on 100
 fresh episodes it never met (``purpose="evaluate"``, one seed per episode, a seed no run used);
-a champion counts as solving when its mean return is at least 475 (CartPole-v1's own line)::
+each champion is the network that did best on the run's validation set of 40 other episodes
+(``--no-validation``: the best by training fitness). A champion counts as solving when its mean
+return is at least 475 (CartPole-v1's own line)::
 
     pip install "dnnevo[gym]"
     python examples/cartpole_memory.py --seeds 10 --out cartpole-memory.png
@@ -34,6 +36,7 @@ SOLVED = 475.0  # CartPole-v1 counts as solved at this mean return over 100 epis
 #: Reactive networks: recurrent weights of (almost exactly) zero and time constants of one step.
 REACTIVE = {"weights": [-1e-9, 1e-9], "tau": [0.1, 0.1 + 1e-9]}
 FRESH_SEED = 50_000  # seed s's champions are judged on episodes from seed FRESH_SEED + s
+CANDIDATES = dnnevo.EvolutionConfig().validation_candidates
 
 
 def cartpole(mode: str = "vector_entry_point") -> GymEnvironment:
@@ -42,11 +45,14 @@ def cartpole(mode: str = "vector_entry_point") -> GymEnvironment:
 
 
 def champion_return(seed: int, reactive: bool, population: int, generations: int,
-                    episodes: int) -> float:
-    """The mean return, on ``episodes`` fresh episodes, of the champion evolved with ``seed``."""
+                    episodes: int, candidates: int = CANDIDATES) -> float:
+    """The mean return, on ``episodes`` fresh episodes, of the champion evolved with ``seed``,
+    chosen among ``candidates`` per generation on the run's validation set (0: by training
+    fitness)."""
     config = dnnevo.EvolutionConfig(population=population, generations=generations, size=5,
                                     n_inputs=len(SEEN), selection="rank", elitism=5,
-                                    ranges=REACTIVE if reactive else {})
+                                    ranges=REACTIVE if reactive else {},
+                                    validation_candidates=candidates)
     fitness = ClosedLoop(cartpole(), episodes=5, max_steps=500, substeps=2)
     result = dnnevo.evolve(fitness, config, seed=seed, progress=False)
     if result.interrupted:  # Ctrl-C or SIGTERM stops evolve after a generation; stop here too
@@ -62,8 +68,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     p.add_argument("--population", type=int, default=200)
     p.add_argument("--generations", type=int, default=60)
     p.add_argument("--episodes", type=int, default=100, help="fresh episodes per champion")
+    p.add_argument("--no-validation", action="store_true",
+                   help="choose each champion by training fitness, not on the validation set")
     p.add_argument("--out", type=Path, help="write the figure here (PNG)")
     args = p.parse_args(argv)
+    candidates = 0 if args.no_validation else CANDIDATES
     kinds = {"CTRNN": False, "reactive": True}
     returns: dict[str, list[float]] = {kind: [] for kind in kinds}
     print("| seed | " + " | ".join(f"{kind} fresh mean return" for kind in kinds) + " |")
@@ -71,7 +80,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     for seed in range(args.seeds):
         for kind, reactive in kinds.items():
             returns[kind].append(champion_return(seed, reactive, args.population,
-                                                 args.generations, args.episodes))
+                                                 args.generations, args.episodes, candidates))
         print(f"| {seed} | " + " | ".join(f"{returns[k][-1]:.1f}" for k in kinds) + " |")
     for kind in kinds:
         solved = sum(r >= SOLVED for r in returns[kind])

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 import sys
 from pathlib import Path
 
@@ -18,6 +19,9 @@ import nav1d_transfer  # noqa: E402
 import trigger_answers  # noqa: E402
 import cartpole_memory  # noqa: E402
 import double_pole  # noqa: E402
+import categorical_perception  # noqa: E402
+import legged_walker  # noqa: E402
+import pendulum  # noqa: E402
 
 
 def test_incremental_plateau(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -98,3 +102,67 @@ def test_double_pole(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
     assert lines[1].split()[:2] == ["0", ">30"]
     assert lines[-1].startswith("solved 0 of 2 seeds within 30 evaluations (95% interval 0%-")
     assert_png(tmp_path / "d.png")
+
+
+def test_categorical_perception(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A row per seed with both steps' counts and intervals, the summary, and the figure."""
+    from cli_helpers import assert_png
+
+    categorical_perception.main(["--seeds", "2", "--population", "6", "--generations", "1",
+                                 "--episodes", "2", "--out", str(tmp_path / "c.png")])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("seed  correct at dt 0.1") and len(lines) == 5
+    assert [line.split()[0] for line in lines[1:3]] == ["0", "1"]
+    assert "/202 (" in lines[1]
+    assert re.fullmatch(r"[0-2] of 2 seeds classify at least 90% of the grid correctly at both "
+                        r"steps \(95% interval \d+%-\d+%\)", lines[3])
+    assert re.fullmatch(r"median correct at dt 0.1: \d+ of 202", lines[4])
+    assert_png(tmp_path / "c.png")
+
+
+def test_categorical_perception_refuses_an_odd_episode_count(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        categorical_perception.main(["--episodes", "3"])
+    assert "--episodes is 3; it must be an even number >= 2" in capsys.readouterr().err
+
+
+def test_legged_walker(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The optimum, a row per seed with its verdict, the summary, and the figure."""
+    from cli_helpers import assert_png
+
+    legged_walker.main(["--seeds", "2", "--population", "6", "--generations", "1",
+                        "--episodes", "1", "--out", str(tmp_path / "w.png")])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "optimal controller: 0.6264; walking: at least 0.3132"
+    assert lines[1].startswith("seed  velocity  walks") and len(lines) == 6
+    assert [line.split()[0] for line in lines[2:4]] == ["0", "1"]
+    assert all(line.endswith(("does not walk", "central", "needs its sensor")) for line in lines[2:4])
+    assert re.fullmatch(r"[0-2] of 2 seeds walk in at least 90% of fresh starts \(95% interval "
+                        r"\d+%-\d+%\); [0-2] of them walk with the sensor cut", lines[4])
+    assert_png(tmp_path / "w.png")
+
+
+def test_pendulum(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The torque-0 baseline, a row per seed with its interval and upright count, the figure."""
+    from cli_helpers import assert_png
+
+    pendulum.main(["--seeds", "1", "--population", "6", "--generations", "1", "--episodes", "1",
+                   "--out", str(tmp_path / "p.png")])
+    lines = capsys.readouterr().out.splitlines()
+    assert re.fullmatch(r"torque 0 throughout: fresh mean return -\d+\.\d", lines[0])
+    assert re.fullmatch(r"\s+0\s+-?\d+\.\d \(\s*-?\d+\.\d to\s+-?\d+\.\d\)\s+\d+/100 "
+                        r"\(\d+%-\d+%\)\s+\d+", lines[2])
+    assert lines[3].startswith("median of the seeds' fresh mean returns: ")
+    assert_png(tmp_path / "p.png")
+
+
+def test_legged_walker_without_its_sensor(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Evolved without the sensor, a walker that walks is central by construction, and the
+    figure draws its one gait."""
+    from cli_helpers import assert_png
+
+    legged_walker.main(["--seeds", "1", "--population", "6", "--generations", "1",
+                        "--episodes", "1", "--no-sensor", "--out", str(tmp_path / "w.png")])
+    row = capsys.readouterr().out.splitlines()[2]
+    assert row.endswith(("does not walk", "central"))
+    assert_png(tmp_path / "w.png")

@@ -33,13 +33,13 @@ FULL = 20.0
 interrupted call was stopped, not finished."""
 
 
-def sized(call: Callable[[int], Any], small: int) -> int:
+def sized(call: Callable[[int], Any], small: int, cap: int) -> int:
     """The size at which ``call(size)`` runs about FULL seconds here, from one timed run at
-    ``small`` (the work grows in proportion to the size)."""
+    ``small`` (the work grows in proportion to the size), at most ``cap`` (memory grows too)."""
     start = time.perf_counter()
     call(small)
     seconds = max(time.perf_counter() - start, 1e-3)
-    return max(small, int(small * FULL / seconds))
+    return max(small, min(cap, int(small * FULL / seconds)))
 
 
 def interrupted_after(call: Callable[[], Any]) -> float:
@@ -70,7 +70,7 @@ def test_run_population_stops_on_ctrl_c() -> None:
     def run(substeps: int) -> Any:
         return dnnevo.run_population(nets, inputs, substeps=substeps, record=False)
 
-    substeps = sized(run, 200)
+    substeps = sized(run, 200, 10**7)
     assert interrupted_after(lambda: run(substeps)) < LATENCY
 
 
@@ -79,7 +79,7 @@ def test_evolution_step_stops_on_ctrl_c_and_keeps_the_population() -> None:
         config = dataclasses.replace(presets.get("sequence-1bit"), population=population)
         return dnnevo.GeneticAlgorithm(config, seed=0)
 
-    ga = scored(sized(lambda p: scored(p).step(), 500))
+    ga = scored(sized(lambda p: scored(p).step(), 500, 400_000))
     before = ga.ask().genomes
     assert interrupted_after(ga.step) < LATENCY
     assert ga.generation == 0
@@ -89,19 +89,19 @@ def test_evolution_step_stops_on_ctrl_c_and_keeps_the_population() -> None:
 def test_sequence_assessment_stops_on_ctrl_c() -> None:
     config = presets.get("sequence-1bit")
     net = dnnevo.Network.random(config.size, config.n_inputs, seed=3)
-    trials = sized(lambda n: sequence.assess(config, net, n, 1), 2000)
+    trials = sized(lambda n: sequence.assess(config, net, n, 1), 2000, 2_000_000)
     assert interrupted_after(lambda: sequence.assess(config, net, trials, 1)) < LATENCY
 
 
 def test_nav1d_assessment_stops_on_ctrl_c() -> None:
     config = presets.get("nav1d-single")
     net = dnnevo.Network.random(config.size, config.n_inputs, seed=3)
-    chains = sized(lambda n: nav1d.assess(config, net, n, 1), 2000)
+    chains = sized(lambda n: nav1d.assess(config, net, n, 1), 2000, 2_000_000)
     assert interrupted_after(lambda: nav1d.assess(config, net, chains, 1)) < LATENCY
 
 
 def test_landmark_assessment_stops_on_ctrl_c() -> None:
     config = presets.get("landmark")
     net = dnnevo.Network.random(config.size, config.n_inputs, seed=3)
-    trials = sized(lambda n: landmark.assess(config, net, n, 1), 200)
+    trials = sized(lambda n: landmark.assess(config, net, n, 1), 200, 200_000)
     assert interrupted_after(lambda: landmark.assess(config, net, trials, 1)) < LATENCY

@@ -146,3 +146,11 @@ def test_bad_settings_are_named() -> None:
         CategoricalPerception(left=2, right=2)
     with pytest.raises(InvalidArgumentError, match="right is -1"):
         CategoricalPerception(right=-1)
+
+
+def test_a_fall_cut_short_is_not_classified_correctly() -> None:
+    net = dnnevo.Network.random(7, 7, seed=0)
+    env = CategoricalPerception(start="grid")
+    result = rollout([net], env, episodes=4, max_steps=10, dt=0.1, substeps=1)
+    assert (result.returns == 0).all()
+    assert not env.success(result.returns[0], result.lengths[0]).any()

@@ -232,6 +232,8 @@ class Broken(Drift):
             reward[3] = np.nan
         if fault == "overflow":
             reward[:] = 1e308
+        if fault == "large once" and self.t == 1:
+            reward[:] = 1e308  # every return finite, though their sum is not
         if fault == "text obs":
             obs = np.array([["a"]] * len(obs))
         if fault == "int done":
@@ -560,3 +562,8 @@ def test_a_sweep_over_a_task_class_judges_every_seed_by_its_rule(tmp_path) -> No
                               "--out", "sw2", *SETTINGS)
     assert ruleless.returncode == 2 and "has no success rule" in ruleless.stderr
     assert not (tmp_path / "sw2").exists()
+
+
+def test_large_finite_returns_are_not_an_error() -> None:
+    result = rollout(networks(4, m=1), Broken("large once"), episodes=2, max_steps=10)
+    assert np.isfinite(result.returns).all() and (result.returns > 1e307).all()

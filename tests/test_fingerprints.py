@@ -18,7 +18,7 @@ import pytest
 
 import dnnevo
 from dnnevo import presets
-from dnnevo.closedloop import ClosedLoop, FarSeeker
+from dnnevo.closedloop import ClosedLoop
 
 TIMINGS = ("elapsed_s", "evals_per_s")
 
@@ -33,10 +33,26 @@ def _founded() -> dnnevo.EvolutionResult:
     return dnnevo.evolve("sequence-1bit", config, seed=5, progress=False, founders=[founder])
 
 
+class Seek:
+    """A task in NumPy with random conditions: reach a target drawn per episode on a line."""
+
+    observation_size = 1
+
+    def reset(self, episodes: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        self.target = rng.uniform(-1.0, 1.0, episodes.max() + 1)[episodes]
+        self.x = np.zeros(len(episodes))
+        return (self.target - self.x)[:, None]
+
+    def step(self, rates: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        self.x = self.x + 0.1 * (rates[:, 1] - rates[:, 0])
+        return ((self.target - self.x)[:, None], -np.abs(self.target - self.x),
+                np.zeros(len(self.x), dtype=bool))
+
+
 def _closed_loop(candidates: int) -> dnnevo.EvolutionResult:
-    config = dnnevo.EvolutionConfig(population=16, generations=3, size=5, n_inputs=1,
+    config = dnnevo.EvolutionConfig(population=16, generations=3, size=3, n_inputs=1,
                                     selection="rank", elitism=2, validation_candidates=candidates)
-    fitness = ClosedLoop(FarSeeker(), episodes=2, max_steps=2000, dt=0.1, substeps=1)
+    fitness = ClosedLoop(Seek(), episodes=2, max_steps=50, dt=0.1, substeps=1)
     return dnnevo.evolve(fitness, config, seed=2, progress=False)
 
 
@@ -66,8 +82,8 @@ RUNS: dict[str, tuple[Callable[[], dnnevo.EvolutionResult], str]] = {
     # Founders placed first, the rest random.
     "sequence, founders": (_founded, "fc5c8c10e392e885"),
     # A task written in NumPy through the protocol, champion by its validation set or by fitness.
-    "closed loop, validated": (lambda: _closed_loop(4), "62c1816b0280f2e7"),
-    "closed loop, by fitness": (lambda: _closed_loop(0), "870c006328e9f72f"),
+    "closed loop, validated": (lambda: _closed_loop(4), "2582994234f6eba1"),
+    "closed loop, by fitness": (lambda: _closed_loop(0), "1057a9a1ab646d54"),
 }
 
 
@@ -87,15 +103,11 @@ def test_each_run_gives_its_pinned_bits(name: str) -> None:
     assert fingerprint(name) == RUNS[name][1]
 
 
-def test_the_runs_differ() -> None:
-    """Each run pins something of its own: no two digests are the same."""
-    digests = [digest for _, digest in RUNS.values()]
-    assert len(set(digests)) == len(digests)
-
-
 def test_a_champion_chosen_otherwise_is_another_champion() -> None:
-    """Validation changes the champion, never the populations: the fitness columns agree."""
+    """Validation changes the champion, never the populations: the fitness columns agree, the
+    champions differ."""
     validated, plain = _closed_loop(4), _closed_loop(0)
     for key in ("best", "mean", "std", "min"):
         np.testing.assert_array_equal(validated.history[key], plain.history[key])
     assert validated.best_validation is not None and plain.best_validation is None
+    assert validated.best.to_json() != plain.best.to_json()

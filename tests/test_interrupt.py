@@ -39,7 +39,10 @@ def sized(call: Callable[[int], Any], small: int, cap: int) -> int:
     start = time.perf_counter()
     call(small)
     seconds = max(time.perf_counter() - start, 1e-3)
-    return max(small, min(cap, int(small * FULL / seconds)))
+    size = max(small, min(cap, int(small * FULL / seconds)))
+    # A call that could end on its own soon after the signal would pass without being stopped.
+    assert seconds * size / small > 4 * (DELAY + LATENCY), f"size {size} would run too briefly"
+    return size
 
 
 def interrupted_after(call: Callable[[], Any]) -> float:

@@ -216,3 +216,18 @@ def test_a_closed_loop_champion_is_chosen_on_its_validation_set() -> None:
     assert validated.best_validation == (rates[0], scores[0])
     assert (rates[0] * VALIDATION_EPISODES) % 1 == 0
     np.testing.assert_array_equal(validated.history["validation_rate"][-1:], rates)
+
+
+def test_validate_may_read_the_ga_it_is_called_from() -> None:
+    """The GA is not held while validate runs: the callable sees the generation being scored."""
+    ga = dnnevo.GeneticAlgorithm(EvolutionConfig(population=10, size=2, n_inputs=1,
+                                                 validation_candidates=3), seed=0)
+    seen: list[int] = []
+
+    def validate(networks: list[dnnevo.Network]) -> tuple[np.ndarray, np.ndarray]:
+        seen.append(ga.generation)
+        return _true_quality(networks)
+
+    for _ in range(2):
+        ga.tell(_square_fitness(ga.ask().networks), validate=validate)
+    assert seen == [0, 1] and ga.generation == 2 and ga.best_validation is not None

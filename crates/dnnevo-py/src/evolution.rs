@@ -191,39 +191,47 @@ impl PyEvolution {
 
     /// Takes the current population's fitness and breeds the next generation. With `validate`,
     /// a callable `validate(networks) -> (rates, scores)`, the champion is chosen by validation
-    /// among the top `validation_candidates`, as for a built-in task.
+    /// among the top `validation_candidates`, as for a built-in task. While `validate` runs, the
+    /// GA is not borrowed: the callable may read it (it sees the generation being scored), and
+    /// the new state replaces the old only when everything succeeded.
     #[pyo3(signature = (fitness, validate=None))]
     fn tell<'py>(
-        &mut self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         fitness: &Bound<'py, PyAny>,
         validate: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let py = slf.py();
+        let population = slf.borrow().inner.config.population;
         let f = dense(fitness, "fitness", FitnessError::new_err)?;
         if f.shape.len() != 1 {
             return Err(FitnessError::new_err(format!(
-                "fitness has shape {}; expected (P,) = ({},)",
-                shape_str(&f.shape),
-                self.inner.config.population
+                "fitness has shape {}; expected (P,) = ({population},)",
+                shape_str(&f.shape)
             )));
         }
-        let inner = &mut self.inner;
         let stats = match validate.filter(|v| !v.is_none()) {
-            None => py.detach(|| inner.tell(&f.data)).py_err()?,
+            None => {
+                let mut this = slf.borrow_mut();
+                let inner = &mut this.inner;
+                py.detach(|| inner.tell(&f.data)).py_err()?
+            }
             Some(validate) => {
+                let mut next = slf.borrow().inner.clone();
                 // A Python error inside `validate` is kept whole and raised as it was.
                 let mut raised: Option<PyErr> = None;
-                let told = inner.tell_validating(&f.data, |batch| {
+                let told = next.tell_validating(&f.data, |batch| {
                     validations(validate, batch).map_err(|e| {
                         let text = e.to_string();
                         raised = Some(e);
                         ctrnn::Error::Fitness(text)
                     })
                 });
-                match (raised, told) {
+                let stats = match (raised, told) {
                     (Some(e), _) => return Err(e),
                     (None, told) => told.py_err()?,
-                }
+                };
+                slf.borrow_mut().inner = next;
+                stats
             }
         };
         stats_dict(py, &stats)

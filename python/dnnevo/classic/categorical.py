@@ -193,10 +193,11 @@ class CategoricalPerception:
     def success(self, returns: npt.NDArray[np.float64], lengths: npt.NDArray[np.int64]
                 ) -> npt.NDArray[np.bool_]:
         """Which episodes of the last rollout were classified correctly: a circle landed on the
-        agent, a diamond did not."""
+        agent, a diamond did not. An episode cut short before its object landed (a rollout with
+        fewer than :attr:`steps` steps) is not classified correctly."""
         reach = AGENT_RADIUS + np.where(self.diamond, DIAMOND_HALF_WIDTH, CIRCLE_RADIUS)
         caught = self.landed < reach
-        return np.asarray(np.where(self.diamond, ~caught, caught))
+        return np.asarray(np.where(self.diamond, ~caught, caught) & ~np.isnan(self.landed))
 
     def _sense(self) -> npt.NDArray[np.float64]:
         d = ray_distances(self.agent, self.x, self.y, self.diamond)

@@ -2,7 +2,7 @@
 reflexive pattern generators, written with the closed-loop protocol
 (:class:`~dnnevo.closedloop.Environment`) as a user would write a task.
 
-A body moves along a line on one leg of length 15, hinged 12.5 above the body's axis. Three
+A body moves along a line on one leg of length 15, hinged to the body. Three
 motor neurons drive it: the foot is down while neuron 0 fires above 0.5; neurons 1 and 2 give
 forward and backward swing forces of up to 0.05 each. With the foot down, the difference of
 the two pushes the body (velocity up to 6), but only while the leg lies within its limits of
@@ -21,8 +21,8 @@ step, ``dt=0.1, substeps=1``); its return is the body's average velocity, the di
 divided by 220.
 
 :func:`optimal_velocity` runs the hand-designed best controller of the model (plant the foot at
-the forward limit, push with full force, lift it when the body would become unstable, swing
-forward at full speed): the upper bound an evolved walker is measured against. An episode
+the forward limit, push with full force, lift it once the foot trails the body by more than 20,
+swing forward at full speed): the upper bound an evolved walker is measured against. An episode
 *walks* (:meth:`LeggedWalker.success`) when its average velocity is at least half that bound.
 
 >>> import dnnevo
@@ -159,8 +159,8 @@ class LeggedWalker:
 def optimal_velocity(dt: float = 0.1) -> float:
     """The average velocity over 220 units of time of the model's best controller, started as
     ``start="forward"`` starts: plant the foot at the forward limit, push forward with full
-    force while the leg is within its limits, lift the foot when the body is about to become
-    unstable, and swing the leg forward at full speed."""
+    force while the leg is within its limits, lift the foot once the foot trails the body by
+    more than 20 (where the body stops), and swing the leg forward at full speed."""
     env = LeggedWalker(dt=dt)
     env.reset(np.zeros(1, dtype=np.int64), np.random.default_rng(0))
     for _ in range(env.steps):

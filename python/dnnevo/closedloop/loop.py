@@ -124,13 +124,13 @@ def rollout(
         np.add(returns, reward, out=returns, where=active)
         np.logical_and(active, done, out=ended)
         if ended.any():  # rare: most steps end no episode
-            if not math.isfinite(returns.sum()):
+            if not np.isfinite(returns).all():
                 _check_rewards(reward, returns, env, active)
             lengths[ended] = t + 1
             np.logical_xor(active, ended, out=active)
             if not active.any():
                 break
-    if not math.isfinite(returns.sum()):
+    if not np.isfinite(returns).all():
         _check_rewards(reward, returns, env, active)
     shape = (batch.networks, episodes)
     return Rollout(returns=returns.reshape(shape), lengths=lengths.reshape(shape))

@@ -88,7 +88,8 @@ class GeneticAlgorithm:
         given (of the top ``config.validation_candidates`` by fitness, those not validated in
         the generation before) on a validation set that stays the same for the whole run; a
         higher rate in [0, 1] wins, then a higher finite score. It never changes evolution,
-        only which network is the champion.
+        only which network is the champion. ``champion_step_check`` is not applied here: a
+        ``validate`` that should check a finer step can validate at both and report the worse.
         """
         return self._evo.tell(fitness, validate)
 

@@ -4,7 +4,9 @@ assess`` judges its champions as it judges the built-in tasks'.
 
 The success rule is the task's own: its class defines ``success_rate``, the fraction of fresh
 episodes that must succeed, and ``success(returns, lengths)``, which says which episodes
-succeeded from their returns and lengths (arrays of shape (E,), one network's episodes). The
+succeeded from their returns and lengths (one value per row of the last rollout: shape (E,),
+one network's episodes, when a champion is judged; every network's rows when a run validates
+its candidates). The
 fresh episodes are drawn with ``purpose="evaluate"``, which no run draws from.
 """
 

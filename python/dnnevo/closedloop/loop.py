@@ -16,7 +16,6 @@ shape, a value that is not finite or an exception names the method and the probl
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any

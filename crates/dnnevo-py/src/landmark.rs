@@ -41,7 +41,7 @@ impl PyLandmarkTask {
     /// (size, n_inputs) of the networks the task drives.
     #[getter]
     fn layout(&self) -> (usize, usize) {
-        crate::run_config::layout(&self.inner)
+        crate::layout::layout(&self.inner)
     }
 
     /// One fresh trial (`Purpose::Evaluate` stream `trial` of `seed`) with `landmark`, recorded

@@ -11,6 +11,7 @@ mod errors;
 mod evolution;
 mod json;
 mod landmark;
+mod layout;
 mod nav1d;
 mod network;
 mod population;

@@ -59,7 +59,7 @@ impl PyNav1dTask {
     /// (size, n_inputs) of the networks the task drives.
     #[getter]
     fn layout(&self) -> (usize, usize) {
-        crate::run_config::layout(&self.inner)
+        crate::layout::layout(&self.inner)
     }
 
     /// Trials per chain of the task's success check: `trials_per_environment` for a `single`

@@ -81,9 +81,3 @@ fn build(py: Python<'_>, run: &RunConfig) -> PyResult<Py<PyAny>> {
         }
     })
 }
-
-/// (size, n_inputs) of the networks a built-in task drives, as the task objects report it.
-pub(crate) fn layout(task: &dyn ctrnn::Task) -> (usize, usize) {
-    let layout = task.layout();
-    (layout.size, layout.n_inputs)
-}

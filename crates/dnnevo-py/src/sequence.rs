@@ -37,7 +37,7 @@ impl PySequenceTask {
     /// (size, n_inputs) of the networks the task drives.
     #[getter]
     fn layout(&self) -> (usize, usize) {
-        crate::run_config::layout(&self.inner)
+        crate::layout::layout(&self.inner)
     }
 
     /// The (delay, gap) of every trigger of a trial, as evolution drew them.

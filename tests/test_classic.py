@@ -104,3 +104,28 @@ def test_bad_settings_are_named() -> None:
         DoublePole(start="random")
     with pytest.raises(InvalidArgumentError, match="steps is 0"):
         DoublePole(steps=0)
+
+
+@pytest.mark.parametrize("name", ["double_pole.DoublePole", "categorical.CategoricalPerception",
+                                  "walker.LeggedWalker"])
+def test_each_classic_task_can_be_named_in_a_config(name: str) -> None:
+    """observation_size is on the class, so `dnnevo run python:...` accepts it before calling it."""
+    from dnnevo.closedloop import named
+
+    assert named.environment_class(f"python:dnnevo.classic.{name}").__name__ == name.split(".")[1]
+
+
+def test_the_walker_runs_and_is_judged_from_the_command_line(tmp_path) -> None:
+    from cli_helpers import run_cli
+
+    run = tmp_path / "walker"
+    r = run_cli("run", "python:dnnevo.classic.walker.LeggedWalker", "--set", "n_inputs=1",
+                "--set", "size=5", "--set", "selection=rank", "--set", "population=8",
+                "--set", "generations=2",
+                "--set", "integrator.substeps=1", "--set", "task_params.episodes=2",
+                "--set", "task_params.max_steps=2200", "--set", "task_params.start=random",
+                "--out", run)
+    assert r.returncode == 0, r.stderr
+    assert 'task = "python:dnnevo.classic.walker.LeggedWalker"' in (run / "config.toml").read_text()
+    r = run_cli("assess", run, "--trials", "10")
+    assert r.returncode in (0, 1) and "success needs >= 90%" in r.stdout, r.stdout + r.stderr

@@ -133,6 +133,8 @@ class CategoricalPerception:
 
     success_rate = 0.9
     """The fraction of episodes a network must classify correctly to succeed."""
+    observation_size = RAYS
+    """The seven rays."""
 
     def __init__(self, *, start: str = "random", dt: float = 0.1, left: int = 0,
                  right: int = 1) -> None:
@@ -148,7 +150,6 @@ class CategoricalPerception:
         self.start = start
         self.dt = float(dt)
         self.left, self.right = left, right
-        self.observation_size = RAYS
 
     @property
     def steps(self) -> int:

@@ -125,7 +125,11 @@ class DoublePole:
         self.start = start
         self.steps = steps
         self.output = output
-        self.observation_size = 6 if self.velocities else 3
+
+    @property
+    def observation_size(self) -> int:
+        """The sensors: 6 with velocities, 3 without."""
+        return 6 if self.velocities else 3
 
     def reset(self, episodes: npt.NDArray[np.int64], rng: np.random.Generator) -> npt.NDArray[np.float64]:
         """Every row at its start; the starts are fixed, so ``rng`` is not used."""

@@ -74,6 +74,8 @@ class LeggedWalker:
 
     success_rate = 0.9
     """The fraction of episodes that must walk."""
+    observation_size = 1
+    """The leg's angle (0 throughout with ``sensor=False``)."""
 
     def __init__(self, *, sensor: bool = True, start: str = "forward", dt: float = 0.1) -> None:
         if start not in ("forward", "random"):
@@ -83,7 +85,6 @@ class LeggedWalker:
         self.sensor = bool(sensor)
         self.start = start
         self.dt = float(dt)
-        self.observation_size = 1
 
     @property
     def steps(self) -> int:

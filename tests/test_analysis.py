@@ -67,6 +67,24 @@ def test_centre_crossing_equilibrium_and_eigenvalues() -> None:
     assert e.stability == "stable_focus" and e.time_scale == pytest.approx(1 / (1 - a / 4))
 
 
+def test_results_are_the_cores_types_with_arrays_and_plain_dicts() -> None:
+    net = centre_pair(5.5, 2.0)
+    (e,) = analysis.equilibria(net)
+    (c,) = analysis.limit_cycles(net)
+    b = analysis.bifurcation(net, 0, -2.0, 2.0, steps=5, cycle_starts=2)
+    assert (type(e), type(c), type(b)) == (_core.Equilibrium, _core.Cycle, _core.Bifurcation)
+    assert analysis.STABILITIES == tuple(_core.STABILITIES) and e.stability in analysis.STABILITIES
+    assert e.eigenvalues.dtype == np.complex128 and c.output_range.shape == (2, 2)
+    d = json.loads(json.dumps(e.to_dict()))
+    assert d["eigenvalues"] == [[z.real, z.imag] for z in e.eigenvalues] and d["stability"] == e.stability
+    assert "orbit" in c.to_dict() and "orbit" not in c.to_dict(orbit=False)
+    bd = b.to_dict()
+    assert bd["index"] == 0 and bd["input"] == [0.0] and bd["values"] == b.values.tolist()
+    assert all("orbit" not in cycle for row in bd["cycles"] for cycle in row) and bd["even"] == b.even
+    assert [len(row) for row in b.equilibria] == [len(row) for row in bd["equilibria"]]
+    assert all(type(x) is _core.CycleBranch for x in b.branches)
+
+
 def measured_period(net: dnnevo.Network) -> float:
     """The period of neuron 0 by the network's own RK4, from upward crossings of its threshold."""
     net = net.copy()

@@ -15,6 +15,7 @@ __all__ = [
     "SEQUENCE_SUCCESS_FRACTION",
     "MUTATION_SCALE",
     "RETRY_STARTS",
+    "STABILITIES",
     "RUN_DEFAULTS",
     "STEP_CHECK_FINER",
     "Batch",
@@ -29,6 +30,12 @@ __all__ = [
     "Nav1dRecord",
     "LandmarkRecord",
     "Trace",
+    "Equilibrium",
+    "Cycle",
+    "Event",
+    "CycleEnd",
+    "CycleBranch",
+    "Bifurcation",
     "__version__",
     "apply_simd_env",
     "build_info",
@@ -55,6 +62,7 @@ RUN_DEFAULTS: str
 MAX_COUNT: int
 MUTATION_SCALE: float
 RETRY_STARTS: int
+STABILITIES: list[str]
 STEP_CHECK_FINER: int
 SEQUENCE_SUCCESS_FRACTION: float
 NAV1D_SUCCESS_RATE: float
@@ -433,6 +441,188 @@ def sim2d_landmark_world(n: int) -> dict[str, Any]: ...
 
 # -- dynamical analysis -----------------------------------------------------------------------
 
+@final
+class Equilibrium:
+    """One equilibrium and its linear stability."""
+
+    @property
+    def state(self) -> _Array:
+        """The state v (length N)."""
+    @property
+    def outputs(self) -> _Array:
+        """The firing rates ``f(v - theta)`` there."""
+    @property
+    def eigenvalues(self) -> npt.NDArray[np.complex128]:
+        """Eigenvalues of the Jacobian of ``dv/dt``, largest real part first."""
+    @property
+    def stability(self) -> str:
+        """One of ``STABILITIES``."""
+    @property
+    def unstable_dimensions(self) -> int:
+        """How many eigenvalues have a positive real part."""
+    @property
+    def time_scale(self) -> float | None:
+        """``1 / min |Re lambda|``: how long the slowest direction takes to approach (or leave) by
+        a factor e. None when non-hyperbolic."""
+    @property
+    def residual(self) -> float:
+        """``max_i tau_i |dv_i/dt|`` there (at most the search's tolerance)."""
+    @property
+    def stable(self) -> bool:
+        """Whether nearby states approach it (a stable node or focus)."""
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types (eigenvalues as ``[re, im]`` pairs)."""
+
+@final
+class Cycle:
+    """One attracting limit cycle."""
+
+    @property
+    def period(self) -> float:
+        """The period, in units of simulated time."""
+    @property
+    def crossings(self) -> int:
+        """Upward crossings of the Poincaré section per period (1 for a simple loop)."""
+    @property
+    def section_neuron(self) -> int:
+        """The neuron whose level defines the section."""
+    @property
+    def amplitude(self) -> _Array:
+        """Per neuron, max minus min of the state over one period."""
+    @property
+    def mean_outputs(self) -> _Array:
+        """Per neuron, the mean firing rate over one period."""
+    @property
+    def output_range(self) -> _Array:
+        """Per neuron, the lowest and highest firing rate over one period, shape (N, 2)."""
+    @property
+    def multipliers(self) -> npt.NDArray[np.complex128]:
+        """Floquet multipliers, largest modulus first; one of them is 1 (along the orbit)."""
+    @property
+    def max_multiplier(self) -> float:
+        """The largest modulus other than the trivial multiplier: below 1 for a stable cycle, and
+        the factor by which a perturbation shrinks per period."""
+    @property
+    def stable(self) -> bool:
+        """Whether every non-trivial multiplier lies inside the unit circle."""
+    @property
+    def orbit(self) -> _Array:
+        """States along one period, shape (K, N)."""
+    def to_dict(self, *, orbit: bool = True) -> dict[str, Any]:
+        """As plain JSON types; ``orbit=False`` leaves the orbit out."""
+
+@final
+class Event:
+    """A fold or Hopf point of a sweep."""
+
+    @property
+    def kind(self) -> str:
+        """``"fold"`` or ``"hopf"``."""
+    @property
+    def value(self) -> float:
+        """The input value where it happens."""
+    @property
+    def state(self) -> _Array:
+        """The equilibrium there: two events at nearly the same value are told apart by it (two
+        folds at one value are two different pairs of equilibria meeting)."""
+    @property
+    def outputs(self) -> _Array:
+        """The firing rates ``f(v - theta)`` at ``state``."""
+    @property
+    def eigenvalue(self) -> complex:
+        """The critical eigenvalue: real and near 0 (fold), or near ``i omega`` (Hopf)."""
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types."""
+
+@final
+class CycleEnd:
+    """Where a cycle branch appears or disappears in a sweep."""
+
+    @property
+    def kind(self) -> str:
+        """``"hopf"`` (the cycle shrinks onto an equilibrium at a Hopf point of the sweep) or
+        ``"lost"`` (it stops being found: a fold of cycles, a homoclinic orbit, or a change the
+        search missed)."""
+    @property
+    def value(self) -> float:
+        """The input value of the end: the Hopf point's, or the last value (by bisection) where
+        the cycle was still found."""
+    @property
+    def with_cycle(self) -> float:
+        """The swept value next to the end where the cycle was found."""
+    @property
+    def without_cycle(self) -> float:
+        """The swept value next to the end, on the other side, where it was not."""
+    @property
+    def period(self) -> float:
+        """The period at the end: ``2 pi / omega`` of a Hopf point's eigenvalues ``±i omega``, or
+        the last cycle the bisection found. A lost cycle whose period grows towards its end ends
+        at a homoclinic orbit or a saddle-node on the cycle; one whose period stays finite, at a
+        fold of cycles."""
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types."""
+
+@final
+class CycleBranch:
+    """One attracting cycle followed across consecutive swept values."""
+
+    @property
+    def id(self) -> int:
+        """Its number, in order of appearance in the sweep (``Bifurcation.cycle_branch`` refers
+        to it)."""
+    @property
+    def first(self) -> int:
+        """Index of the first swept value with the cycle."""
+    @property
+    def last(self) -> int:
+        """Index of the last swept value with the cycle."""
+    @property
+    def start(self) -> CycleEnd | None:
+        """Where it appears (in sweep order), None if it is there at the first value."""
+    @property
+    def end(self) -> CycleEnd | None:
+        """Where it disappears, None if it is there at the last value."""
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types."""
+
+@final
+class Bifurcation:
+    """A sweep of input ``index``: the equilibria at each value and the events between them."""
+
+    @property
+    def index(self) -> int:
+        """The index of the swept input."""
+    @property
+    def input(self) -> _Array:
+        """The other inputs' values (entry ``index`` is swept)."""
+    @property
+    def values(self) -> _Array:
+        """The swept values."""
+    @property
+    def equilibria(self) -> list[list[Equilibrium]]:
+        """The equilibria at each value, sorted by state."""
+    @property
+    def events(self) -> list[Event]:
+        """Folds and Hopf points, by input value."""
+    @property
+    def cycles(self) -> list[list[Cycle]]:
+        """The attracting cycles at each value (empty lists unless the sweep searched for them)."""
+    @property
+    def cycle_branch(self) -> list[list[int]]:
+        """The branch id of each cycle, parallel to ``cycles``: an index into ``branches``."""
+    @property
+    def branches(self) -> list[CycleBranch]:
+        """The cycles followed across values, by id."""
+    @property
+    def retried(self) -> list[float]:
+        """The values where the first search found an even number of equilibria and searched
+        again with ``RETRY_STARTS`` (or the sweep's ``retry_starts``) starts."""
+    @property
+    def even(self) -> list[float]:
+        """The values where the count of equilibria is still even: some were missed there."""
+    def to_dict(self) -> dict[str, Any]:
+        """As plain JSON types (cycles without their orbits)."""
+
 def analysis_equilibria(
     net: Network,
     input: Sequence[float],
@@ -443,7 +633,7 @@ def analysis_equilibria(
     max_iterations: int = 100,
     seed: int = 0,
     retry_starts: int | None = None,
-) -> list[dict[str, Any]]: ...
+) -> list[Equilibrium]: ...
 def analysis_cycles(
     net: Network,
     input: Sequence[float],
@@ -456,7 +646,7 @@ def analysis_cycles(
     tolerance: float = 1e-05,
     orbit_points: int = 200,
     seed: int = 1,
-) -> list[dict[str, Any]]: ...
+) -> list[Cycle]: ...
 def analysis_bifurcation(
     net: Network,
     input: Sequence[float],
@@ -472,4 +662,4 @@ def analysis_bifurcation(
     seed: int = 0,
     cycle_starts: int = 0,
     retry_starts: int | None = None,
-) -> dict[str, Any]: ...
+) -> Bifurcation: ...

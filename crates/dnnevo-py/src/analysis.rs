@@ -1,13 +1,13 @@
 //! Dynamical analysis for `dnnevo.analysis`: equilibria, limit cycles and bifurcation sweeps of a
-//! network under a constant input. Results cross as Python values, read into dataclasses by
-//! the Python wrapper. Each call runs with the GIL released and stops on Ctrl-C.
+//! network under a constant input. Results cross as the typed objects of `dynamics.rs`. Each call
+//! runs with the GIL released and stops on Ctrl-C.
 
 use ctrnn::analysis::{self, CycleSearch, EquilibriumSearch, Sweep};
 use pyo3::prelude::*;
 
 use crate::arrays::{arg_err, AnyInt};
 use crate::detach::detached;
-use crate::json::to_py;
+use crate::dynamics::{PyBifurcation, PyCycle, PyEquilibrium};
 use crate::network::PyNetwork;
 
 /// A count argument in `[min, MAX_COUNT]` as `usize`, or `InvalidArgumentError` naming it.
@@ -34,7 +34,7 @@ fn retry(value: Option<&AnyInt>) -> PyResult<usize> {
     }
 }
 
-/// Every equilibrium Newton's method reaches, with eigenvalues and stability, as a dict; searched
+/// Every equilibrium Newton's method reaches, with eigenvalues and stability, as `Equilibrium` objects; searched
 /// again with `retry_starts` starts (None: the core's default) when the count is even.
 #[pyfunction]
 #[pyo3(signature = (net, input, *, starts=AnyInt::from(512), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, retry_starts=None)")]
@@ -49,7 +49,7 @@ pub fn analysis_equilibria<'py>(
     max_iterations: AnyInt,
     seed: AnyInt,
     retry_starts: Option<AnyInt>,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<Vec<PyEquilibrium>> {
     let settings = EquilibriumSearch {
         starts: count("starts", &starts, 1)?,
         tolerance,
@@ -63,10 +63,13 @@ pub fn analysis_equilibria<'py>(
     let cost = starts as f64 * settings.max_iterations as f64 * n * n * n;
     let net = &net.inner;
     let found = detached(py, cost, |_| analysis::equilibria(net, &input, &settings))?;
-    to_py(py, &found)
+    found
+        .into_iter()
+        .map(|e| PyEquilibrium::new(py, e))
+        .collect()
 }
 
-/// The attracting limit cycles reached from the search's starts, as a dict.
+/// The attracting limit cycles reached from the search's starts, as `Cycle` objects.
 #[pyfunction]
 #[pyo3(signature = (net, input, *, starts=AnyInt::from(8), steps_per_tau=AnyInt::from(20), transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=AnyInt::from(200), seed=AnyInt::from(1)), text_signature = "(net, input, *, starts=8, steps_per_tau=20, transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=200, seed=1)")]
 #[allow(clippy::too_many_arguments)]
@@ -82,7 +85,7 @@ pub fn analysis_cycles<'py>(
     tolerance: f64,
     orbit_points: AnyInt,
     seed: AnyInt,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<Vec<PyCycle>> {
     let settings = CycleSearch {
         starts: count("starts", &starts, 1)?,
         steps_per_tau: count("steps_per_tau", &steps_per_tau, 1)?,
@@ -97,10 +100,10 @@ pub fn analysis_cycles<'py>(
     let found = detached(py, f64::INFINITY, |cancel| {
         analysis::limit_cycles(net, &input, &settings, Some(cancel))
     })?;
-    to_py(py, &found)
+    found.into_iter().map(|c| PyCycle::new(py, c)).collect()
 }
 
-/// A sweep of input `index` from `start` to `stop` with the others held at `input`, as a dict;
+/// A sweep of input `index` from `start` to `stop` with the others held at `input`, as a `Bifurcation`;
 /// with `cycle_starts > 0` it also searches for limit cycles at each value from that many starts
 /// and follows them as branches. `retry_starts` as for `analysis_equilibria`.
 #[pyfunction]
@@ -121,7 +124,7 @@ pub fn analysis_bifurcation<'py>(
     seed: AnyInt,
     cycle_starts: AnyInt,
     retry_starts: Option<AnyInt>,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<PyBifurcation> {
     let cycle_starts = count("cycle_starts", &cycle_starts, 0)?;
     let sweep = Sweep {
         input: count("index", &index, 0)?,
@@ -145,5 +148,5 @@ pub fn analysis_bifurcation<'py>(
     let found = detached(py, f64::INFINITY, |cancel| {
         analysis::bifurcation(net, &input, &sweep, Some(cancel))
     })?;
-    to_py(py, &found)
+    PyBifurcation::new(py, found, input)
 }

@@ -7,6 +7,7 @@ mod analysis;
 mod arrays;
 mod batch;
 mod detach;
+mod dynamics;
 mod errors;
 mod evolution;
 mod json;
@@ -38,6 +39,10 @@ mod _core {
     use super::analysis::{analysis_bifurcation, analysis_cycles, analysis_equilibria};
     #[pymodule_export]
     use super::batch::PyBatch;
+    #[pymodule_export]
+    use super::dynamics::{
+        PyBifurcation, PyCycle, PyCycleBranch, PyCycleEnd, PyEquilibrium, PyEvent,
+    };
     #[pymodule_export]
     use super::evolution::{decode, encode, evaluate, task_names, PyEvolution};
     #[pymodule_export]
@@ -74,6 +79,7 @@ mod _core {
         let defaults = serde_json::to_string(&tasks::RunConfig::default());
         m.add("RUN_DEFAULTS", defaults.expect("defaults always serialise"))?;
         m.add("RETRY_STARTS", ctrnn::analysis::RETRY_STARTS)?;
+        m.add("STABILITIES", super::dynamics::stabilities())?;
         // Each task's success rule, so that Python judges by the core's numbers, never copies.
         m.add(
             "SEQUENCE_SUCCESS_FRACTION",

@@ -13,8 +13,8 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
   the folds (an equilibrium pair appears or vanishes) and Hopf points (a complex pair crosses the
   imaginary axis) located; optionally the attracting cycles followed as :class:`CycleBranch` es,
   each with where it appears and disappears;
-The numerical work is in Rust (``ctrnn::analysis``); this module turns its results into
-dataclasses. The analysis is of the continuous-time system; tasks integrate it with Euler steps
+The numerical work is in Rust (``ctrnn::analysis``), and its results are the core's typed
+objects. The analysis is of the continuous-time system; tasks integrate it with Euler steps
 (``dnnevo assess --dt-check`` tells whether a champion's behaviour depends on the step).
 
 >>> import dnnevo
@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -41,214 +41,22 @@ __all__ = ["RETRY_STARTS", "STABILITIES", "Attractors", "Bifurcation", "Cycle", 
            "Equilibrium", "Event", "attractors", "bifurcation", "equilibria", "limit_cycles",
            "settles_to", "vector_field"]
 
-STABILITIES = ("stable_node", "stable_focus", "saddle", "unstable_node", "unstable_focus", "non_hyperbolic")
+STABILITIES: tuple[str, ...] = tuple(_core.STABILITIES)
 """The stability classes, from the eigenvalues of the Jacobian: every real part negative (a node
 if every eigenvalue is real, else a focus), mixed signs (saddle), every real part positive, or
-some real part 0 within 1e-9 relative (non-hyperbolic: linearisation does not decide)."""
+some real part 0 within 1e-9 relative (non-hyperbolic: linearisation does not decide). The names
+come from the Rust core (``ctrnn::analysis::Stability``)."""
 
 _Array = npt.NDArray[np.float64]
 
-
-def _complex(pairs: Sequence[Sequence[float | None]]) -> npt.NDArray[np.complex128]:
-    return np.array([complex(math.nan if re is None else re, im or 0.0) for re, im in pairs], dtype=complex)
-
-
-def _pairs(z: npt.NDArray[np.complex128]) -> list[list[float]]:
-    return [[float(c.real), float(c.imag)] for c in z]
-
-
-@dataclass(frozen=True)
-class Equilibrium:
-    """One equilibrium and its linear stability."""
-
-    state: _Array
-    """The state v (length N)."""
-    outputs: _Array
-    """The firing rates ``f(v - theta)`` there."""
-    eigenvalues: npt.NDArray[np.complex128]
-    """Eigenvalues of the Jacobian of ``dv/dt``, largest real part first."""
-    stability: str
-    """One of :data:`STABILITIES`."""
-    unstable_dimensions: int
-    """How many eigenvalues have a positive real part."""
-    time_scale: float | None
-    """``1 / min |Re lambda|``: how long the slowest direction takes to approach (or leave) by a
-    factor e. None when non-hyperbolic."""
-    residual: float
-    """``max_i tau_i |dv_i/dt|`` there (at most the search's tolerance)."""
-
-    @property
-    def stable(self) -> bool:
-        """Whether nearby states approach it (a stable node or focus)."""
-        return self.stability in ("stable_node", "stable_focus")
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Equilibrium:
-        """From the JSON form the Rust core returns."""
-        return cls(np.array(d["state"], dtype=float), np.array(d["outputs"], dtype=float),
-                   _complex(d["eigenvalues"]), d["stability"], int(d["unstable_dimensions"]),
-                   d["time_scale"], float(d["residual"]))
-
-    def to_dict(self) -> dict[str, Any]:
-        """As plain JSON types (eigenvalues as ``[re, im]`` pairs)."""
-        return {"state": self.state.tolist(), "outputs": self.outputs.tolist(),
-                "eigenvalues": _pairs(self.eigenvalues), "stability": self.stability,
-                "unstable_dimensions": self.unstable_dimensions, "time_scale": self.time_scale,
-                "residual": self.residual}
-
-
-@dataclass(frozen=True)
-class Cycle:
-    """One attracting limit cycle."""
-
-    period: float
-    crossings: int
-    """Upward crossings of the Poincaré section per period (1 for a simple loop)."""
-    section_neuron: int
-    amplitude: _Array
-    """Per neuron, max minus min of the state over one period."""
-    mean_outputs: _Array
-    output_range: _Array
-    """Per neuron, the lowest and highest firing rate over one period, shape (N, 2)."""
-    multipliers: npt.NDArray[np.complex128]
-    """Floquet multipliers, largest modulus first; one of them is 1 (along the orbit)."""
-    max_multiplier: float
-    """The largest modulus other than the trivial multiplier: below 1 for a stable cycle, and the
-    factor by which a perturbation shrinks per period."""
-    stable: bool
-    orbit: _Array
-    """States along one period, shape (K, N)."""
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Cycle:
-        """From the JSON form the Rust core returns."""
-        return cls(float(d["period"]), int(d["crossings"]), int(d["section_neuron"]),
-                   np.array(d["amplitude"], dtype=float), np.array(d["mean_outputs"], dtype=float),
-                   np.array(d["output_range"], dtype=float).reshape(-1, 2), _complex(d["multipliers"]), float(d["max_multiplier"]), bool(d["stable"]),
-                   np.array(d["orbit"], dtype=float))
-
-    def to_dict(self, *, orbit: bool = True) -> dict[str, Any]:
-        """As plain JSON types; ``orbit=False`` leaves the orbit out."""
-        d: dict[str, Any] = {"period": self.period, "crossings": self.crossings,
-                             "section_neuron": self.section_neuron, "amplitude": self.amplitude.tolist(),
-                             "mean_outputs": self.mean_outputs.tolist(), "output_range": self.output_range.tolist(),
-                             "multipliers": _pairs(self.multipliers), "max_multiplier": self.max_multiplier,
-                             "stable": self.stable}
-        if orbit:
-            d["orbit"] = self.orbit.tolist()
-        return d
-
-
-@dataclass(frozen=True)
-class Event:
-    """A fold or Hopf point of a sweep."""
-
-    kind: str
-    """``"fold"`` or ``"hopf"``."""
-    value: float
-    """The input value where it happens."""
-    state: _Array
-    """The equilibrium there: two events at nearly the same value are told apart by it (two
-    folds at one value are two different pairs of equilibria meeting)."""
-    eigenvalue: complex
-    """The critical eigenvalue: real and near 0 (fold), or near ``i omega`` (Hopf)."""
-    outputs: _Array = field(default_factory=lambda: np.zeros(0))
-    """The firing rates ``f(v - theta)`` at ``state``."""
-
-    def to_dict(self) -> dict[str, Any]:
-        """As plain JSON types."""
-        return {"kind": self.kind, "value": self.value, "state": self.state.tolist(),
-                "outputs": self.outputs.tolist(), "eigenvalue": [self.eigenvalue.real, self.eigenvalue.imag]}
-
-
-@dataclass(frozen=True)
-class CycleEnd:
-    """Where a cycle branch appears or disappears in a sweep."""
-
-    kind: str
-    """``"hopf"`` (the cycle shrinks onto an equilibrium at a Hopf point of the sweep) or
-    ``"lost"`` (it stops being found: a fold of cycles, a homoclinic orbit, or a change the search
-    missed)."""
-    value: float
-    """The input value of the end: the Hopf point's, or the last value (by bisection) where the
-    cycle was still found."""
-    with_cycle: float
-    """The swept value next to the end where the cycle was found."""
-    without_cycle: float
-    """The swept value next to the end, on the other side, where it was not."""
-    period: float
-    """The period at the end: ``2 pi / omega`` of a Hopf point's eigenvalues ``±i omega``, or the
-    last cycle the bisection found. A lost cycle whose period grows towards its end ends at a
-    homoclinic orbit or a saddle-node on the cycle; one whose period stays finite, at a fold of
-    cycles."""
-
-    def to_dict(self) -> dict[str, Any]:
-        """As plain JSON types."""
-        return {"kind": self.kind, "value": self.value, "with_cycle": self.with_cycle,
-                "without_cycle": self.without_cycle, "period": self.period}
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any] | None) -> CycleEnd | None:
-        """From the JSON form the Rust core returns (None stays None)."""
-        if d is None:
-            return None
-        return cls(d["kind"], float(d["value"]), float(d["with_cycle"]), float(d["without_cycle"]),
-                   float(d["period"]))
-
-
-@dataclass(frozen=True)
-class CycleBranch:
-    """One attracting cycle followed across consecutive swept values."""
-
-    id: int
-    first: int
-    """Index of the first swept value with the cycle."""
-    last: int
-    """Index of the last swept value with the cycle."""
-    start: CycleEnd | None
-    """Where it appears (in sweep order), None if it is there at the first value."""
-    end: CycleEnd | None
-    """Where it disappears, None if it is there at the last value."""
-
-    def to_dict(self) -> dict[str, Any]:
-        """As plain JSON types."""
-        return {"id": self.id, "first": self.first, "last": self.last,
-                "start": self.start.to_dict() if self.start else None,
-                "end": self.end.to_dict() if self.end else None}
-
-
-@dataclass(frozen=True)
-class Bifurcation:
-    """A sweep of input ``index``: the equilibria at each value and the events between them."""
-
-    index: int
-    input: _Array
-    """The other inputs' values (entry ``index`` is swept)."""
-    values: _Array
-    equilibria: list[list[Equilibrium]]
-    events: list[Event]
-    cycles: list[list[Cycle]] = field(default_factory=list)
-    """The attracting cycles at each value (empty lists unless the sweep searched for them)."""
-    cycle_branch: list[list[int]] = field(default_factory=list)
-    """The branch id of each cycle, parallel to ``cycles``: an index into ``branches``."""
-    branches: list[CycleBranch] = field(default_factory=list)
-    """The cycles followed across values, by id."""
-    retried: list[float] = field(default_factory=list)
-    """The values where the first search found an even number of equilibria and searched again
-    with :data:`RETRY_STARTS` (or the sweep's ``retry_starts``) starts."""
-
-    @property
-    def even(self) -> list[float]:
-        """The values where the count of equilibria is still even: some were missed there."""
-        return [float(v) for v, row in zip(self.values, self.equilibria, strict=True) if len(row) % 2 == 0]
-
-    def to_dict(self) -> dict[str, Any]:
-        """As plain JSON types (cycles without their orbits)."""
-        return {"index": self.index, "input": self.input.tolist(), "values": self.values.tolist(),
-                "equilibria": [[e.to_dict() for e in row] for row in self.equilibria],
-                "cycles": [[c.to_dict(orbit=False) for c in row] for row in self.cycles],
-                "cycle_branch": self.cycle_branch, "branches": [b.to_dict() for b in self.branches],
-                "events": [e.to_dict() for e in self.events], "retried": self.retried, "even": self.even}
+# The results are the Rust core's own types, built once from its structs with NumPy arrays for
+# their vectors (``crates/dnnevo-py/src/dynamics.rs``); each has ``to_dict()``.
+Equilibrium = _core.Equilibrium
+Cycle = _core.Cycle
+Event = _core.Event
+CycleEnd = _core.CycleEnd
+CycleBranch = _core.CycleBranch
+Bifurcation = _core.Bifurcation
 
 
 def _input(net: _core.Network, value: npt.ArrayLike | None) -> list[float]:
@@ -280,10 +88,9 @@ def equilibria(
     one. None is guaranteed for large N: a generic network has an odd number of equilibria, so
     when the count is even the search is repeated with ``retry_starts`` starts (default
     :data:`RETRY_STARTS`; 0 never). A count that is still even means some were missed."""
-    found = _core.analysis_equilibria(net, _input(net, input), starts=starts, tolerance=tolerance,
+    return _core.analysis_equilibria(net, _input(net, input), starts=starts, tolerance=tolerance,
                                      distinct=distinct, max_iterations=max_iterations, seed=seed,
                                      retry_starts=retry_starts)
-    return [Equilibrium.from_dict(d) for d in found]
 
 
 def limit_cycles(
@@ -298,10 +105,9 @@ def limit_cycles(
     more while watching the upward crossings of the level halfway between the extremes of the
     neuron that moves most. The orbit is closed when a crossing comes within ``tolerance`` of one
     of the 4 before it. Forward integration finds attracting cycles only."""
-    found = _core.analysis_cycles(net, _input(net, input), starts=starts, steps_per_tau=steps_per_tau,
+    return _core.analysis_cycles(net, _input(net, input), starts=starts, steps_per_tau=steps_per_tau,
                                  transient=transient, window=window, tolerance=tolerance,
                                  orbit_points=orbit_points, seed=seed)
-    return [Cycle.from_dict(d) for d in found]
 
 
 def bifurcation(
@@ -317,20 +123,8 @@ def bifurcation(
     disappears; that costs about as much as 100 equilibrium searches per value. A value whose
     count of equilibria is even is searched again with ``retry_starts`` starts (as
     :func:`equilibria`); those values are in ``retried``, and those still even in ``even``."""
-    base = _input(net, input)
-    d = _core.analysis_bifurcation(net, base, index, start, stop, steps=steps, starts=starts,
-                                   seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts)
-    events = [Event(e["kind"], float(e["value"]), np.array(e["state"], dtype=float),
-                    complex(*(math.nan if x is None else x for x in e["eigenvalue"])),
-                    np.array(e["outputs"], dtype=float))
-              for e in d["events"]]
-    return Bifurcation(int(d["input"]), np.array(base), np.array(d["values"], dtype=float),
-                       [[Equilibrium.from_dict(e) for e in row] for row in d["equilibria"]], events,
-                       [[Cycle.from_dict(c) for c in row] for row in d["cycles"]],
-                       [[int(k) for k in row] for row in d["cycle_branch"]],
-                       [CycleBranch(int(b["id"]), int(b["first"]), int(b["last"]), CycleEnd.from_dict(b["start"]),
-                                    CycleEnd.from_dict(b["end"])) for b in d["branches"]],
-                       [float(v) for v in d["retried"]])
+    return _core.analysis_bifurcation(net, _input(net, input), index, start, stop, steps=steps, starts=starts,
+                                      seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts)
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,16 @@ pub enum Stability {
 }
 
 impl Stability {
+    /// Every class, in declaration order.
+    pub const ALL: [Stability; 6] = [
+        Stability::StableNode,
+        Stability::StableFocus,
+        Stability::Saddle,
+        Stability::UnstableNode,
+        Stability::UnstableFocus,
+        Stability::NonHyperbolic,
+    ];
+
     /// Classifies eigenvalues given as `[re, im]` pairs.
     ///
     /// # Example

@@ -218,6 +218,25 @@ def test_a_closed_loop_champion_is_chosen_on_its_validation_set() -> None:
     np.testing.assert_array_equal(validated.history["validation_rate"][-1:], rates)
 
 
+def test_the_validation_set_size_is_a_setting_recorded_only_when_changed() -> None:
+    from dnnevo.closedloop import ClosedLoop
+    from dnnevo.closedloop.named import closed_loop
+
+    default = ClosedLoop(_Reach(), episodes=2, max_steps=20, substeps=1)
+    three = ClosedLoop(_Reach(), episodes=2, max_steps=20, substeps=1, validation_episodes=3)
+    rates, _ = three.validate([dnnevo.Network.random(2, 1, seed=0)], seed=1)
+    assert (rates[0] * 3) % 1 == 0
+    assert "validation_episodes" not in default.configured(EvolutionConfig()).task_params
+    cfg = three.configured(EvolutionConfig(n_inputs=1))
+    assert cfg.task_params["validation_episodes"] == 3
+    assert three.digest() != default.digest()
+    cfg = dataclasses.replace(cfg, task=f"python:{__name__}._Reach")
+    assert closed_loop(cfg).validation_episodes == 3
+    for bad in (0, -1, 2.5, True):
+        with pytest.raises(dnnevo.ConfigError, match="validation_episodes"):
+            ClosedLoop(_Reach(), max_steps=20, validation_episodes=bad)
+
+
 def test_validate_may_read_the_ga_it_is_called_from() -> None:
     """The GA is not held while validate runs: the callable sees the generation being scored."""
     ga = dnnevo.GeneticAlgorithm(EvolutionConfig(population=10, size=2, n_inputs=1,

@@ -56,13 +56,11 @@ def success_rule(env: Any, task: str) -> tuple[Any, float]:
     return rule, float(threshold)
 
 
-
-
-
 class ClosedLoop:
     """``fitness(networks, *, generation, seed)``: the networks' mean returns in ``env``, for
     ``episodes`` episodes of at most ``max_steps`` time steps, each of ``substeps`` integration
     steps of ``dt`` (by default the run config's defaults, as for a task named in a config).
+    The champion is chosen on ``validation_episodes`` episodes of their own (:meth:`validate`).
 
     A run folder names it after the environment's class (or ``name``, ``"python:module.Class"``)
     and records the rollout's settings in ``config.toml``, with a digest of the class's source,
@@ -73,10 +71,16 @@ class ClosedLoop:
 
     def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int,
                  dt: float = _INTEGRATOR.dt, substeps: int = _INTEGRATOR.substeps,
-                 method: str = _INTEGRATOR.method, name: str | None = None) -> None:
+                 method: str = _INTEGRATOR.method, name: str | None = None,
+                 validation_episodes: int = VALIDATION_EPISODES) -> None:
+        if isinstance(validation_episodes, bool) or not isinstance(validation_episodes, int | np.integer) \
+                or validation_episodes < 1:
+            raise ConfigError(f"validation_episodes is {validation_episodes!r}; expected a whole "
+                              "number of episodes, at least 1")
         self.env = env
         self.settings = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps,
                              method=method)
+        self.validation_episodes = int(validation_episodes)
         kind = type(env)
         module, qualname = kind.__module__, kind.__qualname__
         if name is not None:
@@ -90,7 +94,15 @@ class ClosedLoop:
             attributes = vars(env)
         except TypeError:  # a class with __slots__
             attributes = {k: getattr(env, k) for k in getattr(kind, "__slots__", ()) if hasattr(env, k)}
-        self.fitness_source = "\n".join([source, fingerprint(attributes), fingerprint(self.settings)])
+        recorded = self._recorded()
+        self.fitness_source = "\n".join([source, fingerprint(attributes), fingerprint(recorded)])
+
+    def _recorded(self) -> dict[str, Any]:
+        """The settings a run records: the rollout's, and the validation set's size when it is not
+        the default (so that runs from before it was a setting keep their digest)."""
+        if self.validation_episodes == VALIDATION_EPISODES:
+            return dict(self.settings)
+        return {**self.settings, "validation_episodes": self.validation_episodes}
 
     def digest(self) -> str:
         """SHA-256 of :attr:`fitness_source`, as ``config.toml``'s ``fitness_sha256`` records it."""
@@ -102,12 +114,13 @@ class ClosedLoop:
         environment's own parameters are not known, so ``task_params`` holds no others: a
         command that builds the task from the config builds it with its defaults, and the digest
         then tells whether that is the same task."""
-        s = self.settings
+        s = self._recorded()
+        params = {k: s[k] for k in ("episodes", "max_steps", "validation_episodes") if k in s}
         return dataclasses.replace(
             config,
             task=f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}",
             integrator=IntegratorConfig(method=s["method"], dt=s["dt"], substeps=s["substeps"]),
-            task_params={"episodes": s["episodes"], "max_steps": s["max_steps"]},
+            task_params=params,
         )
 
     def judged(self, network: _core.Network, episodes: int, seed: int,
@@ -124,12 +137,13 @@ class ClosedLoop:
     def validate(self, networks: Sequence[_core.Network], *, seed: int
                  ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """Each network's ``(rate, score)`` on the run's validation set: the same
-        :data:`VALIDATION_EPISODES` episodes at every generation, drawn from ``seed`` with
+        ``validation_episodes`` episodes (default :data:`VALIDATION_EPISODES`) at every
+        generation, drawn from ``seed`` with
         ``purpose="validate"`` (never a training episode). The rate is the fraction of episodes
         that meet the environment's success rule (0 for an environment without one), the score
         the mean return. :func:`dnnevo.evolve` chooses the champion by them among the top
         ``config.validation_candidates`` by fitness; set it to 0 to choose by fitness alone."""
-        run = {**self.settings, "episodes": VALIDATION_EPISODES}
+        run = {**self.settings, "episodes": self.validation_episodes}
         result = rollout(networks, self.env, seed=seed, purpose="validate", **run)
         shape = result.returns.shape
         rule = getattr(self.env, "success", None)

@@ -2,7 +2,9 @@
 it from ``config.toml`` alone.
 
 ``config.task = "python:module.Class"`` names the environment class; ``task_params`` holds the
-rollout's ``episodes`` and ``max_steps`` and, besides them, the keyword arguments of the class;
+rollout's ``episodes`` and ``max_steps``, optionally the size of the validation set the champion
+is chosen on (``validation_episodes``, default 40) and, besides them, the keyword arguments of
+the class;
 ``config.integrator`` says how the networks are integrated. For example, ``config.toml``::
 
     task = "python:light.Light"
@@ -36,7 +38,7 @@ from dnnevo.errors import ConfigError, TaskError
 __all__ = ["ROLLOUT_KEYS", "closed_loop", "environment_class", "is_closed_loop", "is_python_task"]
 
 #: The keys of ``task_params`` that set the rollout; every other key goes to the class.
-ROLLOUT_KEYS = ("episodes", "max_steps")
+ROLLOUT_KEYS = ("episodes", "max_steps", "validation_episodes")
 
 #: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
 _MEMBERS = ("observation_size", "reset", "step")

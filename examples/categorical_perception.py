@@ -1,8 +1,8 @@
 """Beer's categorical perception: does an evolved CTRNN catch circles and avoid diamonds at
 positions it was never trained on?
 
-Each seed evolves a population of 7-neuron CTRNNs (neurons 0 and 1 the left and right motors)
-on Beer's performance measure (:class:`dnnevo.classic.CategoricalPerception`), each generation on
+Each seed runs the ``categorical-perception`` preset (``dnnevo presets``): a population of
+7-neuron CTRNNs (neurons 0 and 1 the left and right motors) evolved on Beer's performance measure (:class:`dnnevo.classic.CategoricalPerception`), each generation on
 ``--episodes`` fresh falls (half circles, half diamonds, at random offsets within ±50, the same
 for every network). Its champion is the network that classified best the run's validation set
 of 40 other random falls (``--no-validation``: the best by training fitness, which is often the
@@ -29,33 +29,30 @@ from typing import Any
 import numpy as np
 
 import dnnevo
-from dnnevo import plot
+from dnnevo import plot, presets
 from dnnevo.classic import CategoricalPerception
 from dnnevo.classic import categorical as cp
-from dnnevo.closedloop import ClosedLoop
 from dnnevo.evaluation.stats import wilson
 from dnnevo.runs import save_figure
 
-SIZE = 7
-DT = 0.1
+DT = 0.1  # the preset's step: one Euler step of the network and the world per control step
 FINE_DT = 0.05
 CANDIDATES = dnnevo.EvolutionConfig().validation_candidates
 
 
-def config(population: int, generations: int, candidates: int) -> dnnevo.EvolutionConfig:
-    return dnnevo.EvolutionConfig(population=population, generations=generations, size=SIZE,
-                                  n_inputs=cp.RAYS, selection="rank", elitism=5,
-                                  mutation_rate=0.05, validation_candidates=candidates)
+def config(population: int, generations: int, episodes: int, candidates: int) -> dnnevo.EvolutionConfig:
+    """The ``categorical-perception`` preset with this script's options."""
+    overrides = [f"population={population}", f"generations={generations}",
+                 f"task_params.episodes={episodes}", f"validation_candidates={candidates}"]
+    return presets.get("categorical-perception", overrides=overrides)
 
 
 def one_seed(seed: int, population: int, generations: int, episodes: int,
              candidates: int = CANDIDATES) -> dict[str, Any]:
     """Evolves one seed and tests its champion on the grid at both steps."""
     started = time.perf_counter()
-    env = CategoricalPerception(dt=DT)
-    fitness = ClosedLoop(env, episodes=episodes, max_steps=env.steps, dt=DT, substeps=1)
-    result = dnnevo.evolve(fitness, config(population, generations, candidates), seed=seed,
-                           progress=False)
+    result = dnnevo.evolve("categorical-perception", config(population, generations, episodes, candidates),
+                           seed=seed, progress=False)
     if result.interrupted:  # Ctrl-C or SIGTERM stops evolve after a generation; stop here too
         raise KeyboardInterrupt
     correct, total, performance = cp.grid_accuracy(result.best, dt=DT)

@@ -1,8 +1,8 @@
 """Beer and Gallagher's one-legged walker: how fast do evolved CTRNNs walk, and do they walk by a
 central pattern generator or by reflexes?
 
-Each seed evolves a population of 5-neuron CTRNNs (neuron 0 the foot, 1 and 2 the forward and
-backward swing) on the average velocity of ``--episodes`` episodes from random starting angles
+Each seed runs the ``legged-walker`` preset (``dnnevo presets``): a population of 5-neuron CTRNNs
+(neuron 0 the foot, 1 and 2 the forward and backward swing) evolved on the average velocity of ``--episodes`` episodes from random starting angles
 (:class:`dnnevo.classic.LeggedWalker`), with the leg's angle sensed (``--no-sensor``: never
 sensed, so that only a central pattern generator can walk). Its champion, chosen on the run's
 validation set of 40 other starts, is then judged on 50 fresh starts:
@@ -34,34 +34,33 @@ from typing import Any
 import numpy as np
 
 import dnnevo
-from dnnevo import plot
+from dnnevo import plot, presets
 from dnnevo.analysis import limit_cycles
 from dnnevo.classic import LeggedWalker
 from dnnevo.classic import walker as lw
-from dnnevo.closedloop import ClosedLoop
 from dnnevo.evaluation.stats import wilson
 from dnnevo.runs import save_figure
 
-SIZE = 5
-DT = 0.1
+DT = 0.1  # the preset's step: one Euler step of the network and the body per control step
 FINE_DT = 0.05
 TEST_EPISODES = 50
 TEST_SEED = 2_000_003  # no run uses it: fresh starts for every champion
 GAIT_TIME = 150.0  # the gait drawn: the first 150 of the 220 units of time
 
 
-def config(population: int, generations: int) -> dnnevo.EvolutionConfig:
-    return dnnevo.EvolutionConfig(population=population, generations=generations, size=SIZE,
-                                  n_inputs=1, selection="rank", elitism=5, mutation_rate=0.05)
+def config(population: int, generations: int, episodes: int, sensor: bool) -> dnnevo.EvolutionConfig:
+    """The ``legged-walker`` preset with this script's options."""
+    overrides = [f"population={population}", f"generations={generations}",
+                 f"task_params.episodes={episodes}", f"task_params.sensor={str(sensor).lower()}"]
+    return presets.get("legged-walker", overrides=overrides)
 
 
 def one_seed(seed: int, population: int, generations: int, episodes: int,
              sensor: bool) -> dict[str, Any]:
     """Evolves one seed and judges its champion."""
     started = time.perf_counter()
-    env = LeggedWalker(sensor=sensor, start="random", dt=DT)
-    fitness = ClosedLoop(env, episodes=episodes, max_steps=env.steps, dt=DT, substeps=1)
-    result = dnnevo.evolve(fitness, config(population, generations), seed=seed, progress=False)
+    result = dnnevo.evolve("legged-walker", config(population, generations, episodes, sensor), seed=seed,
+                           progress=False)
     if result.interrupted:  # Ctrl-C or SIGTERM stops evolve after a generation; stop here too
         raise KeyboardInterrupt
     net = result.best

@@ -115,17 +115,15 @@ def test_each_classic_task_can_be_named_in_a_config(name: str) -> None:
     assert named.environment_class(f"python:dnnevo.classic.{name}").__name__ == name.split(".")[1]
 
 
-def test_the_walker_runs_and_is_judged_from_the_command_line(tmp_path) -> None:
+def test_the_walker_preset_runs_resumes_and_is_judged_from_the_command_line(tmp_path) -> None:
     from cli_helpers import run_cli
 
     run = tmp_path / "walker"
-    r = run_cli("run", "python:dnnevo.classic.walker.LeggedWalker", "--set", "n_inputs=1",
-                "--set", "size=5", "--set", "selection=rank", "--set", "population=8",
-                "--set", "generations=2",
-                "--set", "integrator.substeps=1", "--set", "task_params.episodes=2",
-                "--set", "task_params.max_steps=2200", "--set", "task_params.start=random",
-                "--out", run)
+    r = run_cli("run", "legged-walker", "--quick", "--set", "generations=2", "--set", "population=8",
+                "--set", "task_params.episodes=2", "--out", run)
     assert r.returncode == 0, r.stderr
     assert 'task = "python:dnnevo.classic.walker.LeggedWalker"' in (run / "config.toml").read_text()
+    r = run_cli("resume", run, "--generations", "3")
+    assert r.returncode == 0 and "3 generations" in r.stdout, r.stdout + r.stderr
     r = run_cli("assess", run, "--trials", "10")
     assert r.returncode in (0, 1) and "success needs >= 90%" in r.stdout, r.stdout + r.stderr

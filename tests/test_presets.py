@@ -11,12 +11,13 @@ import pytest
 
 import dnnevo
 from dnnevo import presets
+from dnnevo.closedloop import named
 
 
 @pytest.mark.parametrize("name", presets.names())
 def test_every_preset_runs(name: str, tmp_path: Path) -> None:
     full = presets.get(name)
-    assert full.task in dnnevo._core.task_names()
+    assert full.task in dnnevo._core.task_names() or named.is_closed_loop(full)
     config = dataclasses.replace(full, population=6, generations=2, elitism=0, validation_candidates=2)
     result = dnnevo.evolve(name, config, seed=1, progress=False, threads=1)
     assert len(result.history["best"]) == 2 and math.isfinite(result.best_fitness)
@@ -66,7 +67,7 @@ def test_a_misspelt_preset_or_task_gets_a_did_you_mean() -> None:
         presets.get("sequence-2bit-direct1")
     with pytest.raises(dnnevo.ConfigError) as nothing_close:
         presets.get("maze")
-    assert "did you mean" not in str(nothing_close.value) and "presets: landmark, " in str(nothing_close.value)
+    assert "did you mean" not in str(nothing_close.value) and "presets: categorical-perception, landmark, " in str(nothing_close.value)
     # A task name, given alone or with a config that names it: the same message.
     for config in (None, dnnevo.EvolutionConfig(task="sequnce")):
         with pytest.raises(dnnevo.ConfigError, match=r"unknown task 'sequnce' \(did you mean 'sequence'\?\)"):

@@ -10,7 +10,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-from dnnevo.config import PYTHON_TASK, EvolutionConfig, apply_overrides
+from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig, apply_overrides
 from dnnevo.errors import ConfigError, did_you_mean
 
 __all__ = ["Preset", "get", "names", "PRESETS"]
@@ -43,6 +43,18 @@ def _sequence(targets: list[str], size: int, generations: int, mutation: float,
         n_inputs=2,
         task_params={"targets": targets, "trials_per_target": 2, "perf_base": perf_base},
     )
+
+
+#: ``--quick`` for a task written in Python: a demo's population and generations.
+PYTHON_QUICK = {"population": 20, "generations": 5}
+
+
+def _classic(task: str, *, size: int, n_inputs: int, generations: int, **task_params: Any) -> EvolutionConfig:
+    """A classic benchmark of ``dnnevo.classic``: population 100, rank selection, 5 elites, the
+    paper's mutation at 0.05 per gene, one Euler step of 0.1 per control step."""
+    return EvolutionConfig(task=f"{PYTHON_TASK}dnnevo.classic.{task}", population=100, generations=generations,
+                           selection="rank", elitism=5, mutation_rate=0.05, size=size, n_inputs=n_inputs,
+                           integrator=IntegratorConfig(substeps=1), task_params=task_params)
 
 
 _TWO_BIT = ["0", "1", "01", "10"]
@@ -201,17 +213,29 @@ PRESETS: dict[str, Preset] = {
         _sequence(["011", "101", "110"], 10, 700, 0.002, 2 / 3),
         _QUICK,
     ),
+    # The field's classic benchmarks, not in the paper: tasks written in Python with the
+    # closed-loop protocol (dnnevo.classic), run by the examples/ scripts that report their results
+    # (docs/classic.md). The world and the network move together, one Euler step per control step.
+    "legged-walker": Preset(
+        "Beer and Gallagher's one-legged walker with its angle sensor (docs/classic.md); "
+        "5 neurons, 100 x 100, 4 random starts",
+        _classic("walker.LeggedWalker", size=5, n_inputs=1, generations=100, episodes=4,
+                 max_steps=2200, start="random"),
+        PYTHON_QUICK,
+    ),
+    "categorical-perception": Preset(
+        "Beer's categorical perception: catch circles, avoid diamonds (docs/classic.md); "
+        "7 neurons, 100 x 300, 16 falls",
+        _classic("categorical.CategoricalPerception", size=7, n_inputs=7, generations=300,
+                 episodes=16, max_steps=917),
+        PYTHON_QUICK,
+    ),
 }
 
 
 def names() -> list[str]:
     """The preset names, sorted."""
     return sorted(PRESETS)
-
-
-#: ``--quick`` for a task written in Python, which has no preset: a demo's population and
-#: generations.
-PYTHON_QUICK = {"population": 20, "generations": 5}
 
 
 def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -> EvolutionConfig:

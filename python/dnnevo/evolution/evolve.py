@@ -142,6 +142,9 @@ def evolve(
     ``seeds``, its old name, is deprecated). ``run_info`` adds entries to the ``[run]`` table of
     ``config.toml``, e.g. where the founders came from.
     """
+    if isinstance(task, str) and task in presets.names() and named.is_python_task(presets.get(task).task):
+        config = _task_config(task, config)  # a preset of a task written in Python
+        task = config.task
     if isinstance(task, str) and named.is_python_task(task):
         config = dataclasses.replace(config or EvolutionConfig(), task=task)
         task = named.closed_loop(config)  # imports the task's module, checks it, builds it

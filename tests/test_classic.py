@@ -99,9 +99,20 @@ def test_a_random_network_does_not_solve_it() -> None:
     assert result.returns.shape == (1, 625) and (result.lengths < 1000).all()
 
 
+def test_random_starts_fill_the_grids_box_from_the_episodes_generator() -> None:
+    env = DoublePole(start="random")
+    first = env.reset(np.arange(500), np.random.default_rng(5))
+    state = env.state.copy()
+    low, high = np.array(dp.START_SPANS).T
+    assert ((state[:4].T >= low) & (state[:4].T <= high)).all() and (state[4:] == 0).all()
+    assert (state[:4].min(axis=1) < low + 0.1 * (high - low)).all()  # the whole box, not a corner
+    np.testing.assert_array_equal(env.reset(np.arange(500), np.random.default_rng(5)), first)
+    assert not np.array_equal(env.reset(np.arange(500), np.random.default_rng(6)), first)
+
+
 def test_bad_settings_are_named() -> None:
-    with pytest.raises(InvalidArgumentError, match="start is 'random'"):
-        DoublePole(start="random")
+    with pytest.raises(InvalidArgumentError, match="start is 'sideways'"):
+        DoublePole(start="sideways")
     with pytest.raises(InvalidArgumentError, match="steps is 0"):
         DoublePole(steps=0)
 

@@ -43,7 +43,7 @@ from dnnevo import _core
 from dnnevo.closedloop.loop import rollout
 from dnnevo.errors import InvalidArgumentError
 
-__all__ = ["GRID", "STANDARD_START", "DoublePole", "generalization", "long_test", "solves"]
+__all__ = ["GRID", "STANDARD_START", "START_SPANS", "DoublePole", "generalization", "long_test", "solves"]
 
 GRAVITY = -9.8
 CART_MASS = 1.0
@@ -60,10 +60,12 @@ STANDARD_START = (0.0, 0.0, 0.07, 0.0)
 """``(x, x', theta_1, theta_1')`` of the standard start; the short pole starts upright at rest."""
 
 _LEVELS = (0.05, 0.25, 0.5, 0.75, 0.95)
-_SPANS = ((-2.16, 2.16), (-1.35, 1.35), (-np.deg2rad(3.6), np.deg2rad(3.6)),
-          (-np.deg2rad(8.6), np.deg2rad(8.6)))
+START_SPANS = ((-2.16, 2.16), (-1.35, 1.35), (-np.deg2rad(3.6), np.deg2rad(3.6)),
+               (-np.deg2rad(8.6), np.deg2rad(8.6)))
+"""The box the generalisation grid spans, ``(low, high)`` of ``x``, ``x'``, ``theta_1`` and
+``theta_1'``; ``start="random"`` draws from it."""
 GRID: npt.NDArray[np.float64] = np.array(
-    [[lo + level * (hi - lo) for level, (lo, hi) in zip(levels, _SPANS, strict=True)]
+    [[lo + level * (hi - lo) for level, (lo, hi) in zip(levels, START_SPANS, strict=True)]
      for levels in itertools.product(_LEVELS, repeat=4)])
 """The 625 starts of the generalisation test, ``(x, x', theta_1, theta_1')``: every combination
 of 5%, 25%, 50%, 75% and 95% of the ranges ±2.16 m, ±1.35 m/s, ±3.6 degrees and
@@ -106,9 +108,11 @@ def _advance(s: npt.NDArray[np.float64], force: npt.NDArray[np.float64]) -> npt.
 class DoublePole:
     """Double-pole balancing; see the module docs.
 
-    ``start`` is ``"standard"`` (every episode from :data:`STANDARD_START`) or ``"grid"``
-    (episode ``e`` from ``GRID[e % 625]``). An episode lasts at most ``steps`` control steps;
-    the network's output is neuron ``output``.
+    ``start`` is ``"standard"`` (every episode from :data:`STANDARD_START`), ``"grid"``
+    (episode ``e`` from ``GRID[e % 625]``) or ``"random"`` (each episode from a point drawn
+    uniformly from the box the grid spans, :data:`START_SPANS`, with the short pole upright at
+    rest: training on varied starts, which the benchmark's own setup does not do). An episode
+    lasts at most ``steps`` control steps; the network's output is neuron ``output``.
     """
 
     success_rate = GENERALIZATION_NEEDED / len(GRID)
@@ -117,8 +121,8 @@ class DoublePole:
 
     def __init__(self, *, velocities: bool = False, start: str = "standard",
                  steps: int = GENERALIZATION_STEPS, output: int = 0) -> None:
-        if start not in ("standard", "grid"):
-            raise InvalidArgumentError(f"start is {start!r}; expected 'standard' or 'grid'")
+        if start not in ("standard", "grid", "random"):
+            raise InvalidArgumentError(f"start is {start!r}; expected 'standard', 'grid' or 'random'")
         if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
             raise InvalidArgumentError(f"steps is {steps!r}; it must be an integer >= 1")
         self.velocities = bool(velocities)
@@ -132,10 +136,15 @@ class DoublePole:
         return 6 if self.velocities else 3
 
     def reset(self, episodes: npt.NDArray[np.int64], rng: np.random.Generator) -> npt.NDArray[np.float64]:
-        """Every row at its start; the starts are fixed, so ``rng`` is not used."""
+        """Every row at its start; ``rng`` draws the starts only with ``start="random"``."""
         rows = len(episodes)
-        cart = (np.tile(STANDARD_START, (rows, 1)) if self.start == "standard"
-                else GRID[episodes % len(GRID)])
+        if self.start == "standard":
+            cart = np.tile(STANDARD_START, (rows, 1))
+        elif self.start == "grid":
+            cart = GRID[episodes % len(GRID)]
+        else:
+            low, high = np.array(START_SPANS).T
+            cart = rng.uniform(low, high, size=(rows, 4))
         self.state = np.zeros((6, rows))
         self.state[:4] = cart.T
         self.t = 0

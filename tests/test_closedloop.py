@@ -564,6 +564,27 @@ def test_a_sweep_over_a_task_class_judges_every_seed_by_its_rule(tmp_path) -> No
     assert not (tmp_path / "sw2").exists()
 
 
+def test_a_sweep_of_a_task_class_on_dask_workers_matches_one_in_process(tmp_path) -> None:
+    """The workers build the task from its name, importing the user's module from the folder the
+    command runs in, as the command itself does."""
+    pytest.importorskip("distributed")
+    (tmp_path / "seeker_dask.py").write_text(SEEKER)
+    args = ["sweep", "python:seeker_dask.Seeker", "--seeds", "0-1", "--eval-trials", "20", *SETTINGS]
+    here = dnnevo_command(tmp_path, *args, "--out", "here")
+    there = dnnevo_command(tmp_path, *args, "--out", "there", "--workers", "2")
+    assert here.returncode == 0 and there.returncode == 0, here.stderr + there.stderr
+    assert "a local Dask cluster of 2 workers" in there.stdout
+
+    def runs(out: str) -> list[dict]:
+        summary = json.loads((tmp_path / out / "summary.json").read_text())
+        return [{k: v for k, v in r.items() if k != "wall_s"} for r in summary["runs"]]
+
+    assert runs("here") == runs("there")
+    for seed in (0, 1):
+        best = f"seed-{seed}/best.json"
+        assert (tmp_path / "here" / best).read_bytes() == (tmp_path / "there" / best).read_bytes()
+
+
 def test_large_finite_returns_are_not_an_error() -> None:
     result = rollout(networks(4, m=1), Broken("large once"), episodes=2, max_steps=10)
     assert np.isfinite(result.returns).all() and (result.returns > 1e307).all()

@@ -11,6 +11,11 @@
 //! | sonar cone, noise, specular misses, network input | [`Sonar`], [`input`] (`sonar.rs`) |
 //! | finding and following the perimeter | [`WallFollower`] (`wall_follow.rs`) |
 //! | a trial at a fixed time step | [`Sim`] (`sim.rs`) |
+//! | many robots stepped together, one per row, for a closed loop | [`Fleet`] (`fleet.rs`) |
+//! | pursuers and their pure-pursuit policy | [`PursuerSpec`] (`pursuer.rs`) |
+//! | a ring of sonars that pursuers echo on | [`Ring`] (`ring.rs`) |
+//! | the pursuer sensor | [`SectorSpec`] (`sectors.rs`) |
+//! | exact `f64` ray casts against walls, boxes and discs | [`Scene`] (`scene.rs`) |
 //!
 //! Randomness (start poses, sonar noise, jitter) comes only from a caller's
 //! [`streams::Stream`], so a trial is reproducible to the bit.
@@ -37,8 +42,13 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod fleet;
 mod pose;
+pub mod pursuer;
+pub mod ring;
 pub mod robot;
+pub mod scene;
+pub mod sectors;
 pub mod sim;
 pub mod sonar;
 // Internals for the crate's own integration tests (tests/unit); not public API.
@@ -49,8 +59,13 @@ pub mod world;
 pub mod world_spec;
 
 pub use error::Error;
+pub use fleet::{Arena, Fleet, FleetSpec, Row};
 pub use pose::{wrap_angle, Pose};
+pub use pursuer::PursuerSpec;
+pub use ring::{Ring, RingSpec};
 pub use robot::RobotSpec;
+pub use scene::{Disc, Scene, SceneHit};
+pub use sectors::SectorSpec;
 pub use sim::{Sim, SimSpec, Trace};
 pub use sonar::{input, Echo, Sonar, SonarSpec, DEFAULT_D0};
 pub use wall_follow::{Phase, WallFollower, WallFollowerSpec};

@@ -5,8 +5,13 @@
 //! through `sim2d::testing`, which is not public API.
 
 mod error;
+mod fleet;
 mod pose;
+mod pursuer;
+mod ring;
 mod robot;
+mod scene;
+mod sectors;
 mod sim;
 mod sonar;
 mod wall_follow;

@@ -9,7 +9,12 @@ need it are skipped; the others go on. On Dask:
   at a time each; ``scheduler`` connects to a running cluster instead (its workers must see the
   same folders, e.g. on a shared filesystem);
 - a worker that dies is replaced and its task is run again, which resumes the run from its last
-  checkpoint, so the result's bits are those of an uninterrupted run.
+  checkpoint, so the result's bits are those of an uninterrupted run;
+- every worker must run the dnnevo this process runs, the same version built from the same
+  commit (:func:`check_workers`), since another could give other results;
+- a cluster that is lost (its scheduler dies, or the network drops for longer than Dask waits)
+  ends the command in one line; every run keeps its last checkpoint, and the same command
+  continues them to the same results.
 
 Dask is optional (``pip install "dnnevo[cluster]"``); without it only :func:`run_in_process`
 works.
@@ -24,19 +29,22 @@ works.
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import importlib.util
 import logging
 import os
 import uuid
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from dnnevo import _core
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.experiments.runsview import RunsView
 
-__all__ = ["CLUSTER_EXTRA", "Outcome", "Task", "check_options", "dask_client", "describe", "run_in_process", "run_on_dask"]
+__all__ = ["CLUSTER_EXTRA", "Outcome", "Task", "check_options", "check_workers", "dask_client", "describe", "identity",
+           "run_in_process", "run_on_dask"]
 
 CLUSTER_EXTRA = 'pip install "dnnevo[cluster]"'
 """How to install Dask for dnnevo."""
@@ -101,12 +109,19 @@ def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str,
                                          key=f"{task.id}-{token}", pure=False)
     by_key = {f.key: task for task, f in zip(tasks, futures.values(), strict=True)}
     ended: dict[str, tuple[bool, Any]] = {}  # (finished, its result or its error), as it ended
-    for future in _distributed().as_completed(list(futures.values())):
-        task = by_key[future.key]
-        ok = future.status == "finished"
-        ended[task.id] = (ok, future.result() if ok else future.exception())
-        view.finished(task.id, "done" if ok else "failed", wall=_wall(ended[task.id][1]) if ok else None,
-                      running=_running(client))
+    try:
+        for future in _distributed().as_completed(list(futures.values())):
+            task = by_key[future.key]
+            if future.status not in ("finished", "error"):  # cancelled or lost with the scheduler
+                raise concurrent.futures.CancelledError(f"{task.id} was {future.status}")
+            ok = future.status == "finished"
+            ended[task.id] = (ok, future.result() if ok else future.exception())
+            view.finished(task.id, "done" if ok else "failed", wall=_wall(ended[task.id][1]) if ok else None,
+                          running=_running(client))
+    except LOST as e:
+        raise DnnevoError(f"lost the Dask cluster after {len(ended)} of {len(tasks)} tasks "
+                          f"({type(e).__name__}: {e or 'no reason given'}); every run keeps its last "
+                          "checkpoint: run the same command again to continue") from None
     # Decided in order: a task whose need did not finish is skipped, whatever its future says.
     outcomes: dict[str, Outcome] = {}
     for task in tasks:
@@ -120,6 +135,36 @@ def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str,
             text = str(value) if isinstance(value, DnnevoError) else f"{type(value).__name__}: {value}"
             outcomes[task.id] = Outcome(task, "failed", message=text)
     return outcomes
+
+
+LOST = (OSError, TimeoutError, concurrent.futures.CancelledError)
+"""What waiting on a cluster that is gone raises: a closed connection (an ``OSError``), a timeout,
+or futures the scheduler cancelled as it went."""
+
+
+def identity() -> dict[str, str]:
+    """What a process's results depend on besides its inputs: dnnevo's version and the commit its
+    core was built from (every kernel gives the same bits, so the CPU is not part of it)."""
+    info = _core.build_info()
+    return {"version": str(info["version"]), "commit": str(info["commit"])}
+
+
+def check_workers(client: Any, expected: Mapping[str, str] | None = None) -> None:
+    """Every worker of ``client`` runs the dnnevo ``expected`` names (default: this process's
+    :func:`identity`), or a one-line :class:`ConfigError` names the first that does not: its
+    results could differ from this process's."""
+    want = dict(expected or identity())
+    try:
+        found = client.run(identity)
+    except Exception as e:  # noqa: BLE001 - a worker without dnnevo cannot even run the check
+        raise ConfigError(f"cannot ask the Dask workers which dnnevo they run ({type(e).__name__}: "
+                          f"{e}); install this dnnevo on every worker") from None
+    for address, theirs in sorted(found.items()):
+        if theirs != want:
+            raise ConfigError(f"the Dask worker at {address} runs dnnevo {theirs.get('version')} built "
+                              f"from {theirs.get('commit')}, this command dnnevo {want['version']} built "
+                              f"from {want['commit']}; its results could differ, so the cluster is "
+                              "refused: install the same dnnevo on every worker")
 
 
 def _wall(result: Any) -> float | None:
@@ -151,7 +196,6 @@ def check_options(*, workers: int | None, scheduler: str | None) -> None:
         raise ConfigError(f"Dask is not installed; {CLUSTER_EXTRA}")
 
 
-
 def _distributed() -> Any:
     """The ``distributed`` package, imported here and only when a Dask cluster is used: it is an
     optional extra (``pip install "dnnevo[cluster]"``), and its import takes about a second."""
@@ -168,12 +212,15 @@ def dask_client(*, workers: int | None, scheduler: str | None) -> Iterator[Any]:
     check_options(workers=workers, scheduler=scheduler)
     distributed = _distributed()
 
+    # A client that loses its scheduler logs it before the command can say so in one line.
+    logging.getLogger("distributed.client").setLevel(logging.CRITICAL)
     if scheduler is not None:
         try:
             client = distributed.Client(scheduler, timeout="20s")
         except (OSError, ValueError, TypeError) as e:
             raise ConfigError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
         with client:
+            check_workers(client)
             yield client
         return
     n = workers if workers is not None else (os.cpu_count() or 1)
@@ -182,6 +229,7 @@ def dask_client(*, workers: int | None, scheduler: str | None) -> Iterator[Any]:
     # reported by the caller, not as the workers' log of its traceback.
     with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                       silence_logs=logging.CRITICAL) as cluster, distributed.Client(cluster) as client:
+        check_workers(client)
         yield client
 
 

@@ -189,3 +189,22 @@ def test_collect_needs_the_commit_when_the_report_names_none(tmp_path: Path, rep
     assert r.returncode == 0, r.stderr
     provenance = json.loads((tmp_path / "results" / "provenance.json").read_text())
     assert provenance["environment"]["dnnevo"] == "0.1.0 (git ca5f9b8)" and provenance["commit"] == "ca5f9b8"
+
+
+def test_an_examples_results_file_is_checked_when_read(tmp_path: Path) -> None:
+    from dnnevo.experiments import examples
+    from dnnevo.runs import RunFileError
+
+    path = tmp_path / "demo.json"
+    examples.write(path, command="python examples/demo.py", columns=["seed", "score"], rows=[[0, 0.5]],
+                   summary=["1 seed"])
+    assert examples.read(path)["rows"] == [["0", "0.5"]]
+    good = json.loads(path.read_text())
+    for broken, message in [("{", "not an example's results"), ("[]", "format is not"),
+                            (json.dumps({**good, "rows": [["0"]]}), "rows of as many cells"),
+                            (json.dumps({**good, "summary": [1]}), "all text")]:
+        path.write_text(broken)
+        with pytest.raises(RunFileError, match=message):
+            examples.read(path)
+    with pytest.raises(RunFileError, match="make it with the example's --record"):
+        examples.read(tmp_path / "missing.json")

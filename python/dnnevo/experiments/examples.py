@@ -1,0 +1,94 @@
+"""The results of the example scripts (``examples/*.py``), kept as files so that the docs' tables
+are made from them by a command, never typed.
+
+A script run with ``--record docs/results/examples/NAME.json`` writes its table there with the
+command that made it and the machine it ran on (:func:`write`); ``python -m
+dnnevo.experiments.results render`` then fills every ``<!-- results:example:NAME:begin -->`` ...
+``<!-- results:example:NAME:end -->`` pair of the docs from that file (:func:`blocks`), and
+``render --check`` fails when a page differs from it.
+
+>>> import tempfile, pathlib
+>>> path = pathlib.Path(tempfile.mkdtemp()) / "demo.json"
+>>> write(path, command="python examples/demo.py --seeds 2", columns=["seed", "score"],
+...       rows=[[0, "0.5"], [1, "0.7"]], summary=["2 seeds"])
+>>> print(markdown(read(path)).split("(made by")[0], end="")
+`python examples/demo.py --seeds 2`:
+<BLANKLINE>
+| seed | score |
+|---|---|
+| 0 | 0.5 |
+| 1 | 0.7 |
+<BLANKLINE>
+2 seeds
+<BLANKLINE>
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from dnnevo import _core
+from dnnevo.experiments import report
+from dnnevo.runs.files import RunFileError, write_atomic
+
+__all__ = ["EXAMPLES_DIR", "blocks", "markdown", "read", "write"]
+
+EXAMPLES_DIR = Path("examples")
+"""Where, under the results folder (``docs/results``), the examples' results live."""
+
+FORMAT = "dnnevo-example-results/1"
+
+
+def write(path: Path, *, command: str, columns: Sequence[str], rows: Sequence[Sequence[Any]],
+          summary: Sequence[str]) -> None:
+    """Writes an example's table (``rows`` of cells, shown as ``str`` of each), the lines that
+    sum it up, the ``command`` that made it and the dnnevo that ran it, atomically."""
+    info = _core.build_info()
+    doc = {"format": FORMAT, "command": command, "columns": [str(c) for c in columns],
+           "rows": [[str(c) for c in row] for row in rows], "summary": [str(s) for s in summary],
+           "made": {"commit": info["commit"], "version": info["version"], "kernel": info["kernel"],
+                    "arch": platform.machine()}}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(path, json.dumps(doc, indent=1) + "\n")
+
+
+def read(path: Path) -> dict[str, Any]:
+    """An example's results, checked: a :class:`~dnnevo.runs.RunFileError` names what is wrong."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise RunFileError(f"{path} does not exist; make it with the example's --record") from None
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise RunFileError(f"{path}: not an example's results ({e})") from None
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise RunFileError(f"{path}: not an example's results (format is not {FORMAT})")
+    columns, rows = doc.get("columns"), doc.get("rows")
+    ok = (isinstance(doc.get("command"), str) and _strings(columns) and _strings(doc.get("summary"))
+          and isinstance(rows, list) and all(_strings(r) and len(r) == len(columns) for r in rows))
+    if not ok:
+        raise RunFileError(f"{path}: an example's results need a command, columns, rows of as many "
+                           "cells and summary lines, all text")
+    return doc
+
+
+def _strings(value: Any) -> bool:
+    return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+
+def blocks(doc: dict[str, Any]) -> list[report.Block]:
+    """The command, the table, the summary lines and the dnnevo that made them."""
+    table = report.Block("table", rows=(tuple(doc["columns"]), *(tuple(r) for r in doc["rows"])))
+    made = doc.get("made") or {}
+    source = (f"(made by dnnevo {made.get('version')} at commit {made.get('commit')}, "
+              f"{made.get('kernel')} kernel)") if made else ""
+    return [report.Block("p", f"`{doc['command']}`:"), table,
+            *(report.Block("p", line) for line in doc["summary"]), *([report.Block("p", source)] if source else [])]
+
+
+def markdown(doc: dict[str, Any]) -> str:
+    """:func:`blocks` as Markdown."""
+    return report.markdown(blocks(doc))

@@ -18,6 +18,7 @@ mod network;
 mod population;
 mod pyjson;
 mod records;
+mod robots;
 mod run_config;
 mod sequence;
 mod simd;
@@ -57,6 +58,8 @@ mod _core {
     use super::network::{compose, PyNetwork, PyTrace};
     #[pymodule_export]
     use super::population::run_population;
+    #[pymodule_export]
+    use super::robots::PyFleet;
     #[pymodule_export]
     use super::run_config::PyRunConfig;
     #[pymodule_export]

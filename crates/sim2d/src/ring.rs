@@ -7,6 +7,12 @@
 //! return plus Gaussian noise of `noise_sd`, clamped to `[min_range, max_range]`, or `max_range`
 //! when nothing echoed. Walls, boxes and every pursuer's disc echo. Casts are exact in `f64`
 //! (see [`Scene`]), where a lone [`Sonar`](crate::Sonar) goes through parry2d in `f32`.
+//!
+//! Ray `i` of a sonar at `a` degrees points at `a_i = radians(a) - cone / 2 + i * cone / (rays -
+//! 1)` from the heading `h`. Its direction is computed once in the robot's frame,
+//! `(cos a_i, sin a_i)`, and turned by the heading at each reading: `(cos h cos a_i - sin h sin
+//! a_i, sin h cos a_i + cos h sin a_i)`, which is `(cos(h + a_i), sin(h + a_i))` to rounding.
+//! The transducer sits on the rim, at the robot's radius along the sonar's axis.
 
 use streams::Stream;
 
@@ -105,12 +111,12 @@ impl RingSpec {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Ring {
     spec: RingSpec,
-    /// Each sonar's axis in radians.
-    axes: Vec<f64>,
+    /// Each sonar's axis as a unit vector in the robot's frame (x ahead, y to the left).
+    axes: Vec<[f64; 2]>,
+    /// Each ray's direction in the robot's frame, `rays` per sonar, sonar by sonar.
+    rays: Vec<[f64; 2]>,
     /// The transducers' distance from the robot's centre: its radius.
     offset: f64,
-    first_ray: f64,
-    ray_step: f64,
     /// The cosine of the steepest incidence that still echoes (-1: no specular misses).
     min_cos_incidence: f64,
 }
@@ -130,12 +136,21 @@ impl Ring {
             Some(a) => a.to_radians().cos(),
             None => -1.0,
         };
+        let unit = |angle: f64| {
+            let (s, c) = angle.sin_cos();
+            [c, s]
+        };
+        let axes: Vec<f64> = spec.angles_deg.iter().map(|a| a.to_radians()).collect();
         Ok(Ring {
             spec: spec.clone(),
-            axes: spec.angles_deg.iter().map(|a| a.to_radians()).collect(),
+            rays: axes
+                .iter()
+                .flat_map(|a| {
+                    (0..spec.rays).map(move |i| unit(a + first_ray + ray_step * i as f64))
+                })
+                .collect(),
+            axes: axes.into_iter().map(unit).collect(),
             offset: radius,
-            first_ray,
-            ray_step,
             min_cos_incidence,
         })
     }
@@ -169,12 +184,15 @@ impl Ring {
         ranges: &mut [f64],
     ) {
         let s = &self.spec;
-        for (axis, out) in self.axes.iter().zip(ranges.iter_mut()) {
-            let [mx, my] = pose.direction_at(*axis);
+        let (sin, cos) = pose.heading.sin_cos();
+        let turn = |v: &[f64; 2]| [cos * v[0] - sin * v[1], sin * v[0] + cos * v[1]];
+        let rays = self.rays.chunks_exact(s.rays as usize);
+        for ((axis, rays), out) in self.axes.iter().zip(rays).zip(ranges.iter_mut()) {
+            let [mx, my] = turn(axis);
             let origin = [pose.x + self.offset * mx, pose.y + self.offset * my];
             let mut nearest: Option<f64> = None;
-            for i in 0..s.rays {
-                let dir = pose.direction_at(axis + self.first_ray + self.ray_step * i as f64);
+            for ray in rays {
+                let dir = turn(ray);
                 let reach = nearest.unwrap_or(s.max_range);
                 let Some(hit) = scene.cast(origin, dir, reach, discs) else {
                     continue;

@@ -543,7 +543,10 @@ impl Evolution {
         serde_json::to_string(self).expect("an evolution state always serialises")
     }
 
-    /// Reads a state written by [`to_json`](Self::to_json), checking it is consistent.
+    /// Reads a state written by [`to_json`](Self::to_json), checking it is consistent: every
+    /// genome of the population and the champion's decode to a network of the layout, and the
+    /// champion was scored in a generation already run, with a validation rate in [0, 1] and a
+    /// finite score. So a state that reads continues without an error the file caused.
     pub fn from_json(text: &str) -> Result<Self> {
         let evo: Evolution = serde_json::from_str(text)
             .map_err(|e| Error::Format(format!("not a valid checkpoint: {e}")))?;
@@ -557,6 +560,42 @@ impl Evolution {
                 evo.config.population,
                 evo.layout.len()
             )));
+        }
+        if evo.generation == u64::MAX {
+            return Err(Error::Format(format!(
+                "checkpoint generation is {}; no generation can follow it",
+                evo.generation
+            )));
+        }
+        let bad = |what: &str, e: Error| {
+            Error::Format(format!("checkpoint {what}: {}", crate::io::strip(e)))
+        };
+        if let Some((i, e)) = evo
+            .population
+            .chunks(evo.layout.len())
+            .enumerate()
+            .find_map(|(i, genes)| genome::decode(evo.layout, genes).err().map(|e| (i, e)))
+        {
+            return Err(bad(&format!("population[{i}]"), e));
+        }
+        if let Some(c) = &evo.champion {
+            genome::decode(evo.layout, &c.genes).map_err(|e| bad("champion", e))?;
+            if c.generation >= evo.generation {
+                return Err(Error::Format(format!(
+                    "checkpoint champion was scored in generation {}; the state is at generation \
+                     {}, so it can only come from an earlier one",
+                    c.generation, evo.generation
+                )));
+            }
+            if let Some(v) = c.validation {
+                if !((0.0..=1.0).contains(&v.rate) && v.score.is_finite()) {
+                    return Err(Error::Format(format!(
+                        "checkpoint champion has validation rate {} and score {}; a rate lies in \
+                         [0, 1] and a score is finite",
+                        v.rate, v.score
+                    )));
+                }
+            }
         }
         Ok(evo)
     }

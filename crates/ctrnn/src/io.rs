@@ -176,7 +176,7 @@ pub fn from_json(text: &str) -> Result<NetworkFile> {
 }
 
 /// The message of an error without its category prefix.
-fn strip(e: Error) -> String {
+pub(crate) fn strip(e: Error) -> String {
     match e {
         Error::InvalidNetwork(m) | Error::InvalidArgument(m) => m,
         other => other.to_string(),
@@ -190,13 +190,30 @@ pub fn save(path: &Path, file: &NetworkFile) -> Result<()> {
     write_atomic(path, text.as_bytes())
 }
 
-/// Reads and validates the network file at `path`.
+/// Parses and validates a network file's bytes: [`from_json`], after checking they are UTF-8
+/// text. Every failure is [`Error::Format`], so damaged content is never mistaken for an I/O
+/// error.
+///
+/// # Example
+/// ```
+/// let e = ctrnn::io::from_bytes(b"{\"format\": \"dnnevo-net\xffwork\"}").unwrap_err();
+/// assert_eq!(e.to_string(), "invalid network file: not UTF-8 text (byte 22)");
+/// ```
+pub fn from_bytes(bytes: &[u8]) -> Result<NetworkFile> {
+    let text = std::str::from_utf8(bytes)
+        .map_err(|e| Error::Format(format!("not UTF-8 text (byte {})", e.valid_up_to())))?;
+    from_json(text)
+}
+
+/// Reads and validates the network file at `path`. A file that cannot be read is
+/// [`Error::Io`]; one whose content is not a network file (not UTF-8 included) is
+/// [`Error::Format`], naming the path.
 pub fn load(path: &Path) -> Result<NetworkFile> {
-    let text = fs::read_to_string(path).map_err(|source| Error::Io {
+    let bytes = fs::read(path).map_err(|source| Error::Io {
         context: format!("cannot read {}", path.display()),
         source,
     })?;
-    from_json(&text).map_err(|e| match e {
+    from_bytes(&bytes).map_err(|e| match e {
         Error::Format(m) => Error::Format(format!("{}: {m}", path.display())),
         other => other,
     })

@@ -55,7 +55,7 @@ def test_run_show_assess_resume_sweep(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "fragment"),
     [
-        (["run", "no-such-preset"], "unknown preset 'no-such-preset'; presets: landmark, "),
+        (["run", "no-such-preset"], "unknown preset 'no-such-preset'; presets: categorical-perception, "),
         (["run", "sequence-1bti"], "unknown preset 'sequence-1bti' (did you mean 'sequence-1bit'?)"),
         (["run", "nav1d-clasifier"], "(did you mean 'nav1d-classifier'?)"),
         (["run", "sequence-1bit", "--set", "task=sequnce"], "unknown task 'sequnce' (did you mean 'sequence'?)"),

@@ -1,20 +1,26 @@
 """One file of a run folder: written atomically (a temporary file beside it, then a rename), read
 with every check of its type, and every failure a :class:`RunFileError` of one line naming the
-file."""
+file.
+
+Every reader of a file dnnevo wrote (a run's, a sweep's, a reproduction's) reads it as a whole
+through :func:`read_text` or :func:`read_json`, and checks it inside :func:`checked`, so that no
+damage to the file can escape as anything but a :class:`RunFileError` naming it.
+"""
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import json
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from dnnevo.errors import DnnevoError, WriteError
 
-__all__ = ['FILE_MODE', 'RunFileError', 'fail', 'load_json', 'number', 'read_text', 'save_figure', 'short', 'write_atomic', 'write_atomic_with', 'write_error']
+__all__ = ['FILE_MODE', 'RunFileError', 'checked', 'fail', 'load_json', 'number', 'read_json', 'read_text', 'save_figure', 'short', 'write_atomic', 'write_atomic_with', 'write_error']
 
 def _umask() -> int:
     mask = os.umask(0o022)
@@ -27,7 +33,8 @@ FILE_MODE = 0o666 & ~_umask()
 
 
 class RunFileError(DnnevoError):
-    """A file of a run folder is missing, damaged or disagrees with the others."""
+    """A file of a run folder (or of a sweep's or a reproduction's folder) is missing, damaged or
+    disagrees with the others."""
 
 
 def fail(path: Path, problem: str) -> RunFileError:
@@ -110,10 +117,46 @@ def load_json(path: Path, text: str) -> Any:
         raise fail(path, f"not valid JSON: {e}") from None
 
 
+def read_json(path: Path) -> Any:
+    """The JSON document in ``path``, read by :func:`read_text` and :func:`load_json`: a file
+    that is missing, a symlink, not UTF-8, not JSON or nested too deeply is a
+    :class:`RunFileError` naming it."""
+    return load_json(path, read_text(path))
+
+
+#: What a damaged file can make a reader's own code raise when a check is missing: a value of
+#: the wrong type or range (``int("x")``, ``None["a"]``, ``"a" < 1``, ``round(inf)``), a
+#: missing key or item, or nesting deeper than Python's recursion limit.
+_DAMAGE = (ValueError, TypeError, KeyError, IndexError, AttributeError, OverflowError, RecursionError)
+
+
+@contextlib.contextmanager
+def checked(path: Path) -> Iterator[None]:
+    """Reads and checks of ``path`` inside this block fail only with a
+    :class:`~dnnevo.errors.DnnevoError`: one is passed on as it is; any exception in
+    :data:`_DAMAGE` (a check the reader lacks, which the fuzzers in ``fuzz/`` look for) becomes
+    a :class:`RunFileError` naming ``path`` and what went wrong.
+
+    >>> with checked(Path("log.csv")):
+    ...     float("x")
+    Traceback (most recent call last):
+    dnnevo.runs.files.RunFileError: log.csv: damaged (ValueError: could not convert string to float: 'x')
+    """
+    try:
+        yield
+    except DnnevoError:
+        raise
+    except _DAMAGE as e:
+        raise fail(path, f"damaged ({type(e).__name__}: {e})") from e
+
+
 def number(path: Path, where: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise fail(path, f"{where} is {short(value)}; expected a number")
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an integer of more than 308 digits
+        raise fail(path, f"{where} is {short(value)}; expected a number a float can hold") from None
 
 
 def short(value: Any) -> str:

@@ -42,7 +42,7 @@ from dnnevo._core import Network
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FormatError
 from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
-from dnnevo.runs.files import FILE_MODE, RunFileError, fail, load_json, read_text, short, write_atomic
+from dnnevo.runs.files import FILE_MODE, RunFileError, checked, fail, read_json, read_text, short, write_atomic
 from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, log_cell, history_rows
 from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth, first_difference
 
@@ -214,28 +214,29 @@ class RunDir:
         path = self.config
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no config.toml; is it a dnnevo run folder?")
-        text = read_text(path)
-        try:
-            doc = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as e:
-            raise fail(path, f"not valid TOML: {e}") from None
-        except RecursionError:
-            raise fail(path, "TOML nested too deeply") from None
-        if depth(doc) > MAX_CONFIG_DEPTH:
-            raise fail(path, f"tables and arrays nested deeper than {MAX_CONFIG_DEPTH}")
-        run = doc.pop("run", {})
-        if not isinstance(run, dict):
-            raise fail(path, f"run is {short(run)}; expected a table")
-        seed = run.get("seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-            raise fail(path, f"run.seed is {short(seed)}; expected an integer in [0, 2**64)")
-        if "task" not in doc:
-            raise fail(path, "has no task")
-        try:
-            config = EvolutionConfig.from_dict(doc)
-        except ConfigError as e:
-            raise fail(path, str(e)) from None
-        return config, run
+        with checked(path):
+            text = read_text(path)
+            try:
+                doc = tomllib.loads(text)
+            except tomllib.TOMLDecodeError as e:
+                raise fail(path, f"not valid TOML: {e}") from None
+            except RecursionError:
+                raise fail(path, "TOML nested too deeply") from None
+            if depth(doc) > MAX_CONFIG_DEPTH:
+                raise fail(path, f"tables and arrays nested deeper than {MAX_CONFIG_DEPTH}")
+            run = doc.pop("run", {})
+            if not isinstance(run, dict):
+                raise fail(path, f"run is {short(run)}; expected a table")
+            seed = run.get("seed", 0)
+            if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
+                raise fail(path, f"run.seed is {short(seed)}; expected an integer in [0, 2**64)")
+            if "task" not in doc:
+                raise fail(path, "has no task")
+            try:
+                config = EvolutionConfig.from_dict(doc)
+            except ConfigError as e:
+                raise fail(path, str(e)) from None
+            return config, run
 
     def read_run_config(self) -> tuple[EvolutionConfig, dict[str, Any]]:
         """``config.toml`` as a command that reads a run must take it: :meth:`read_config`,
@@ -259,33 +260,34 @@ class RunDir:
         path = self.checkpoint
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no checkpoint.json; is it a dnnevo run folder?")
-        doc = load_json(path, read_text(path))
-        if not isinstance(doc, dict):
-            raise fail(path, f"is a JSON {type(doc).__name__}; expected an object")
-        if doc.get("format") != CHECKPOINT_FORMAT or doc.get("version") not in (1, CHECKPOINT_VERSION):
-            raise fail(path, f"format/version is {short(doc.get('format'))}/"
-                              f"{short(doc.get('version'))}; expected {CHECKPOINT_FORMAT}/1 or 2")
-        state = doc.get("state")
-        if not isinstance(state, dict) or set(state) != {"config", "evolution"}:
-            raise fail(path, "state must be an object with 'config' and 'evolution'")
-        if not isinstance(state["evolution"], str):
-            raise fail(path, "state.evolution must be the GA state as JSON text")
-        if depth(state["config"]) > MAX_CONFIG_DEPTH:
-            raise fail(path, f"state.config nests deeper than {MAX_CONFIG_DEPTH}")
-        try:
-            config = EvolutionConfig.from_dict(state["config"])
-        except ConfigError as e:
-            raise fail(path, f"state.config: {e}") from None
-        history = history_rows(path, doc.get("history"))
-        run = None
-        if doc["version"] >= 2:
-            run = doc.get("run")
-            seed = run.get("seed") if isinstance(run, dict) else None
-            if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-                raise fail(path, "run.seed must be an integer in [0, 2**64)")
-            if doc.get("config_sha256") != config_digest(config, seed):
-                raise fail(path, "its config does not match the digest it carries (was it edited?)")
-        return Checkpoint(state, history, run, config)
+        with checked(path):
+            doc = read_json(path)
+            if not isinstance(doc, dict):
+                raise fail(path, f"is a JSON {type(doc).__name__}; expected an object")
+            if doc.get("format") != CHECKPOINT_FORMAT or doc.get("version") not in (1, CHECKPOINT_VERSION):
+                raise fail(path, f"format/version is {short(doc.get('format'))}/"
+                                  f"{short(doc.get('version'))}; expected {CHECKPOINT_FORMAT}/1 or 2")
+            state = doc.get("state")
+            if not isinstance(state, dict) or set(state) != {"config", "evolution"}:
+                raise fail(path, "state must be an object with 'config' and 'evolution'")
+            if not isinstance(state["evolution"], str):
+                raise fail(path, "state.evolution must be the GA state as JSON text")
+            if depth(state["config"]) > MAX_CONFIG_DEPTH:
+                raise fail(path, f"state.config nests deeper than {MAX_CONFIG_DEPTH}")
+            try:
+                config = EvolutionConfig.from_dict(state["config"])
+            except ConfigError as e:
+                raise fail(path, f"state.config: {e}") from None
+            history = history_rows(path, doc.get("history"))
+            run = None
+            if doc["version"] >= 2:
+                run = doc.get("run")
+                seed = run.get("seed") if isinstance(run, dict) else None
+                if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
+                    raise fail(path, "run.seed must be an integer in [0, 2**64)")
+                if doc.get("config_sha256") != config_digest(config, seed):
+                    raise fail(path, "its config does not match the digest it carries (was it edited?)")
+            return Checkpoint(state, history, run, config)
 
     def read_log(self, config: EvolutionConfig | None = None) -> list[dict[str, float]]:
         """The rows of ``log.csv`` as floats, checked by the rules of the checkpoint's history,
@@ -293,34 +295,35 @@ class RunDir:
         path = self.log
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no log.csv; is it a dnnevo run folder?")
-        text = read_text(path)
-        try:
-            table = list(csv.reader(io.StringIO(text, newline=""), strict=True))
-        except csv.Error as e:
-            raise fail(path, f"not valid CSV: {e}") from None
-        if not table:
-            raise fail(path, "is empty")
-        header = table[0]
-        required = [c for c in LOG_COLUMNS if c not in OPTIONAL_COLUMNS]
-        if len(set(header)) != len(header) or not set(required) <= set(header) <= set(LOG_COLUMNS):
-            raise fail(path, f"has columns {','.join(header)[:80]}; expected {','.join(LOG_COLUMNS)}")
-        rows = []
-        for i, cells in enumerate(table[1:]):
-            if len(cells) != len(header):
-                raise fail(path, f"row {i + 1} has {len(cells)} values; expected {len(header)}")
-            row = dict.fromkeys(LOG_COLUMNS, math.nan)
-            for k, cell in zip(header, cells, strict=True):
-                try:
-                    row[k] = float(cell)
-                except ValueError:
-                    raise fail(path, f"row {i + 1}: {k} is {short(cell)}; expected a number") from None
-            rows.append(row)
-        check_history(path, rows)
-        if not rows:
-            raise fail(path, "has no generations yet")
-        if config is not None and len(rows) > config.generations:
-            raise fail(path, f"has {len(rows)} generations; config.toml has {config.generations}")
-        return rows
+        with checked(path):
+            text = read_text(path)
+            try:
+                table = list(csv.reader(io.StringIO(text, newline=""), strict=True))
+            except csv.Error as e:
+                raise fail(path, f"not valid CSV: {e}") from None
+            if not table:
+                raise fail(path, "is empty")
+            header = table[0]
+            required = [c for c in LOG_COLUMNS if c not in OPTIONAL_COLUMNS]
+            if len(set(header)) != len(header) or not set(required) <= set(header) <= set(LOG_COLUMNS):
+                raise fail(path, f"has columns {','.join(header)[:80]}; expected {','.join(LOG_COLUMNS)}")
+            rows = []
+            for i, cells in enumerate(table[1:]):
+                if len(cells) != len(header):
+                    raise fail(path, f"row {i + 1} has {len(cells)} values; expected {len(header)}")
+                row = dict.fromkeys(LOG_COLUMNS, math.nan)
+                for k, cell in zip(header, cells, strict=True):
+                    try:
+                        row[k] = float(cell)
+                    except ValueError:
+                        raise fail(path, f"row {i + 1}: {k} is {short(cell)}; expected a number") from None
+                rows.append(row)
+            check_history(path, rows)
+            if not rows:
+                raise fail(path, "has no generations yet")
+            if config is not None and len(rows) > config.generations:
+                raise fail(path, f"has {len(rows)} generations; config.toml has {config.generations}")
+            return rows
 
     def read_best(self, config: EvolutionConfig, run: Mapping[str, Any] | None = None) -> Network:
         """``best.json``, which must be a network of the run's size and inputs, and, when its
@@ -328,16 +331,17 @@ class RunDir:
         path = self.best
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")
-        try:
-            net = Network.load(path)
-        except FormatError as e:
-            raise RunFileError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
-        if (net.size, net.n_inputs) != (config.size, config.n_inputs):
-            raise fail(path, f"is a network of size {net.size} with {net.n_inputs} inputs; the run "
-                              f"has size {config.size} with {config.n_inputs} inputs")
-        meta = net.meta
-        if "task" in meta and meta["task"] != config.task:
-            raise fail(path, f"meta.task is {short(meta['task'])}; the run's task is {config.task!r}")
-        if run is not None and "seed" in meta and "seed" in run and meta["seed"] != run["seed"]:
-            raise fail(path, f"meta.seed is {short(meta.get('seed'))}; the run's seed is {run.get('seed')}")
-        return net
+        with checked(path):
+            try:
+                net = Network.load(path)
+            except FormatError as e:
+                raise RunFileError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
+            if (net.size, net.n_inputs) != (config.size, config.n_inputs):
+                raise fail(path, f"is a network of size {net.size} with {net.n_inputs} inputs; the run "
+                                  f"has size {config.size} with {config.n_inputs} inputs")
+            meta = net.meta
+            if "task" in meta and meta["task"] != config.task:
+                raise fail(path, f"meta.task is {short(meta['task'])}; the run's task is {config.task!r}")
+            if run is not None and "seed" in meta and "seed" in run and meta["seed"] != run["seed"]:
+                raise fail(path, f"meta.seed is {short(meta.get('seed'))}; the run's seed is {run.get('seed')}")
+            return net

@@ -12,7 +12,7 @@ from typing import Any
 
 from dnnevo.config import LATER_SETTINGS, EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError
-from dnnevo.runs.files import RunFileError, short
+from dnnevo.runs.files import RunFileError, checked, read_json, short
 
 __all__ = ['MAX_CONFIG_DEPTH', 'depth', 'check_settings', 'config_digest', 'first_difference']
 
@@ -54,14 +54,16 @@ def check_settings(manifest: Path, settings: dict[str, Any], *, what: str, force
     :class:`RunFileError` when the file is unreadable. ``force``: the command has ``--force``."""
     again = ", or pass --force" if force else ""
     try:
-        found = json.loads(manifest.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise RunFileError(f"{manifest}: unreadable ({e}); choose another --out{again}") from None
+        found = read_json(manifest)
+    except RunFileError as e:
+        problem = str(e).removeprefix(f"{manifest}: ")
+        raise RunFileError(f"{manifest}: unreadable ({problem}); choose another --out{again}") from None
     if not isinstance(found, dict):
         raise RunFileError(f"{manifest}: expected a JSON object of settings; choose another --out{again}")
     if "config" in found:
         found = {**found, "config": with_later_defaults(found["config"])}
-    diff = first_difference(found, json.loads(json.dumps(settings)))
+    with checked(manifest):
+        diff = first_difference(found, json.loads(json.dumps(settings)))
     if diff is not None:
         raise ConfigError(
             f"{manifest.parent} holds a {what} with {diff[0]} = {short(diff[1])}, not {short(diff[2])}; "

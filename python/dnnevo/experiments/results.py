@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import statistics
 import sys
@@ -47,7 +48,8 @@ from typing import Any
 from dnnevo.errors import DnnevoError
 from dnnevo.experiments import jobs, plan, report
 from dnnevo.experiments.scheduler import Outcome, Task
-from dnnevo.runs import write_atomic
+from dnnevo.runs import RunFileError, short, write_atomic
+from dnnevo.runs.files import checked, read_json
 
 __all__ = ["RESULTS_DIR", "SETTINGS_FILE", "PROVENANCE_FILE", "Results", "load", "collect", "blocks", "render",
            "main"]
@@ -107,22 +109,59 @@ def _done(job: plan.Job, result: dict[str, Any]) -> Outcome:
     return Outcome(Task(job.id, job.needs, _nothing), "done", result)
 
 
-def _read_json(path: Path) -> Any:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise DnnevoError(f"{path}: not readable JSON ({type(e).__name__}: {e})") from None
+def _is_count(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 0
+
+
+def _is_seconds(value: Any) -> bool:
+    return (isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+            and value >= 0)
+
+
+def _read_settings(path: Path) -> dict[str, Any]:
+    """``reproduce.json``: an object whose ``settings`` are an object."""
+    settings = read_json(path)
+    if not isinstance(settings, dict) or not isinstance(settings.get("settings"), dict):
+        raise RunFileError(f"{path}: not a reproduction's settings (an object with an object 'settings')")
+    return settings
+
+
+def _read_provenance(path: Path) -> dict[str, Any]:
+    """``provenance.json``, with every field the tables and ``collect`` read of the type they
+    read it as; a file without it is no provenance (``{}``)."""
+    if not path.exists() and not path.is_symlink():
+        return {}
+    prov = read_json(path)
+    if not isinstance(prov, dict):
+        raise RunFileError(f"{path}: is a JSON {type(prov).__name__}; expected an object")
+    seeds = prov.get("seeds", [])
+    if not isinstance(seeds, list) or not all(_is_count(s) for s in seeds):
+        raise RunFileError(f"{path}: seeds is {short(seeds)}; expected a list of integers >= 0")
+    if not isinstance(prov.get("environment", {}), dict):
+        raise RunFileError(f"{path}: environment is {short(prov['environment'])}; expected an object")
+    families = prov.get("families", {})
+    if not isinstance(families, dict):
+        raise RunFileError(f"{path}: families is {short(families)}; expected an object")
+    for family, info in families.items():
+        if not (isinstance(info, dict) and isinstance(info.get("command"), str)
+                and isinstance(info.get("commit"), str) and _is_count(info.get("runs"))
+                and _is_count(info.get("planned")) and _is_seconds(info.get("elapsed_s"))):
+            raise RunFileError(f"{path}: families.{family} is {short(info)}; expected an object with "
+                               "command and commit (strings), runs and planned (counts) and elapsed_s "
+                               "(seconds)")
+    return prov
 
 
 def load(folder: Path) -> Results:
     """The results stored in ``folder`` (e.g. ``docs/results``); no results when it holds no
     ``reproduce.json``. Every result file must belong to a job of the plan and carry the
-    folder's settings."""
+    folder's settings. Every field the tables read is checked here, so that a damaged file is a
+    :class:`~dnnevo.errors.DnnevoError` naming it, never an error of the tables' code."""
     settings_file = folder / SETTINGS_FILE
-    if not settings_file.exists():
+    if not settings_file.exists() and not settings_file.is_symlink():
         return Results(folder, None, {}, {})
-    settings = _read_json(settings_file)
-    provenance = _read_json(folder / PROVENANCE_FILE) if (folder / PROVENANCE_FILE).exists() else {}
+    settings = _read_settings(settings_file)
+    provenance = _read_provenance(folder / PROVENANCE_FILE)
     known = {e.name for e in plan.EXPERIMENTS}
     found: dict[str, dict[str, Any]] = {}
     for path in sorted(folder.glob("*/seed-*.json")):
@@ -130,19 +169,22 @@ def load(folder: Path) -> Results:
         if name not in known:
             raise DnnevoError(f"{path}: {name} is no experiment of the plan; delete "
                               f"{path.parent.relative_to(folder)} or collect again")
-        if not number.isdigit():
+        if not re.fullmatch(r"[0-9]+", number):
             raise DnnevoError(f"{path}: not a result file (they are EXPERIMENT/seed-N.json)")
         job = next(j for j in plan.jobs([int(number)]) if j.experiment == name)
-        result = _read_json(path)
+        result = read_json(path)
         if not isinstance(result, dict) or result.get("job") != job.id:
             raise DnnevoError(f"{path}: not the result of job {job.id}")
-        if result.get("settings") != settings.get("settings"):
+        if result.get("settings") != settings["settings"]:
             raise DnnevoError(f"{path}: made with other settings than {settings_file}")
+        if not _is_seconds(result.get("wall_s")):
+            raise DnnevoError(f"{path}: wall_s is {short(result.get('wall_s'))}; expected seconds (a finite "
+                              "number >= 0)")
         one = {job.id: _done(job, result)}
         try:  # every field a table reads is there: the tables' own code reads them
             report.summary_row(job.spec, [job], one)
             report.seed_table(job.spec, [job], one)
-        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as e:
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError, OverflowError, RecursionError) as e:
             raise DnnevoError(f"{path}: not a valid job result ({type(e).__name__}: {e})") from None
         found[job.id] = result
     return Results(folder, settings, provenance, found)
@@ -199,12 +241,12 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
     settings_file = source / SETTINGS_FILE
     if not settings_file.exists():
         raise DnnevoError(f"{source} holds no {SETTINGS_FILE}: not a reproduction's folder")
-    manifest = _read_json(settings_file)
-    if (dest / SETTINGS_FILE).exists() and _read_json(dest / SETTINGS_FILE) != manifest:
+    manifest = _read_settings(settings_file)
+    if (dest / SETTINGS_FILE).exists() and read_json(dest / SETTINGS_FILE) != manifest:
         raise DnnevoError(f"{dest / SETTINGS_FILE} holds another reproduction's settings than {settings_file}; "
                           f"empty {dest} first to replace them")
     dest.mkdir(parents=True, exist_ok=True)
-    old = _read_json(dest / PROVENANCE_FILE) if (dest / PROVENANCE_FILE).exists() else {}
+    old = _read_provenance(dest / PROVENANCE_FILE)
     if old and old.get("seeds") != sorted(seeds):
         raise DnnevoError(f"{dest / PROVENANCE_FILE} covers seeds {old.get('seeds')}, not {sorted(seeds)}; "
                           "collect with its --seeds")
@@ -217,7 +259,8 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
         why = ("its report names no commit" if (source / report.REPORT_FILES[0]).exists()
                else "it has no report yet to name its commit")
         raise DnnevoError(f"{source}: {why}; pass --commit, the commit the reproduction ran")
-    settings = jobs.Settings(**manifest["settings"])
+    with checked(settings_file):
+        settings = jobs.Settings(**manifest["settings"])
     copied, times = [], {}
     for family in plan.families(families):
         done = []
@@ -231,7 +274,7 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             done.append(src)
         if done:
             ends = [p.stat().st_mtime for p in done]
-            starts = [e - float(_read_json(p)["wall_s"]) for p, e in zip(done, ends)]
+            starts = [e - float(read_json(p)["wall_s"]) for p, e in zip(done, ends)]
             times[family] = {"command": _command(seeds, family, settings), "commit": named.group(1),
                              "runs": len(done), "planned": len(plan.jobs(list(seeds), [family])),
                              "elapsed_s": round(max(ends) - min(starts))}

@@ -63,7 +63,10 @@ fn a_ga_state_is_refused_unless_it_can_continue() {
         "{e}"
     );
     let e = refused(|s| s["population"][0] = (-1.0).into());
-    assert!(e.contains("checkpoint population[0]: gene 0 (neuron 0, tau[0]) is -1"), "{e}");
+    assert!(
+        e.contains("checkpoint population[0]: gene 0 (neuron 0, tau[0]) is -1"),
+        "{e}"
+    );
     let e = refused(|s| s["champion"]["generation"] = 3.into());
     assert!(
         e.contains("champion was scored in generation 3; the state is at generation 3"),

@@ -8,7 +8,8 @@ sweep.json, a reproduction's results) reads:
 - the damage every reader must refuse alike (no bytes, bytes that are not UTF-8, nesting deeper
   than Python's recursion limit, ...);
 - a short Hypothesis pass of its seeds with bytes cut, changed, inserted (tokens of the format,
-  from ``fuzz/dicts/``) and repeated.
+  from ``fuzz/dicts/``) and repeated; derandomized, so that CI runs the same cases every time
+  (the long run explores).
 
 Any input may be refused, but only with a :class:`~dnnevo.errors.DnnevoError`; any other
 exception fails, and so does a read that takes more than :data:`TIME_LIMIT`. The long,
@@ -174,10 +175,45 @@ def _seeds(name: str) -> tuple[bytes, ...]:
 
 @pytest.mark.parametrize("name", readers.READERS)
 def test_mutated_seeds_are_read_or_refused(name: str) -> None:
-    @settings(max_examples=40 if name in SLOW else 200, deadline=None, database=None,
+    @settings(max_examples=40 if name in SLOW else 200, deadline=None, database=None, derandomize=True,
               suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
     @given(data=mutated(_seeds(name)))
     def read(data: bytes) -> None:
         read_or_refuse(name, data)
 
     read()
+
+
+def test_a_deep_job_result_is_a_run_file_error(tmp_path: Path) -> None:
+    # json.loads raised RecursionError past read_result's except clause.
+    from dnnevo.experiments import jobs, plan
+
+    job = plan.jobs([0], only=["landmark"])[0]
+    path = jobs.result_path(tmp_path, job)
+    path.parent.mkdir(parents=True)
+    path.write_bytes(DAMAGE["deep JSON array"])
+    with pytest.raises(RunFileError, match="seed-0.json"):
+        jobs.read_result(tmp_path, job, jobs.Settings())
+
+
+def test_a_sweep_continued_on_a_deep_manifest_is_one_line(tmp_path: Path) -> None:
+    # The check for a sweep to extend read sweep.json with json.loads and let RecursionError out.
+    from cli_helpers import assert_one_line_error, run_cli
+
+    out = tmp_path / "sweep"
+    out.mkdir()
+    (out / "sweep.json").write_bytes(DAMAGE["deep JSON object"])
+    r = run_cli("sweep", "sequence-1bit", "--quick", "--seeds", "0", "--out", out)
+    assert_one_line_error(r, "sweep.json")
+
+
+def test_a_lone_surrogate_escape_is_refused_naming_the_file() -> None:
+    # "\ud800" in the GA state made json.loads give a str the Rust core cannot take
+    # (UnicodeEncodeError on resume); a pair of surrogate escapes is a character and stays fine.
+    text = (readers.CORPUS / "checkpoint" / "seed-checkpoint.json").read_text()
+    doc = json.loads(text)
+    doc["state"]["evolution"] = "\\ud800" + doc["state"]["evolution"]
+    damaged = json.dumps(doc).replace("\\\\ud800", "\\ud800")
+    assert "\\ud800{" in damaged
+    with pytest.raises(RunFileError, match=r"checkpoint.json: holds a \\u escape of a lone surrogate"):
+        readers.read(readers.READERS["checkpoint"], damaged.encode())

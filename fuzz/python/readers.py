@@ -36,7 +36,7 @@ from typing import Any
 from dnnevo import EvolutionConfig, Network
 from dnnevo.errors import DnnevoError
 from dnnevo.evolution.ga import GeneticAlgorithm
-from dnnevo.experiments import plan, report, results
+from dnnevo.experiments import examples, plan, report, results
 from dnnevo.runs import RunDir, check_settings
 
 __all__ = ["ALLOWED", "CORPUS", "READERS", "Reader", "read"]
@@ -172,6 +172,12 @@ def _provenance(data: bytes, folder: Path) -> None:
     _results_folder(folder, provenance=data)
 
 
+def _example(data: bytes, folder: Path) -> None:
+    path = folder / "example.json"
+    path.write_bytes(data)
+    examples.markdown(examples.read(path))
+
+
 READERS: dict[str, Reader] = {r.name: r for r in (
     Reader("network", _network),
     Reader("checkpoint", _checkpoint),
@@ -181,5 +187,6 @@ READERS: dict[str, Reader] = {r.name: r for r in (
     Reader("results", _results),
     Reader("reproduce", _reproduce),
     Reader("provenance", _provenance),
+    Reader("example", _example),
 )}
 """Every reader, by name."""

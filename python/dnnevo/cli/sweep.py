@@ -22,7 +22,8 @@ from dnnevo.closedloop.fitness import success_rule
 from dnnevo.tasks import DEFAULT_TRIALS, registry
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.runs import LOCK_NAME, RunDir, check_settings, first_difference, write_atomic
+from dnnevo.runs import LOCK_NAME, RunDir, RunFileError, check_settings, first_difference, write_atomic
+from dnnevo.runs.files import checked, read_json
 from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "sweep.json"
@@ -97,12 +98,13 @@ def _extend(manifest: Path, settings: dict[str, Any]) -> None:
     settings is extended: ``manifest`` is rewritten to say so, and each seed's run continues to
     ``G`` generations when its turn comes. Anything else is left to :func:`check_settings`."""
     try:
-        found = json.loads(manifest.read_text(encoding="utf-8"))
-        found = {**found, "config": with_later_defaults(found["config"])}
-        before = found["config"]["generations"]
+        with checked(manifest):  # a damaged manifest is check_settings' to report, not this
+            found = read_json(manifest)
+            found = {**found, "config": with_later_defaults(found["config"])}
+            before = found["config"]["generations"]
         if not isinstance(before, int) or isinstance(before, bool):
             return
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError):
+    except RunFileError:
         return
     after = settings["config"]["generations"]
     if before < after and first_difference(

@@ -33,7 +33,7 @@ from typing import Any
 
 from dnnevo import _core
 from dnnevo.experiments import report
-from dnnevo.runs.files import RunFileError, write_atomic
+from dnnevo.runs.files import RunFileError, read_json, write_atomic
 
 __all__ = ["EXAMPLES_DIR", "blocks", "markdown", "read", "write"]
 
@@ -58,12 +58,9 @@ def write(path: Path, *, command: str, columns: Sequence[str], rows: Sequence[Se
 
 def read(path: Path) -> dict[str, Any]:
     """An example's results, checked: a :class:`~dnnevo.runs.RunFileError` names what is wrong."""
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise RunFileError(f"{path} does not exist; make it with the example's --record") from None
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise RunFileError(f"{path}: not an example's results ({e})") from None
+    if not path.exists() and not path.is_symlink():
+        raise RunFileError(f"{path} does not exist; make it with the example's --record")
+    doc = read_json(path)
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         raise RunFileError(f"{path}: not an example's results (format is not {FORMAT})")
     columns, rows = doc.get("columns"), doc.get("rows")

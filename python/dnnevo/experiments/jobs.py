@@ -33,6 +33,7 @@ from dnnevo.evaluation.assessment import Assessment
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError
 from dnnevo.runs import RunDir, RunFileError, first_difference, short, write_atomic
+from dnnevo.runs.files import read_json
 from dnnevo.evolution.seeding import Seeding
 
 __all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "Settings", "Stopped", "result_path", "read_result", "run_job"]
@@ -108,7 +109,7 @@ def read_result(root: Path, job: plan.Job, settings: Settings) -> dict[str, Any]
     if not path.exists() and not path.is_symlink():
         return None
     try:
-        found = json.loads(path.read_text(encoding="utf-8"))
+        found = read_json(path)
         if not isinstance(found, dict):
             raise ValueError("not a JSON object")
         expected = _header(job, settings)
@@ -122,7 +123,8 @@ def read_result(root: Path, job: plan.Job, settings: Settings) -> dict[str, Any]
             return None
     except RunFileError:
         raise
-    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError, IndexError) as e:
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError, IndexError,
+            OverflowError, RecursionError) as e:
         raise RunFileError(f"{path}: not a valid job result ({type(e).__name__}: {e}); delete it to "
                            "redo the job") from None
     return found

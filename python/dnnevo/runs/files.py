@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import json
+import re
 import os
 import tempfile
 from collections.abc import Callable, Iterator
@@ -108,13 +109,25 @@ def read_text(path: Path) -> str:
         raise fail(path, f"is not UTF-8 text (byte {e.start})") from None
 
 
+#: A ``\u`` escape of a UTF-16 surrogate: half of a pair, or, alone, no character at all.
+_SURROGATE_ESCAPE = re.compile(r"\\u[dD][89a-fA-F][0-9a-fA-F]{2}")
+
+
 def load_json(path: Path, text: str) -> Any:
     try:
-        return json.loads(text)
+        doc = json.loads(text)
     except RecursionError:
         raise fail(path, "JSON nested too deeply") from None
     except ValueError as e:
         raise fail(path, f"not valid JSON: {e}") from None
+    # json.loads turns an escaped lone surrogate into a str that no UTF-8 consumer (the Rust core,
+    # a file) accepts; pairs are fine. Checked only when the text holds such an escape at all.
+    if _SURROGATE_ESCAPE.search(text):
+        try:
+            json.dumps(doc, ensure_ascii=False).encode("utf-8")
+        except UnicodeEncodeError:
+            raise fail(path, "holds a \\u escape of a lone surrogate, which is no character") from None
+    return doc
 
 
 def read_json(path: Path) -> Any:

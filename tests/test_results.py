@@ -200,7 +200,7 @@ def test_an_examples_results_file_is_checked_when_read(tmp_path: Path) -> None:
                    summary=["1 seed"])
     assert examples.read(path)["rows"] == [["0", "0.5"]]
     good = json.loads(path.read_text())
-    for broken, message in [("{", "not an example's results"), ("[]", "format is not"),
+    for broken, message in [("{", "not valid JSON"), ("[]", "format is not"),
                             (json.dumps({**good, "rows": [["0"]]}), "rows of as many cells"),
                             (json.dumps({**good, "summary": [1]}), "all text")]:
         path.write_text(broken)
@@ -208,3 +208,22 @@ def test_an_examples_results_file_is_checked_when_read(tmp_path: Path) -> None:
             examples.read(path)
     with pytest.raises(RunFileError, match="make it with the example's --record"):
         examples.read(tmp_path / "missing.json")
+
+
+def test_an_examples_table_is_rendered_from_its_record_and_checked(repo: Path) -> None:
+    from dnnevo.experiments import examples
+
+    page = repo / "docs" / "classic.md"
+    page.write_text("# Demo\n\n<!-- results:example:demo:begin -->\nold\n<!-- results:example:demo:end -->\n")
+    record = repo / "docs" / "results" / "examples" / "demo.json"
+    examples.write(record, command="python examples/demo.py --seeds 2", columns=["seed", "score"],
+                   rows=[[0, "0.5"], [1, "0.7"]], summary=["2 seeds"])
+    assert _results("render", "--root", repo, "--check").returncode == 1
+    assert _results("render", "--root", repo).returncode == 0
+    text = page.read_text()
+    assert "`python examples/demo.py --seeds 2`:\n\n| seed | score |\n|---|---|\n| 0 | 0.5 |\n| 1 | 0.7 |" in text
+    assert "\n2 seeds\n" in text and "old" not in text
+    assert _results("render", "--root", repo, "--check").returncode == 0
+    record.unlink()
+    r = _results("render", "--root", repo, "--check")
+    assert r.returncode == 2 and "demo.json does not exist; make it with the example's --record" in r.stderr

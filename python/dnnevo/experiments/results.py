@@ -26,6 +26,8 @@ Markdown file under ``docs/``, from ``docs/results/`` alone:
 - ``<!-- results:summary:FAMILY:begin -->``: the same table, for one family;
 - ``<!-- results:FAMILY:begin -->``: each experiment of the family, with one row per seed;
 - ``<!-- results:machine:begin -->``: the machine, and the time per experiment and family.
+- ``<!-- results:example:NAME:begin -->``: an example script's table, from ``examples/NAME.json``
+  (written by the script's ``--record``; :mod:`~dnnevo.experiments.examples`).
 
 ``render --check`` changes nothing and exits with status 1, naming each file whose tables differ
 from what ``render`` would write. The rows are :mod:`~dnnevo.experiments.report`'s, so a
@@ -46,7 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo.errors import DnnevoError
-from dnnevo.experiments import jobs, plan, report
+from dnnevo.experiments import examples, jobs, plan, report
 from dnnevo.experiments.scheduler import Outcome, Task
 from dnnevo.runs import RunFileError, short, write_atomic
 from dnnevo.runs.files import checked, read_json
@@ -390,7 +392,11 @@ def _machine(results: Results) -> list[report.Block]:
 
 def blocks(results: Results, key: str) -> list[report.Block]:
     """The blocks a marker ``key`` stands for (``summary``, ``summary:FAMILY``, ``FAMILY``,
-    ``machine``); raises :class:`~dnnevo.errors.DnnevoError` for an unknown one."""
+    ``machine``, or ``example:NAME``, an example script's table from
+    ``examples/NAME.json`` of the results folder); raises :class:`~dnnevo.errors.DnnevoError` for
+    an unknown one."""
+    if key.startswith("example:"):
+        return examples.blocks(examples.read(results.folder / examples.EXAMPLES_DIR / f"{key[len('example:'):]}.json"))
     if key in ("summary", _README_KEY):
         return _summary(results, None)
     if key.startswith("summary:") and key.split(":", 1)[1] in plan.FAMILIES:
@@ -400,7 +406,7 @@ def blocks(results: Results, key: str) -> list[report.Block]:
     if key == "machine":
         return _machine(results)
     raise DnnevoError(f"unknown results marker {key!r}; markers are summary, summary:FAMILY, FAMILY, machine "
-                      f"(FAMILY one of {', '.join(plan.FAMILIES)}), and results-table in the README")
+                      f"(FAMILY one of {', '.join(plan.FAMILIES)}), example:NAME, and results-table in the README")
 
 
 def fill(text: str, results: Results, *, where: str = "") -> str:

@@ -1,109 +1,164 @@
 """Double-pole balancing without velocities, the classic neuroevolution benchmark: how many
-network evaluations dnnevo's GA needs before a CTRNN solves it.
+episodes dnnevo's GA runs before a CTRNN solves it.
 
-Each seed evolves a population of 5-neuron CTRNNs on Gruau et al.'s damping fitness
-(:class:`dnnevo.classic.DoublePole`, one 1,000-step episode from the standard start). Whenever
-the champion changes and has balanced a whole training episode, it takes the benchmark's test
+Each seed runs the ``double-pole`` preset (``dnnevo presets``; change it with ``--set
+key=value``) on :class:`dnnevo.classic.DoublePole`. Whenever the champion changes and has
+balanced at least half of its training steps, it takes the benchmark's test
 (:func:`dnnevo.classic.double_pole.solves`): at least 200 of the 625 generalisation starts, and
-100,000 steps from the standard start. The evaluations a seed needed are the population size times
-the generations run when its champion first passed; a seed that spends ``--budget`` evaluations
-without passing counts as not solved::
+100,000 steps from the standard start. A seed's cost is the episodes it ran until its champion
+first passed, training and validation together (an episode is one of the benchmark's
+evaluations: up to 1,000 steps of one network); a seed that spends ``--budget`` episodes without
+passing counts as not solved::
 
-    python examples/double_pole.py --seeds 10 --out double-pole.png
+    python examples/double_pole.py --seeds 20 --out double-pole.png
     python examples/double_pole.py --seeds 10 --velocities    # the Markovian task
+    python examples/double_pole.py --seeds 10 --set task_params.start=standard --set task_params.episodes=1 \\
+        --set validation_candidates=0    # the benchmark's own training: one episode from the standard start
 
-prints one row per seed (evaluations, and the best generalisation score of a tested champion with
-its long-test steps, 0 where the long test did not run), the solved count with its 95% Wilson
-interval and the median evaluations of the solved seeds, and draws each seed's best
+prints one row per seed (episodes, generations, and the best generalisation score of a tested
+champion with its long-test steps, 0 where the long test did not run), the solved count with its
+95% Wilson interval and the median episodes of the solved seeds, and draws each seed's best
 generalisation score.
 """
 
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
+import shlex
+import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 import dnnevo
-from dnnevo import plot
-from dnnevo.classic import DoublePole
+from dnnevo import plot, presets
 from dnnevo.classic import double_pole as dp
-from dnnevo.closedloop import ClosedLoop
+from dnnevo.closedloop import ClosedLoop, named
 from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
 from dnnevo.runs import save_figure
 
-SIZE = 5
-BALANCED_EPISODE = 0.1  # the damping fitness of a whole 1,000-step episode is above 0.1
+PRESET = "double-pole"
+TESTED = 0.05  # a champion takes the test once its mean training fitness shows 500 balanced steps
 
 
-def config(population: int, generations: int, velocities: bool) -> dnnevo.EvolutionConfig:
-    return dnnevo.EvolutionConfig(population=population, generations=generations, size=SIZE,
-                                  n_inputs=6 if velocities else 3, selection="rank", elitism=5,
-                                  mutation_rate=0.05, validation_candidates=0)
+class Counted:
+    """A closed-loop task that counts the episodes it runs, for training and for validation."""
+
+    def __init__(self, loop: ClosedLoop) -> None:
+        self.loop, self.episodes = loop, 0
+
+    def __call__(self, networks: Sequence[dnnevo.Network], *, generation: int = 0,
+                 seed: int = 0) -> np.ndarray:
+        self.episodes += len(networks) * self.loop.settings["episodes"]
+        return self.loop(networks, generation=generation, seed=seed)
+
+    def validate(self, networks: Sequence[dnnevo.Network], *, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        self.episodes += len(networks) * self.loop.validation_episodes
+        return self.loop.validate(networks, seed=seed)
 
 
-def one_seed(seed: int, population: int, budget: int, velocities: bool = False) -> dict[str, Any]:
-    """Evolves until the champion solves the task or ``budget`` evaluations are spent."""
+def config(budget: int, overrides: Sequence[str]) -> dnnevo.EvolutionConfig:
+    """The preset with ``overrides``, and generations enough for ``budget`` training episodes."""
+    base = presets.get(PRESET, overrides=list(overrides))
+    per_generation = base.population * int(base.task_params.get("episodes", 1))
+    return presets.get(PRESET, overrides=[*overrides, f"generations={-(-budget // per_generation)}"])
+
+
+def one_seed(seed: int, budget: int, overrides: Sequence[str]) -> dict[str, Any]:
+    """Evolves until the champion solves the task or ``budget`` episodes are spent."""
+    cfg = config(budget, overrides)
+    velocities = bool(cfg.task_params.get("velocities", False))
+    fitness = Counted(named.closed_loop(cfg))
     tested: dict[int, tuple[bool, int, int]] = {}
     found: dict[str, int] = {}
 
     def check(stats: dict[str, float], ga: dnnevo.GeneticAlgorithm) -> bool:
+        if fitness.episodes >= budget:
+            return True
         generation = ga.best_generation
         if ga.best is None or generation is None or generation in tested:
             return False
-        if (ga.best_fitness or 0.0) <= BALANCED_EPISODE:
+        if (ga.best_fitness or 0.0) < TESTED:
             return False
         tested[generation] = dp.solves(ga.best, velocities=velocities)
         if tested[generation][0]:
-            found["evaluations"] = population * ga.generation
+            found.update(episodes=fitness.episodes, generations=ga.generation)
             return True
         return False
 
     started = time.perf_counter()
-    fitness = ClosedLoop(DoublePole(velocities=velocities), episodes=1,
-                         max_steps=dp.GENERALIZATION_STEPS)
-    result = dnnevo.evolve(fitness, config(population, budget // population, velocities), seed=seed,
-                           progress=False, callback=check)
+    result = dnnevo.evolve(fitness, cfg, seed=seed, progress=False, callback=check)
     if result.interrupted:  # Ctrl-C or SIGTERM stops evolve after a generation; stop here too
         raise KeyboardInterrupt
     # The champion that solved it, else the one that came closest.
     best = max(tested.values(), key=lambda t: (t[0], t[2], t[1]), default=(False, 0, 0))
-    return {"seed": seed, "evaluations": found.get("evaluations"), "long": best[1],
-            "generalization": best[2], "tests": len(tested),
+    return {"seed": seed, "episodes": found.get("episodes"), "generations": found.get("generations"),
+            "long": best[1], "generalization": best[2], "tests": len(tested),
             "seconds": time.perf_counter() - started}
+
+
+def seeds_run(seeds: int, workers: int, budget: int, overrides: Sequence[str]) -> Iterator[dict[str, Any]]:
+    """Each seed's result, in seed order, as it comes: one after another here, or ``workers`` at
+    a time in processes of their own (the same results either way)."""
+    if workers <= 1:
+        for seed in range(seeds):
+            yield one_seed(seed, budget, overrides)
+        return
+    with concurrent.futures.ProcessPoolExecutor(workers) as pool:
+        running = [pool.submit(one_seed, seed, budget, overrides) for seed in range(seeds)]
+        for future in running:
+            yield future.result()
 
 
 def main(argv: Sequence[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--seeds", type=int, default=10, help="seeds 0 .. N-1 (default 10)")
-    p.add_argument("--population", type=int, default=100)
+    p.add_argument("--seeds", type=int, default=20, help="seeds 0 .. N-1 (default 20)")
     p.add_argument("--velocities", action="store_true",
                    help="the Markovian task: the network also senses the three velocities")
-    p.add_argument("--budget", type=int, default=50_000, help="evaluations per seed (default 50000)")
+    p.add_argument("--budget", type=int, default=100_000,
+                   help="episodes per seed, training and validation (default 100000)")
+    p.add_argument("--workers", type=int, default=1,
+                   help="run this many seeds at once, each in a process of its own (default 1)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a setting of the preset (repeatable), as for dnnevo run")
     p.add_argument("--out", type=Path, help="write the figure here")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs (docs/results/examples/double-pole.json)")
     args = p.parse_args(argv)
+    overrides = [*args.set, *(["task_params.velocities=true", "n_inputs=6"] if args.velocities else [])]
     rows = []
-    print("seed  evaluations  generalisation  long-test steps  tests  seconds")
-    for seed in range(args.seeds):
-        r = one_seed(seed, args.population, args.budget, args.velocities)
+    print("seed     episodes  generations  generalisation  long-test steps  tests  seconds")
+    for r in seeds_run(args.seeds, args.workers, args.budget, overrides):
         rows.append(r)
-        shown = r["evaluations"] if r["evaluations"] is not None else f">{args.budget}"
-        print(f"{seed:4d}  {shown!s:>11}  {r['generalization']:14d}  {r['long']:15d}  "
-              f"{r['tests']:5d}  {r['seconds']:7.0f}", flush=True)
-    solved = [r["evaluations"] for r in rows if r["evaluations"] is not None]
+        shown = r["episodes"] if r["episodes"] is not None else f">{args.budget}"
+        print(f"{r['seed']:4d}  {shown!s:>11}  {r['generations'] or '-'!s:>11}  {r['generalization']:14d}  "
+              f"{r['long']:15d}  {r['tests']:5d}  {r['seconds']:7.0f}", flush=True)
+    solved = [r["episodes"] for r in rows if r["episodes"] is not None]
     lo, hi = wilson(len(solved), len(rows))
-    print(f"solved {len(solved)} of {len(rows)} seeds within {args.budget} evaluations "
-          f"(95% interval {lo:.0%}-{hi:.0%})")
+    summary = [f"solved {len(solved)} of {len(rows)} seeds within {args.budget} episodes "
+               f"(95% interval {lo:.0%}-{hi:.0%})"]
     if solved:
-        print(f"median evaluations of the solved seeds: {np.median(solved):.0f}")
+        summary.append(f"episodes of the solved seeds: median {np.median(solved):.0f}, "
+                       f"mean {np.mean(solved):.0f}")
+    print("\n".join(summary))
+    if args.record:
+        given = list(sys.argv[1:] if argv is None else argv)
+        if "--record" in given:  # the command that makes the table, without where it was written
+            del given[given.index("--record"):given.index("--record") + 2]
+        table = [[r["seed"], r["episodes"] or f"not within {args.budget}", r["generations"] or "-",
+                  r["generalization"], r["long"]] for r in rows]
+        examples.write(args.record, command=shlex.join(["python", "examples/double_pole.py", *given]),
+                       columns=["seed", "episodes", "generations", "generalisation (of 625)",
+                                "long test (steps)"], rows=table, summary=summary)
     if args.out:
         fig, ax = plot.subplots(figsize=(7, 3.5), layout="constrained")
         ax.bar([r["seed"] for r in rows], [r["generalization"] for r in rows],
-               color=["tab:green" if r["evaluations"] is not None else "tab:gray" for r in rows])
+               color=["tab:green" if r["episodes"] is not None else "tab:gray" for r in rows])
         ax.axhline(dp.GENERALIZATION_NEEDED, color="k", lw=0.8, ls="--",
                    label="200 of 625: the generalisation test")
         ax.set_ylim(0, len(dp.GRID))
@@ -111,7 +166,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         ax.set_ylabel("best champion's generalisation score")
         task = "with velocities" if args.velocities else "no velocities"
         ax.set_title(f"double pole, {task}: {len(solved)}/{len(rows)} solved within "
-                     f"{args.budget} evaluations")
+                     f"{args.budget} episodes")
         ax.legend(loc="lower right", fontsize=8)
         save_figure(fig, args.out)
         plot.close(fig)

@@ -95,12 +95,18 @@ def test_double_pole(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
     """A row per seed, the solved count with its interval, and the figure."""
     from cli_helpers import assert_png
 
-    double_pole.main(["--seeds", "2", "--population", "10", "--budget", "30",
-                      "--out", str(tmp_path / "d.png")])
+    from dnnevo.experiments import examples
+
+    double_pole.main(["--seeds", "2", "--set", "population=10", "--budget", "120", "--workers", "2",
+                      "--out", str(tmp_path / "d.png"), "--record", str(tmp_path / "d.json")])
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].startswith("seed  evaluations  generalisation") and len(lines) == 4
-    assert lines[1].split()[:2] == ["0", ">30"]
-    assert lines[-1].startswith("solved 0 of 2 seeds within 30 evaluations (95% interval 0%-")
+    assert lines[0].split()[:3] == ["seed", "episodes", "generations"] and len(lines) == 4
+    assert lines[1].split()[:3] == ["0", ">120", "-"] and lines[2].split()[0] == "1"
+    assert lines[-1].startswith("solved 0 of 2 seeds within 120 episodes (95% interval 0%-")
+    recorded = examples.read(tmp_path / "d.json")
+    assert recorded["command"] == ("python examples/double_pole.py --seeds 2 --set population=10 --budget 120 "
+                                   f"--workers 2 --out {tmp_path / 'd.png'}")
+    assert recorded["rows"][0][:3] == ["0", "not within 120", "-"] and recorded["summary"] == [lines[-1]]
     assert_png(tmp_path / "d.png")
 
 

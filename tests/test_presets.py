@@ -67,7 +67,7 @@ def test_a_misspelt_preset_or_task_gets_a_did_you_mean() -> None:
         presets.get("sequence-2bit-direct1")
     with pytest.raises(dnnevo.ConfigError) as nothing_close:
         presets.get("maze")
-    assert "did you mean" not in str(nothing_close.value) and "presets: categorical-perception, landmark, " in str(nothing_close.value)
+    assert "did you mean" not in str(nothing_close.value) and "presets: categorical-perception, double-pole, landmark, " in str(nothing_close.value)
     # A task name, given alone or with a config that names it: the same message.
     for config in (None, dnnevo.EvolutionConfig(task="sequnce")):
         with pytest.raises(dnnevo.ConfigError, match=r"unknown task 'sequnce' \(did you mean 'sequence'\?\)"):

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import dataclasses
 import shlex
 import sys
 import time
@@ -73,6 +74,7 @@ def one_seed(seed: int, budget: int, overrides: Sequence[str]) -> dict[str, Any]
     """Evolves until the champion solves the task or ``budget`` episodes are spent."""
     cfg = config(budget, overrides)
     velocities = bool(cfg.task_params.get("velocities", False))
+    integrator = dataclasses.asdict(cfg.integrator)  # the test integrates as training did
     fitness = Counted(named.closed_loop(cfg))
     tested: dict[int, tuple[bool, int, int]] = {}
     found: dict[str, int] = {}
@@ -85,7 +87,7 @@ def one_seed(seed: int, budget: int, overrides: Sequence[str]) -> dict[str, Any]
             return False
         if (ga.best_fitness or 0.0) < TESTED:
             return False
-        tested[generation] = dp.solves(ga.best, velocities=velocities)
+        tested[generation] = dp.solves(ga.best, velocities=velocities, **integrator)
         if tested[generation][0]:
             found.update(episodes=fitness.episodes, generations=ga.generation)
             return True
@@ -111,18 +113,32 @@ def seeds_run(seeds: int, workers: int, budget: int, overrides: Sequence[str]) -
         return
     with concurrent.futures.ProcessPoolExecutor(workers) as pool:
         running = [pool.submit(one_seed, seed, budget, overrides) for seed in range(seeds)]
-        for future in running:
-            yield future.result()
+        try:
+            for future in running:
+                yield future.result()
+        except BaseException:  # Ctrl-C: the seeds not yet started never start
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1")
+    return value
 
 
 def main(argv: Sequence[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--seeds", type=int, default=20, help="seeds 0 .. N-1 (default 20)")
+    p.add_argument("--seeds", type=_positive, default=20, help="seeds 0 .. N-1 (default 20)")
     p.add_argument("--velocities", action="store_true",
                    help="the Markovian task: the network also senses the three velocities")
-    p.add_argument("--budget", type=int, default=100_000,
+    p.add_argument("--budget", type=_positive, default=100_000,
                    help="episodes per seed, training and validation (default 100000)")
-    p.add_argument("--workers", type=int, default=1,
+    p.add_argument("--workers", type=_positive, default=1,
                    help="run this many seeds at once, each in a process of its own (default 1)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a setting of the preset (repeatable), as for dnnevo run")
@@ -150,6 +166,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         given = list(sys.argv[1:] if argv is None else argv)
         if "--record" in given:  # the command that makes the table, without where it was written
             del given[given.index("--record"):given.index("--record") + 2]
+        given = [a for a in given if not a.startswith("--record=")]
         table = [[r["seed"], r["episodes"] or f"not within {args.budget}", r["generations"] or "-",
                   r["generalization"], r["long"]] for r in rows]
         examples.write(args.record, command=shlex.join(["python", "examples/double_pole.py", *given]),

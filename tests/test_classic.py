@@ -108,6 +108,11 @@ def test_random_starts_fill_the_grids_box_from_the_episodes_generator() -> None:
     assert (state[:4].min(axis=1) < low + 0.1 * (high - low)).all()  # the whole box, not a corner
     np.testing.assert_array_equal(env.reset(np.arange(500), np.random.default_rng(5)), first)
     assert not np.array_equal(env.reset(np.arange(500), np.random.default_rng(6)), first)
+    # Rows of one episode (the rollout's networks x episodes) start alike: common random numbers.
+    env.reset(np.tile(np.arange(4), 3), np.random.default_rng(1))
+    np.testing.assert_array_equal(env.state[:, :4], env.state[:, 4:8])
+    np.testing.assert_array_equal(env.state[:, :4], env.state[:, 8:])
+    assert len({tuple(env.state[:, k]) for k in range(4)}) == 4
 
 
 def test_bad_settings_are_named() -> None:

@@ -136,7 +136,8 @@ class DoublePole:
         return 6 if self.velocities else 3
 
     def reset(self, episodes: npt.NDArray[np.int64], rng: np.random.Generator) -> npt.NDArray[np.float64]:
-        """Every row at its start; ``rng`` draws the starts only with ``start="random"``."""
+        """Every row at its episode's start; ``rng`` draws the starts only with
+        ``start="random"``, one per episode, so that every network meets the same ones."""
         rows = len(episodes)
         if self.start == "standard":
             cart = np.tile(STANDARD_START, (rows, 1))
@@ -144,7 +145,8 @@ class DoublePole:
             cart = GRID[episodes % len(GRID)]
         else:
             low, high = np.array(START_SPANS).T
-            cart = rng.uniform(low, high, size=(rows, 4))
+            count = int(episodes.max()) + 1 if rows else 0
+            cart = rng.uniform(low, high, size=(count, 4))[episodes]
         self.state = np.zeros((6, rows))
         self.state[:4] = cart.T
         self.t = 0

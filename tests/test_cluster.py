@@ -23,7 +23,7 @@ from dnnevo.experiments.runsview import RunsView
 
 pytest.importorskip("distributed")
 
-SWEEP = ["sweep", "sequence-1bit", "--quick", "--set", "population=12", "--set", "generations=40",
+SWEEP = ["sweep", "sequence-1bit", "--quick", "--set", "population=12", "--set", "generations=120",
          "--eval-trials", "5", "--no-dt-check"]
 
 
@@ -35,6 +35,14 @@ def test_a_worker_that_runs_another_dnnevo_is_refused_in_one_line() -> None:
     message = str(refused.value)
     assert "runs dnnevo" in message and "its results could differ" in message
     assert scheduler.identity()["commit"] in message and "\n" not in message
+
+
+def test_a_task_on_a_worker_that_runs_another_dnnevo_refuses_to_run() -> None:
+    """A worker that joined after the cluster was checked is held to the same dnnevo."""
+    other = {**scheduler.identity(), "version": "0.0.0"}
+    with pytest.raises(ConfigError, match="this Dask worker runs dnnevo .* the command dnnevo 0.0.0"):
+        scheduler._checked_call(other, abs, (-1,), {})
+    assert scheduler._checked_call(scheduler.identity(), abs, (-1,), {}) == 1
 
 
 def test_waiting_on_a_lost_cluster_is_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -97,6 +105,7 @@ def test_a_sweep_whose_scheduler_dies_ends_in_one_line_and_continues_to_the_same
             if list(out.glob("seed-*/checkpoint.json")) or sweep.poll() is not None:
                 break
             time.sleep(0.05)
+        assert sweep.poll() is None, "the sweep ended before its scheduler could be stopped"
         _stop(boss)
         stdout, stderr = sweep.communicate(timeout=120)
     finally:

@@ -202,7 +202,8 @@ def test_an_examples_results_file_is_checked_when_read(tmp_path: Path) -> None:
     good = json.loads(path.read_text())
     for broken, message in [("{", "not valid JSON"), ("[]", "format is not"),
                             (json.dumps({**good, "rows": [["0"]]}), "rows of as many cells"),
-                            (json.dumps({**good, "summary": [1]}), "all text")]:
+                            (json.dumps({**good, "summary": [1]}), "all text"),
+                            (json.dumps({**good, "made": "abc"}), "what made them")]:
         path.write_text(broken)
         with pytest.raises(RunFileError, match=message):
             examples.read(path)

@@ -308,6 +308,9 @@ def test_bad_worlds_resets_and_placements_name_the_argument(tmp_path: Path) -> N
         f.place([[1, 1, 0], [1, 1, 0]], [[4, 4, 0], [4, 4, 0]])
     with pytest.raises(InvalidArgumentError, match=r"poses\[1\] is \(0.1, 1\) with clearance"):
         f.place([[1, 1, 0], [0.1, 1, 0]])
+    # Beyond the walls the clearance to them is large: a pose there is outside the room all the same.
+    with pytest.raises(InvalidArgumentError, match=r"poses\[1\] is \(100, 100\).*inside the room"):
+        f.place([[1, 1, 0], [100, 100, 0]])
     with pytest.raises(InvalidArgumentError, match=r"pursuers.min_start_distance is 50"):
         _core.Fleet(_core.sim2d_landmark_world(1), {"pursuers": {"count": 1, "min_start_distance": 50}}).reset([0], 0)
 

@@ -25,12 +25,37 @@ pub fn stabilities() -> Vec<String> {
     Stability::ALL.iter().map(name).collect()
 }
 
-fn complex(py: Python<'_>, pairs: &[[f64; 2]]) -> Py<PyArray1<Complex64>> {
+fn complex(py: Python<'_>, pairs: &[[f64; 2]]) -> PyResult<Py<PyArray1<Complex64>>> {
     let z: Vec<Complex64> = pairs
         .iter()
         .map(|&[re, im]| Complex64::new(re, im))
         .collect();
-    PyArray1::from_vec(py, z).unbind()
+    frozen(py, PyArray1::from_vec(py, z).unbind())
+}
+
+/// `array`, made read-only: a result is frozen, and its `to_dict()` is built from the struct.
+fn frozen<T>(py: Python<'_>, array: Py<T>) -> PyResult<Py<T>> {
+    let kwargs = PyDict::new(py);
+    kwargs.set_item("write", false)?;
+    array
+        .bind(py)
+        .as_any()
+        .call_method("setflags", (), Some(&kwargs))?;
+    Ok(array)
+}
+
+/// A read-only 1-D array of `v`.
+fn fixed(py: Python<'_>, v: Vec<f64>) -> PyResult<Py<PyArrayDyn<f64>>> {
+    frozen(py, vector(py, v)?)
+}
+
+/// A read-only (rows, columns) array.
+fn fixed_rows<R: AsRef<[f64]>>(
+    py: Python<'_>,
+    rows: Vec<R>,
+    columns: usize,
+) -> PyResult<Py<PyArrayDyn<f64>>> {
+    frozen(py, matrix(py, rows, columns)?)
 }
 
 /// One equilibrium and its linear stability.
@@ -54,9 +79,9 @@ pub struct PyEquilibrium {
 impl PyEquilibrium {
     pub fn new(py: Python<'_>, e: Equilibrium) -> PyResult<Self> {
         Ok(PyEquilibrium {
-            state: vector(py, e.state.clone())?,
-            outputs: vector(py, e.outputs.clone())?,
-            eigenvalues: complex(py, &e.eigenvalues),
+            state: fixed(py, e.state.clone())?,
+            outputs: fixed(py, e.outputs.clone())?,
+            eigenvalues: complex(py, &e.eigenvalues)?,
             stability: name(&e.stability),
             inner: e,
         })
@@ -131,11 +156,11 @@ impl PyCycle {
     pub fn new(py: Python<'_>, c: Cycle) -> PyResult<Self> {
         let n = c.amplitude.len();
         Ok(PyCycle {
-            amplitude: vector(py, c.amplitude.clone())?,
-            mean_outputs: vector(py, c.mean_outputs.clone())?,
-            output_range: matrix(py, c.output_range.clone(), 2)?,
-            multipliers: complex(py, &c.multipliers),
-            orbit: matrix(py, c.orbit.clone(), n)?,
+            amplitude: fixed(py, c.amplitude.clone())?,
+            mean_outputs: fixed(py, c.mean_outputs.clone())?,
+            output_range: fixed_rows(py, c.output_range.clone(), 2)?,
+            multipliers: complex(py, &c.multipliers)?,
+            orbit: fixed_rows(py, c.orbit.clone(), n)?,
             inner: c,
         })
     }
@@ -399,8 +424,8 @@ impl PyBifurcation {
         let events = objects(py, &b.events, |py, e: Event| {
             Ok(PyEvent {
                 kind: name(&e.kind),
-                state: vector(py, e.state.clone())?,
-                outputs: vector(py, e.outputs.clone())?,
+                state: fixed(py, e.state.clone())?,
+                outputs: fixed(py, e.outputs.clone())?,
                 inner: e,
             })
         })?;
@@ -412,8 +437,8 @@ impl PyBifurcation {
             })
         })?;
         Ok(PyBifurcation {
-            input: vector(py, base.clone())?,
-            values: vector(py, b.values.clone())?,
+            input: fixed(py, base.clone())?,
+            values: fixed(py, b.values.clone())?,
             base,
             equilibria,
             events,

@@ -381,18 +381,22 @@ impl Fleet {
         Ok(())
     }
 
-    /// Checks that `p` is finite and that a disc of `radius` there overlaps no wall or box.
+    /// Checks that `p` is finite and that a disc of `radius` there lies inside the room and
+    /// overlaps no wall or box.
     fn check_pose(&self, at: &str, p: &Pose, radius: f64) -> Result<(), Error> {
         for (v, what) in [(p.x, "x"), (p.y, "y"), (p.heading, "heading")] {
             let field = format!("{at}.{what}");
             check_range(&field, v, f64::NEG_INFINITY, false, f64::INFINITY, false)?;
         }
+        // Clearance measures the distance to the walls, which is as large outside the room.
+        let [w, h] = self.arena.world.room();
+        let inside = (radius..=w - radius).contains(&p.x) && (radius..=h - radius).contains(&p.y);
         let c = self.arena.world.clearance(p.position(), radius);
-        if c < 0.0 {
+        if !inside || c < 0.0 {
             return Err(Error::invalid(
                 at,
                 format!("({}, {}) with clearance {c:.4} m", p.x, p.y),
-                "a position where it overlaps no wall or box",
+                "a position inside the room where it overlaps no wall or box",
             ));
         }
         Ok(())

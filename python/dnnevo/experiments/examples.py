@@ -64,11 +64,13 @@ def read(path: Path) -> dict[str, Any]:
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         raise RunFileError(f"{path}: not an example's results (format is not {FORMAT})")
     columns, rows = doc.get("columns"), doc.get("rows")
+    made = doc.get("made", {})
     ok = (isinstance(doc.get("command"), str) and _strings(columns) and _strings(doc.get("summary"))
-          and isinstance(rows, list) and all(_strings(r) and len(r) == len(columns) for r in rows))
+          and isinstance(rows, list) and all(_strings(r) and len(r) == len(columns) for r in rows)
+          and isinstance(made, dict) and _strings(list(made.values())))
     if not ok:
         raise RunFileError(f"{path}: an example's results need a command, columns, rows of as many "
-                           "cells and summary lines, all text")
+                           "cells, summary lines and what made them, all text")
     return doc
 
 

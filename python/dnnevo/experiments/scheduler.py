@@ -103,25 +103,32 @@ def run_on_dask(tasks: Sequence[Task], view: RunsView, client: Any) -> dict[str,
     extra arguments after its own, so the scheduler runs it after them."""
     token = uuid.uuid4().hex[:8]
     futures: dict[str, Any] = {}
+    here = identity()
     for task in tasks:
         needed = [futures[n] for n in task.needs]
-        futures[task.id] = client.submit(_call, task.fn, task.args, task.kwargs, *needed,
+        futures[task.id] = client.submit(_checked_call, here, task.fn, task.args, task.kwargs, *needed,
                                          key=f"{task.id}-{token}", pure=False)
     by_key = {f.key: task for task, f in zip(tasks, futures.values(), strict=True)}
     ended: dict[str, tuple[bool, Any]] = {}  # (finished, its result or its error), as it ended
-    try:
-        for future in _distributed().as_completed(list(futures.values())):
+    done: Iterator[Any] | None = None
+    while True:
+        try:  # only waiting on the cluster is a sign of losing it, not writing the view
+            if done is None:
+                done = iter(_distributed().as_completed(list(futures.values())))
+            future = next(done, None)
+            if future is None:
+                break
             task = by_key[future.key]
             if future.status not in ("finished", "error"):  # cancelled or lost with the scheduler
                 raise concurrent.futures.CancelledError(f"{task.id} was {future.status}")
             ok = future.status == "finished"
             ended[task.id] = (ok, future.result() if ok else future.exception())
-            view.finished(task.id, "done" if ok else "failed", wall=_wall(ended[task.id][1]) if ok else None,
-                          running=_running(client))
-    except LOST as e:
-        raise DnnevoError(f"lost the Dask cluster after {len(ended)} of {len(tasks)} tasks "
-                          f"({type(e).__name__}: {e or 'no reason given'}); every run keeps its last "
-                          "checkpoint: run the same command again to continue") from None
+        except LOST as e:
+            raise DnnevoError(f"lost the Dask cluster after {len(ended)} of {len(tasks)} tasks "
+                              f"({type(e).__name__}: {e or 'no reason given'}); every run keeps its last "
+                              "checkpoint: run the same command again to continue") from None
+        view.finished(task.id, "done" if ok else "failed", wall=_wall(ended[task.id][1]) if ok else None,
+                      running=_running(client))
     # Decided in order: a task whose need did not finish is skipped, whatever its future says.
     outcomes: dict[str, Outcome] = {}
     for task in tasks:
@@ -176,6 +183,18 @@ def _wall(result: Any) -> float | None:
 def _call(fn: Callable[..., Any], args: tuple[Any, ...], kwargs: dict[str, Any], *needed: Any) -> Any:
     """``fn(*args, **kwargs)``; ``needed`` (results of the tasks it waited for) is dropped."""
     return fn(*args, **kwargs)
+
+
+def _checked_call(expected: dict[str, str], fn: Callable[..., Any], args: tuple[Any, ...],
+                  kwargs: dict[str, Any], *needed: Any) -> Any:
+    """:func:`_call` on a worker that runs the dnnevo ``expected`` names, checked again here:
+    a worker that joined the cluster after :func:`check_workers` is held to it too."""
+    theirs = identity()
+    if theirs != expected:
+        raise ConfigError(f"this Dask worker runs dnnevo {theirs['version']} built from {theirs['commit']}, "
+                          f"the command dnnevo {expected['version']} built from {expected['commit']}; its "
+                          "results could differ, so it refused the task: install the same dnnevo on every worker")
+    return _call(fn, args, kwargs, *needed)
 
 
 def _running(client: Any) -> int | None:

@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import concurrent.futures
 import dataclasses
+import multiprocessing
 import shlex
 import sys
 import time
@@ -111,7 +112,10 @@ def seeds_run(seeds: int, workers: int, budget: int, overrides: Sequence[str]) -
         for seed in range(seeds):
             yield one_seed(seed, budget, overrides)
         return
-    with concurrent.futures.ProcessPoolExecutor(workers) as pool:
+    # Spawned, not forked: a fork of a process that runs threads (rayon's, a test runner's) can
+    # inherit a lock held by one of them and hang.
+    spawn = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=spawn) as pool:
         running = [pool.submit(one_seed, seed, budget, overrides) for seed in range(seeds)]
         try:
             for future in running:

@@ -8,6 +8,14 @@
 //! relative to the pursuer's heading, wrapped into `(-pi, pi]`, so a pursuer that can turn far
 //! enough faces the robot at the end of the step. It always drives forward at `speed`.
 //!
+//! Pure pursuit stops dead at a box between a pursuer and the robot: the pursuer presses into
+//! the box's face for as long as the robot stays behind it. With `detour` on, a pursuer whose
+//! pure-pursuit step a wall or box would cut short takes another step instead, turning left as
+//! fast as it can (`omega = max_turn_rate`) at `speed`: pressed against a face, it turns until it
+//! runs along it, skims it with the obstacle on its right, and turns back to the robot past the
+//! corner, as a bug algorithm does around a convex obstacle. The detour needs no memory: the
+//! heading carries it from step to step.
+//!
 //! # Motion
 //! A pursuer moves as the robot does ([`RobotSpec::step`]: along the chord of the step's arc,
 //! stopping short of walls and boxes), with the `v` and `omega` of its policy; it never enters a
@@ -51,6 +59,9 @@ pub struct PursuerSpec {
     /// How far from the robot's centre a pursuer's centre starts at least, in metres, >= 0.
     /// Default 2.
     pub min_start_distance: f64,
+    /// Whether a pursuer blocked by a wall or box turns left around it instead of pressing into
+    /// it (see the [module docs](self)). Default false: pure pursuit alone.
+    pub detour: bool,
 }
 
 impl Default for PursuerSpec {
@@ -62,6 +73,7 @@ impl Default for PursuerSpec {
             max_turn_rate: 1.5,
             capture_radius: 0.5,
             min_start_distance: 2.0,
+            detour: false,
         }
     }
 }
@@ -119,8 +131,10 @@ impl PursuerSpec {
     }
 
     /// Moves a pursuer for `dt` seconds towards `target` by [`PursuerSpec::command`], stopping
-    /// short of walls and boxes as [`RobotSpec::step`] does. Returns whether a wall or box cut the
-    /// motion short. Errors if `dt` is not finite and >= 0.
+    /// short of walls and boxes as [`RobotSpec::step`] does; with `detour` on, a step that a wall
+    /// or box would cut short is replaced by a left turn at the turning limit (see the
+    /// [module docs](self)). Returns whether a wall or box cut the motion short. Errors if `dt`
+    /// is not finite and >= 0.
     ///
     /// # Example
     /// ```
@@ -145,6 +159,13 @@ impl PursuerSpec {
         let (v, omega) = self.command(pursuer, target, dt);
         let body = self.body();
         let (v_left, v_right) = body.wheels(v, omega);
+        let start = *pursuer;
+        let blocked = body.step(pursuer, v_left, v_right, dt, world)?;
+        if !(blocked && self.detour) {
+            return Ok(blocked);
+        }
+        *pursuer = start;
+        let (v_left, v_right) = body.wheels(v, self.max_turn_rate);
         body.step(pursuer, v_left, v_right, dt, world)
     }
 

@@ -1,0 +1,179 @@
+"""Predator avoidance (dnnevo.robots.Pursuit): its reward and success rule on hand-built cases,
+the baselines, and a short evolution."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dnnevo
+from dnnevo.closedloop import ClosedLoop, rollout
+from dnnevo.errors import InvalidArgumentError
+from dnnevo.robots import Pursuit
+from dnnevo.robots.pursuit import ARENA, PURSUERS, TRANSFER, drive, escape
+
+STILL = np.array([[0.5, 0.5]])  # rates of 0.5: both wheels at 0 m/s
+AHEAD = np.array([[1.0, 1.0]])  # full speed ahead
+ONE = np.array([True])
+
+
+def placed(robot: list[float], pursuers: list[list[float]], **kwargs: object) -> Pursuit:
+    """A Pursuit of one row with its robot and pursuers placed by hand."""
+    env = Pursuit(**kwargs)  # type: ignore[arg-type]
+    env.reset(np.array([0]), np.random.default_rng(0))
+    env.fleet.place([robot], [pursuers])
+    return env
+
+
+def run(env: Pursuit, rates: np.ndarray, steps: int) -> tuple[list[float], list[bool]]:
+    rewards, done = [], []
+    for _ in range(steps):
+        _, r, d = env.step(rates, ONE)
+        rewards.append(float(r[0]))
+        done.append(bool(d[0]))
+        if d[0]:
+            break
+    return rewards, done
+
+
+# ---------------------------------------------------------------------------------------------
+# the reward and the success rule on hand-built cases
+
+
+def test_a_caught_robot_is_paid_for_the_steps_it_survived_and_fails() -> None:
+    # A still robot at (1, 5), a pursuer 1.5 m to its right facing it, the other far away: the
+    # gap closes at 0.4 m/s, 0.04 m per step, and reaches the capture radius of 0.5 m after
+    # 1.0 / 0.04 = 25 steps. The 24 steps before pay 1/50 each; the step of the capture nothing.
+    env = placed([1.0, 5.0, 0.0], [[2.5, 5.0, np.pi], [7.5, 0.5, 0.0]], steps=50)
+    rewards, done = run(env, STILL, 50)
+    assert len(rewards) == 25 and done[-1] and not any(done[:-1])
+    assert rewards[:-1] == [pytest.approx(1 / 50)] * 24 and rewards[-1] == 0.0
+    assert env.caught[0] and env.contact_steps[0] == 0
+    assert not env.success(np.array([sum(rewards)]), np.array([25]))[0]
+
+
+def test_a_robot_against_a_wall_pays_for_each_step_it_is_stopped() -> None:
+    # Full speed at the left wall from x = 1: 0.735 m to go at 0.1 m per step, so the eighth
+    # step is the first the wall cuts short, and every step after it pays nothing (penalty 1);
+    # with penalty 2 those steps cost as much as a free step pays.
+    for penalty, stopped in ((1.0, 0.0), (2.0, -1 / 50)):
+        env = placed([1.0, 3.0, np.pi], [[7.0, 5.5, 0.0], [7.0, 0.6, 0.0]], steps=50,
+                     contact_penalty=penalty)
+        rewards, done = run(env, AHEAD, 20)
+        assert not any(done) and not env.caught[0]
+        assert rewards[:7] == [pytest.approx(1 / 50)] * 7
+        assert rewards[8:] == [pytest.approx(stopped)] * 12
+        assert env.contact_steps[0] in (12, 13)  # the eighth step may or may not be cut short
+
+
+def test_the_success_rule_needs_no_capture_the_whole_trial_and_few_contacts() -> None:
+    env = Pursuit(steps=450)  # at most 2% of 450 steps, 9, in contact
+    env.reset(np.arange(5), np.random.default_rng(0))
+    env.caught[:] = [False, True, False, False, False]
+    env.contact_steps[:] = [0, 0, 9, 10, 0]
+    lengths = np.array([450, 450, 450, 450, 449])  # the last cut short by max_steps
+    assert env.success(np.ones(5), lengths).tolist() == [True, False, True, False, False]
+
+
+def test_the_world_and_settings_are_the_documented_ones() -> None:
+    env = Pursuit()
+    assert env.world["room"] == ARENA["room"] and len(env.world["boxes"]) == 3
+    assert {k: env.settings["pursuers"][k] for k in PURSUERS} == PURSUERS
+    assert env.observation_size == 12 and env.steps == 450
+    # A section given changes only its keys.
+    env = Pursuit(pursuers={"speed": 0.2})
+    assert env.settings["pursuers"]["speed"] == 0.2 and env.settings["pursuers"]["detour"] is True
+    assert env.settings["pursuers"]["count"] == 2
+    moved = Pursuit(**TRANSFER)
+    assert moved.world["room"] == TRANSFER["world"]["room"] and moved.sector_noise_sd == 0.2
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"steps": 0}, "steps is 0"),
+    ({"steps": 4.5}, "steps is 4.5"),
+    ({"contact_penalty": -1}, "contact_penalty is -1"),
+    ({"max_contact": 1.5}, "max_contact is 1.5"),
+    ({"sector_noise_sd": "loud"}, "sector_noise_sd is 'loud'"),
+    ({"pursuers": 3}, "pursuers is 3"),
+    ({"pursuers": {"sped": 1.0}}, "settings.pursuers.sped"),
+    ({"world": "landmark3"}, "world is 'landmark3'"),
+])
+def test_bad_settings_are_named(kwargs: dict, message: str) -> None:
+    with pytest.raises(InvalidArgumentError, match=message):
+        Pursuit(**kwargs)
+
+
+def test_without_the_detour_a_robot_that_never_moves_hides_and_with_it_is_caught() -> None:
+    """Pure pursuit stops at a box between a pursuer and the robot; the detour goes round it."""
+    def still(obs: np.ndarray) -> np.ndarray:
+        return np.full((len(obs), 2), 0.5)
+
+    escaped = {}
+    for detour in (False, True):
+        env = Pursuit(pursuers={"detour": detour})
+        r = drive(still, env, episodes=40, max_steps=env.steps, seed=1)
+        escaped[detour] = int(env.success(r.returns[0], r.lengths[0]).sum())
+    assert escaped[False] >= 8 and escaped[True] == 0, escaped
+
+
+def test_sector_noise_changes_only_the_pursuer_sensor() -> None:
+    rng = np.random.default_rng
+    quiet = Pursuit().reset(np.arange(6), rng(3))
+    loud_env = Pursuit(sector_noise_sd=0.3)
+    loud = loud_env.reset(np.arange(6), rng(3))
+    assert np.array_equal(quiet[:, :8], loud[:, :8])  # the same starts and sonars
+    assert not np.array_equal(quiet[:, 8:], loud[:, 8:])
+    assert ((loud[:, 8:] >= 0) & (loud[:, 8:] <= 1)).all()
+
+
+# ---------------------------------------------------------------------------------------------
+# the baselines
+
+
+def test_drive_meets_the_starts_a_networks_rollout_meets() -> None:
+    a, b = Pursuit(steps=5), Pursuit(steps=5)
+    drive(escape(a), a, episodes=4, max_steps=0, seed=9, purpose="evaluate")
+    rollout([dnnevo.Network.random(6, 12, seed=0)], b, episodes=4, max_steps=0, seed=9, purpose="evaluate")
+    assert np.array_equal(a.fleet.poses, b.fleet.poses) and np.array_equal(a.fleet.pursuers, b.fleet.pursuers)
+    with pytest.raises(InvalidArgumentError, match="episodes is 0"):
+        drive(escape(a), a, episodes=0, max_steps=5)
+
+
+def test_the_escape_rule_outlasts_random_networks() -> None:
+    env = Pursuit(steps=300)
+    ruled = drive(escape(env), env, episodes=12, max_steps=300, seed=4, purpose="evaluate")
+    nets = [dnnevo.Network.random(6, 12, seed=s) for s in range(5)]
+    randoms = rollout(nets, Pursuit(steps=300), episodes=12, max_steps=300, seed=4, purpose="evaluate")
+    assert ruled.returns.mean() > randoms.fitness.max() + 0.1, (ruled.returns.mean(), randoms.fitness)
+
+
+def test_the_escape_rule_turns_away_from_a_pursuer_and_from_a_wall() -> None:
+    env = Pursuit()
+    policy = escape(env)
+    obs = np.zeros((3, 12))
+    obs[0, 8] = 0.9    # a pursuer straight ahead: turn (the wheels differ) and do not drive on
+    obs[1, 9] = 0.9    # a pursuer on the left: turn right, the left wheel faster
+    obs[2, 0] = 1.0    # a wall right ahead, no pursuer
+    rates = policy(obs)
+    assert rates.shape == (3, 2) and ((rates >= 0) & (rates <= 1)).all()
+    assert rates[0].mean() <= 0.5 + 1e-12 and rates[0, 0] != rates[0, 1]
+    assert rates[1, 0] > rates[1, 1]
+    assert rates[2].mean() <= 0.5 + 1e-12
+
+
+# ---------------------------------------------------------------------------------------------
+# evolution
+
+
+def test_a_champion_evolves_past_random_networks() -> None:
+    """A short evolution on the task's own fitness beats the random networks it started from
+    on the same fresh episodes."""
+    config = dnnevo.EvolutionConfig(population=30, generations=8, size=6, n_inputs=12, selection="rank",
+                                    elitism=2, validation_candidates=3)
+    env = Pursuit(steps=200)
+    result = dnnevo.evolve(ClosedLoop(env, episodes=3, max_steps=200, validation_episodes=6), config,
+                           seed=2, progress=False)
+    nets = [dnnevo.Network.random(6, 12, seed=s) for s in range(5)]
+    fresh = rollout([result.best, *nets], Pursuit(steps=200), episodes=16, max_steps=200, seed=5,
+                    purpose="evaluate")
+    assert fresh.fitness[0] > fresh.fitness[1:].max(), fresh.fitness

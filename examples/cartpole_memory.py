@@ -13,8 +13,10 @@ return is at least 475 (CartPole-v1's own line)::
     pip install "dnnevo[gym]"
     python examples/cartpole_memory.py --seeds 10 --out cartpole-memory.png
 
-prints one row per seed and the solved counts with 95% Wilson intervals, and draws the fresh
-mean returns of both kinds of network, seed by seed.
+prints one row per seed and the solved counts with 95% Wilson intervals and the range of the
+fresh mean returns, and draws the fresh mean returns of both kinds of network, seed by seed.
+``--record JSON`` also writes the table and those lines for the docs
+(:mod:`dnnevo.experiments.examples`).
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from dnnevo import plot
 from dnnevo.closedloop import ClosedLoop, rollout
 from dnnevo.closedloop.gym import GymEnvironment
 from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
 from dnnevo.runs import save_figure
 
 SEEN = [0, 2]  # the cart's position and the pole's angle; the velocities are hidden
@@ -71,7 +74,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     p.add_argument("--no-validation", action="store_true",
                    help="choose each champion by training fitness, not on the validation set")
     p.add_argument("--out", type=Path, help="write the figure here (PNG)")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs (docs/results/examples/cartpole-memory.json)")
     args = p.parse_args(argv)
+    if args.seeds < 1:
+        p.error(f"--seeds is {args.seeds}; it must be at least 1")
     candidates = 0 if args.no_validation else CANDIDATES
     kinds = {"CTRNN": False, "reactive": True}
     returns: dict[str, list[float]] = {kind: [] for kind in kinds}
@@ -82,10 +89,18 @@ def main(argv: Sequence[str] | None = None) -> None:
             returns[kind].append(champion_return(seed, reactive, args.population,
                                                  args.generations, args.episodes, candidates))
         print(f"| {seed} | " + " | ".join(f"{returns[k][-1]:.1f}" for k in kinds) + " |")
+    lines = []
     for kind in kinds:
         solved = sum(r >= SOLVED for r in returns[kind])
         low, high = wilson(solved, args.seeds)
-        print(f"{kind}: {solved} of {args.seeds} seeds solved (95% interval {low:.0%}-{high:.0%})")
+        lines.append(f"{kind}: {solved} of {args.seeds} seeds solved (95% interval {low:.0%}-{high:.0%}); "
+                     f"fresh mean returns from {min(returns[kind]):.1f} to {max(returns[kind]):.1f}")
+    print("\n".join(lines))
+    if args.record:
+        table = [[seed, *(f"{returns[k][seed]:.1f}" for k in kinds)] for seed in range(args.seeds)]
+        examples.write(args.record, command=examples.command("examples/cartpole_memory.py", argv),
+                       columns=["seed", *(f"{kind} fresh mean return" for kind in kinds)], rows=table,
+                       summary=lines)
     if args.out is not None:
         fig, ax = plot.subplots(figsize=(6, 3.5), layout="constrained")
         for i, kind in enumerate(kinds):

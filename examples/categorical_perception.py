@@ -11,11 +11,14 @@ luckiest draw). It is then tested on the grid of every whole offset from -50 to
 world and network alike): a behaviour that only exists at the coarse step is an artefact::
 
     python examples/categorical_perception.py --seeds 10 --out categorical.png
+    python examples/categorical_perception.py --seeds 10 --no-validation    # the same evolutions
 
 prints one row per seed (the falls classified correctly at each step, with the 95% Wilson
 interval, and the mean performance), how many seeds classify at least 90% correctly at both
-steps, with its interval, and draws each seed's accuracy and the best seed's paths: the object's
-offset from the agent as it falls, circles and diamonds apart.
+steps, with its interval, the median count, how far the two steps differ, the range of Beer's
+performance and the best seed, and draws each seed's accuracy and the best seed's paths: the
+object's offset from the agent as it falls, circles and diamonds apart. ``--record JSON`` also
+writes the table and those lines for the docs (:mod:`dnnevo.experiments.examples`).
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from dnnevo import plot, presets
 from dnnevo.classic import CategoricalPerception
 from dnnevo.classic import categorical as cp
 from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
 from dnnevo.runs import save_figure
 
 DT = 0.1  # the preset's step: one Euler step of the network and the world per control step
@@ -67,6 +71,28 @@ def _interval(k: int, n: int) -> str:
     return f"{k:3d}/{n} ({lo:.0%}-{hi:.0%})"
 
 
+def best_seed(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """The seed that classifies most falls at both steps together (then by performance)."""
+    return max(rows, key=lambda r: (r["correct"] + r["fine"], r["performance"]))
+
+
+def summary(rows: list[dict[str, Any]]) -> list[str]:
+    """The lines that sum the seeds up."""
+    need = CategoricalPerception.success_rate
+    good = sum(min(r["correct"], r["fine"]) >= need * r["total"] for r in rows)
+    lo, hi = wilson(good, len(rows))
+    total = rows[0]["total"]
+    apart = max(rows, key=lambda r: abs(r["correct"] - r["fine"]))
+    performance = [r["performance"] for r in rows]
+    return [f"{good} of {len(rows)} seeds classify at least {need:.0%} of the grid correctly at both "
+            f"steps (95% interval {lo:.0%}-{hi:.0%})",
+            f"median correct at dt {DT}: {np.median([r['correct'] for r in rows]):.0f} of {total}",
+            f"largest difference between the two steps: {abs(apart['correct'] - apart['fine'])} "
+            f"falls (seed {apart['seed']})",
+            f"Beer's performance: {min(performance):.3f} to {max(performance):.3f}",
+            f"best seed at both steps (the figure draws its paths): {best_seed(rows)['seed']}"]
+
+
 def figure(rows: list[dict[str, Any]], path: Path) -> None:
     fig, (bars, circles, diamonds) = plot.subplots(
         1, 3, figsize=(12, 3.8), layout="constrained", gridspec_kw={"width_ratios": [1.4, 1, 1]})
@@ -82,7 +108,7 @@ def figure(rows: list[dict[str, Any]], path: Path) -> None:
     bars.set_xlabel("seed")
     bars.set_ylabel("falls classified correctly (202)")
     bars.legend(loc="lower right", fontsize=8)
-    best = max(rows, key=lambda r: (r["correct"] + r["fine"], r["performance"]))
+    best = best_seed(rows)
     height, offset, ok = cp.paths(best["network"], dt=DT)
     for ax, shape, colour in ((circles, 0, "tab:blue"), (diamonds, 1, "tab:red")):
         for e in range(shape, len(offset), 2):
@@ -107,8 +133,13 @@ def main(argv: Sequence[str] | None = None) -> None:
                    help="choose each seed's champion by training fitness, not on the validation "
                         "set of 40 falls")
     p.add_argument("--out", type=Path, help="write the figure here")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs "
+                        "(docs/results/examples/categorical.json)")
     args = p.parse_args(argv)
     candidates = 0 if args.no_validation else CANDIDATES
+    if args.seeds < 1:
+        p.error(f"--seeds is {args.seeds}; it must be at least 1")
     if args.episodes < 2 or args.episodes % 2:
         p.error(f"--episodes is {args.episodes}; it must be an even number >= 2")
     rows = []
@@ -119,12 +150,14 @@ def main(argv: Sequence[str] | None = None) -> None:
         print(f"{seed:4d}  {_interval(r['correct'], r['total'])}  "
               f"{_interval(r['fine'], r['total'])}  {r['performance']:11.3f}  "
               f"{r['seconds']:7.0f}", flush=True)
-    need = CategoricalPerception.success_rate
-    good = sum(min(r["correct"], r["fine"]) >= need * r["total"] for r in rows)
-    lo, hi = wilson(good, len(rows))
-    print(f"{good} of {len(rows)} seeds classify at least {need:.0%} of the grid correctly at both "
-          f"steps (95% interval {lo:.0%}-{hi:.0%})")
-    print(f"median correct at dt {DT}: {np.median([r['correct'] for r in rows]):.0f} of 202")
+    lines = summary(rows)
+    print("\n".join(lines))
+    if args.record:
+        table = [[r["seed"], f"{r['correct']}/{r['total']}", f"{r['fine']}/{r['total']}",
+                  f"{r['performance']:.3f}"] for r in rows]
+        examples.write(args.record, command=examples.command("examples/categorical_perception.py", argv),
+                       columns=["seed", f"correct, dt {DT}", f"correct, dt {FINE_DT}", "Beer's performance"],
+                       rows=table, summary=lines)
     if args.out:
         figure(rows, args.out)
 

@@ -21,6 +21,8 @@ validation set of 40 other starts, is then judged on 50 fresh starts:
 
 prints one row per seed and a summary, and draws each seed's velocities and the best seed's
 gait: the leg's angle with the foot down (thick) and up (thin), sensed and with the sensor cut.
+``--record JSON`` also writes the table and the summary for the docs
+(:mod:`dnnevo.experiments.examples`).
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from dnnevo.analysis import limit_cycles
 from dnnevo.classic import LeggedWalker
 from dnnevo.classic import walker as lw
 from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
 from dnnevo.runs import save_figure
 
 DT = 0.1  # the preset's step: one Euler step of the network and the body per control step
@@ -93,6 +96,34 @@ def _walks(k: int) -> str:
     return f"{k:2d}/{TEST_EPISODES} ({lo:.0%}-{hi:.0%})"
 
 
+def summary(rows: list[dict[str, Any]], sensor: bool) -> list[str]:
+    """The lines that sum the seeds up."""
+    best = lw.optimal_velocity(DT)
+    good = [r for r in rows if kind(r) != "does not walk"]
+    lo, hi = wilson(len(good), len(rows))
+    central = sum(kind(r) == "central" for r in rows)
+    sensed = [r["sensed"] for r in rows]
+    lines = [f"{len(good)} of {len(rows)} seeds walk in at least 90% of fresh starts (95% interval "
+             f"{lo:.0%}-{hi:.0%})" + (f"; {central} of them walk with the sensor cut" if sensor else ""),
+             f"median velocity: {np.median(sensed):.4f} ({np.median(sensed) / best:.0%} of optimal)",
+             f"velocities from {min(sensed):.4f} to {max(sensed):.4f} "
+             f"({min(sensed) / best:.0%}-{max(sensed) / best:.0%} of optimal)"]
+    if sensor:
+        cut = [r["cut"] for r in rows]
+        lines.append(f"with the sensor cut: velocities from {min(cut):.4f} to {max(cut):.4f}; "
+                     f"{sum(r['cut_walks'] for r in rows)} of {TEST_EPISODES * len(rows)} starts walk")
+    periods = [r["period"] for r in rows if r["period"] is not None]
+    lines.append(f"{len(periods)} of {len(rows)} networks oscillate with their input at 0"
+                 + (f" (periods {min(periods):.2f} to {max(periods):.2f})" if periods else ""))
+    need = LeggedWalker.success_rate * TEST_EPISODES
+    change = max(rows, key=lambda r: abs(r["fine"] - r["sensed"]))
+    verdicts = sum((r["fine_walks"] >= need) != (r["sensed_walks"] >= need) for r in rows)
+    lines.append(f"at dt {FINE_DT}: velocities change by at most {abs(change['fine'] - change['sensed']):.4f} "
+                 f"({abs(change['fine'] - change['sensed']) / change['sensed']:.1%}, seed {change['seed']}); "
+                 f"{verdicts} of {len(rows)} seeds change whether they walk in at least 90% of starts")
+    return lines
+
+
 def figure(rows: list[dict[str, Any]], path: Path) -> None:
     fig, (bars, lines) = plot.subplots(1, 2, figsize=(10, 3.8), layout="constrained")
     seeds = np.array([r["seed"] for r in rows])
@@ -133,7 +164,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     p.add_argument("--no-sensor", action="store_true",
                    help="evolve without the angle sensor: only a central pattern generator walks")
     p.add_argument("--out", type=Path, help="write the figure here")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs (docs/results/examples/walker.json)")
     args = p.parse_args(argv)
+    if args.seeds < 1:
+        p.error(f"--seeds is {args.seeds}; it must be at least 1")
     rows = []
     print(f"optimal controller: {lw.optimal_velocity(DT):.4f}; walking: at least "
           f"{lw.WALKING * lw.optimal_velocity(DT):.4f}")
@@ -145,13 +180,18 @@ def main(argv: Sequence[str] | None = None) -> None:
         period = f"{r['period']:.2f}" if r["period"] is not None else "none"
         print(f"{seed:4d}  {r['sensed']:8.4f}  {_walks(r['sensed_walks'])}  {r['fine']:10.4f}  "
               f"{r['cut']:10.4f}  {_walks(r['cut_walks'])}  {period:>10}  {kind(r)}", flush=True)
-    good = [r for r in rows if kind(r) != "does not walk"]
-    lo, hi = wilson(len(good), len(rows))
-    central = sum(kind(r) == "central" for r in rows)
-    print(f"{len(good)} of {len(rows)} seeds walk in at least 90% of fresh starts (95% interval "
-          f"{lo:.0%}-{hi:.0%}); {central} of them walk with the sensor cut")
-    print(f"median velocity: {np.median([r['sensed'] for r in rows]):.4f} "
-          f"({np.median([r['sensed'] for r in rows]) / lw.optimal_velocity(DT):.0%} of optimal)")
+    lines = summary(rows, not args.no_sensor)
+    print("\n".join(lines))
+    if args.record:
+        cut = not args.no_sensor  # without a sensor, cutting it changes nothing
+        columns = ["seed", "velocity", "walks (of 50)", f"at dt {FINE_DT}", f"walks at dt {FINE_DT}",
+                   *(["sensor cut", "walks, sensor cut"] if cut else []), "cycle at input 0 (period)", "kind"]
+        table = [[r["seed"], f"{r['sensed']:.4f}", r["sensed_walks"], f"{r['fine']:.4f}", r["fine_walks"],
+                  *([f"{r['cut']:.4f}", r["cut_walks"]] if cut else []),
+                  f"{r['period']:.2f}" if r["period"] is not None else "none", kind(r)] for r in rows]
+        examples.write(args.record, command=examples.command("examples/legged_walker.py", argv),
+                       columns=columns, rows=table,
+                       summary=[f"optimal controller: {lw.optimal_velocity(DT):.4f}", *lines])
     if args.out:
         figure(rows, args.out)
 

@@ -13,8 +13,10 @@ episodes from a seed no run used, beside a network that never pushes (torque 0):
     python examples/pendulum.py --seeds 10 --out pendulum.png
 
 prints one row per seed (the fresh mean return with a 95% bootstrap interval, and the share of
-fresh episodes that end with the pendulum within 10 degrees of upright), then the median, and
-draws every seed's fresh returns.
+fresh episodes that end with the pendulum within 10 degrees of upright), then the median, how
+many seeds beat torque 0 and the range of the upright counts, and draws every seed's fresh
+returns. ``--record JSON`` also writes the table and those lines for the docs
+(:mod:`dnnevo.experiments.examples`).
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from dnnevo import plot
 from dnnevo.closedloop import ClosedLoop, rollout
 from dnnevo.closedloop.gym import GymEnvironment
 from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
 from dnnevo.runs import save_figure
 
 SCALE = [1.0, 1.0, 1.0 / 8.0]
@@ -94,7 +97,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     p.add_argument("--generations", type=int, default=50)
     p.add_argument("--episodes", type=int, default=3, help="episodes per network per generation")
     p.add_argument("--out", type=Path, help="write the figure here")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs (docs/results/examples/pendulum.json)")
     args = p.parse_args(argv)
+    if args.seeds < 1:
+        p.error(f"--seeds is {args.seeds}; it must be at least 1")
     idle = idle_returns()
     print(f"torque 0 throughout: fresh mean return {idle.mean():.1f}")
     print("seed  fresh mean return (95% interval)   ends upright          seconds")
@@ -106,8 +113,24 @@ def main(argv: Sequence[str] | None = None) -> None:
         ulo, uhi = wilson(r["upright"], FRESH)
         print(f"{seed:4d}  {r['returns'].mean():8.1f} ({lo:7.1f} to {hi:7.1f})   "
               f"{r['upright']:3d}/{FRESH} ({ulo:.0%}-{uhi:.0%})  {r['seconds']:7.0f}", flush=True)
-    print(f"median of the seeds' fresh mean returns: "
-          f"{np.median([r['returns'].mean() for r in rows]):.1f}")
+    means = [r["returns"].mean() for r in rows]
+    upright = [r["upright"] for r in rows]
+    lines = [f"median of the seeds' fresh mean returns: {np.median(means):.1f}",
+             f"{sum(m > idle.mean() for m in means)} of {len(rows)} champions have a higher fresh mean "
+             f"return than torque 0 throughout ({idle.mean():.1f})",
+             f"fresh episodes that end within 10 degrees of upright: {min(upright)} to {max(upright)} "
+             f"of {FRESH}, by seed"]
+    print("\n".join(lines))
+    if args.record:
+        table = []
+        for r in rows:
+            lo, hi = r["interval"]
+            ulo, uhi = wilson(r["upright"], FRESH)
+            table.append([r["seed"], f"{r['returns'].mean():.1f} ({lo:.1f} to {hi:.1f})",
+                          f"{r['upright']}/{FRESH} ({ulo:.0%}-{uhi:.0%})"])
+        examples.write(args.record, command=examples.command("examples/pendulum.py", argv),
+                       columns=["seed", "fresh mean return (95% bootstrap interval)",
+                                "ends within 10 degrees of upright"], rows=table, summary=lines)
     if args.out:
         fig, ax = plot.subplots(figsize=(7, 3.5), layout="constrained")
         ax.boxplot([r["returns"] for r in rows], positions=[r["seed"] for r in rows])

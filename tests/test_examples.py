@@ -24,6 +24,36 @@ import legged_walker  # noqa: E402
 import pendulum  # noqa: E402
 
 
+def assert_rendered(tmp_path: Path, name: str, script: str, argv: list[str], summary: list[str]) -> None:
+    """The record an example wrote with ``--record`` renders into a page's markers: its command
+    (``argv`` without the ``--record``), its table and the ``summary`` lines it printed; and the
+    page, once rendered, is not stale."""
+    from dnnevo.experiments import examples, results
+
+    recorded = examples.read(tmp_path / "results" / "examples" / f"{name}.json")
+    given = argv[:argv.index("--record")] + argv[argv.index("--record") + 2:]
+    assert recorded["command"] == examples.command(script, given) == " ".join(["python", script, *given])
+    assert recorded["summary"][-len(summary):] == summary
+    page = tmp_path / "page.md"
+    page.write_text(f"<!-- results:example:{name}:begin -->\nold\n<!-- results:example:{name}:end -->\n")
+    assert results.render(tmp_path, results_dir=tmp_path / "results", files=[page]) == [page]
+    text = page.read_text()
+    assert f"`{recorded['command']}`:" in text and "old" not in text
+    assert "| " + " | ".join(recorded["columns"]) + " |" in text
+    assert all("| " + " | ".join(row) + " |" in text for row in recorded["rows"])
+    assert all(f"\n{line}\n" in text for line in summary)
+    assert results.render(tmp_path, results_dir=tmp_path / "results", files=[page], check=True) == []
+
+
+def test_a_records_command_leaves_out_where_it_was_written() -> None:
+    from dnnevo.experiments import examples
+
+    for given in (["--record", "r.json"], ["--record=r.json"], ["--rec", "r.json"]):
+        assert examples.command("examples/x.py", ["--seeds", "2", *given, "--out", "f.png"]) == \
+            "python examples/x.py --seeds 2 --out f.png"
+    assert examples.command("examples/x.py", ["--out", "my figure.png"]) == "python examples/x.py --out 'my figure.png'"
+
+
 def test_incremental_plateau(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A composite with zero cross weights answers as its 1-bit part on every trial."""
     alternating = tmp_path / "alt.json"
@@ -79,12 +109,16 @@ def test_cartpole_memory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     reactive (their recurrent weights are zero to 1e-9)."""
     from cli_helpers import assert_png
 
-    cartpole_memory.main(["--seeds", "1", "--population", "20", "--generations", "2",
-                          "--episodes", "5", "--out", str(tmp_path / "m.png")])
+    argv = ["--seeds", "1", "--population", "20", "--generations", "2", "--episodes", "5",
+            "--out", str(tmp_path / "m.png"), "--record", str(tmp_path / "results/examples/m.json")]
+    cartpole_memory.main(argv)
     lines = capsys.readouterr().out.splitlines()
     assert lines[0] == "| seed | CTRNN fresh mean return | reactive fresh mean return |"
-    assert lines[2].startswith("| 0 | ") and lines[-1].startswith("reactive: ")
+    assert lines[2].startswith("| 0 | ") and re.match(r"CTRNN: [01] of 1 seeds solved", lines[-2])
+    assert re.fullmatch(r"reactive: [01] of 1 seeds solved \(95% interval \d+%-\d+%\); fresh mean "
+                        r"returns from (\d+\.\d) to \1", lines[-1])
     assert_png(tmp_path / "m.png")
+    assert_rendered(tmp_path, "m", "examples/cartpole_memory.py", argv, lines[-2:])
     config = dnnevo.EvolutionConfig(size=5, n_inputs=2, ranges=cartpole_memory.REACTIVE)
     net = dnnevo.GeneticAlgorithm(config, seed=0).ask().networks[0]
     assert abs(net.weights).max() <= 1e-9
@@ -114,16 +148,23 @@ def test_categorical_perception(tmp_path: Path, capsys: pytest.CaptureFixture[st
     """A row per seed with both steps' counts and intervals, the summary, and the figure."""
     from cli_helpers import assert_png
 
-    categorical_perception.main(["--seeds", "2", "--population", "6", "--generations", "1",
-                                 "--episodes", "2", "--out", str(tmp_path / "c.png")])
+    argv = ["--seeds", "2", "--population", "6", "--generations", "1", "--episodes", "2",
+            "--out", str(tmp_path / "c.png"), "--record", str(tmp_path / "results/examples/c.json")]
+    categorical_perception.main(argv)
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].startswith("seed  correct at dt 0.1") and len(lines) == 5
+    assert lines[0].startswith("seed  correct at dt 0.1") and len(lines) == 8
     assert [line.split()[0] for line in lines[1:3]] == ["0", "1"]
     assert "/202 (" in lines[1]
     assert re.fullmatch(r"[0-2] of 2 seeds classify at least 90% of the grid correctly at both "
                         r"steps \(95% interval \d+%-\d+%\)", lines[3])
     assert re.fullmatch(r"median correct at dt 0.1: \d+ of 202", lines[4])
+    counts = [[int(c.split("/")[0]) for c in line.split()[1:4:2]] for line in lines[1:3]]
+    assert lines[5] == f"largest difference between the two steps: {max(abs(a - b) for a, b in counts)} falls " \
+                       f"(seed {max((0, 1), key=lambda s: abs(counts[s][0] - counts[s][1]))})"
+    assert re.fullmatch(r"Beer's performance: 0\.\d{3} to 0\.\d{3}", lines[6])
+    assert re.fullmatch(r"best seed at both steps \(the figure draws its paths\): [01]", lines[7])
     assert_png(tmp_path / "c.png")
+    assert_rendered(tmp_path, "c", "examples/categorical_perception.py", argv, lines[3:])
 
 
 def test_categorical_perception_refuses_an_odd_episode_count(capsys: pytest.CaptureFixture[str]) -> None:
@@ -136,30 +177,48 @@ def test_legged_walker(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
     """The optimum, a row per seed with its verdict, the summary, and the figure."""
     from cli_helpers import assert_png
 
-    legged_walker.main(["--seeds", "2", "--population", "6", "--generations", "1",
-                        "--episodes", "1", "--out", str(tmp_path / "w.png")])
+    from dnnevo.experiments import examples
+
+    argv = ["--seeds", "2", "--population", "6", "--generations", "1", "--episodes", "1",
+            "--out", str(tmp_path / "w.png"), "--record", str(tmp_path / "results/examples/w.json")]
+    legged_walker.main(argv)
     lines = capsys.readouterr().out.splitlines()
     assert lines[0] == "optimal controller: 0.6264; walking: at least 0.3132"
-    assert lines[1].startswith("seed  velocity  walks") and len(lines) == 6
+    assert lines[1].startswith("seed  velocity  walks") and len(lines) == 10
     assert [line.split()[0] for line in lines[2:4]] == ["0", "1"]
     assert all(line.endswith(("does not walk", "central", "needs its sensor")) for line in lines[2:4])
     assert re.fullmatch(r"[0-2] of 2 seeds walk in at least 90% of fresh starts \(95% interval "
                         r"\d+%-\d+%\); [0-2] of them walk with the sensor cut", lines[4])
+    velocities = sorted(line.split()[1] for line in lines[2:4])
+    assert lines[6].startswith(f"velocities from {velocities[0]} to {velocities[1]} (")
+    assert lines[7].startswith("with the sensor cut: velocities from ")
+    assert re.fullmatch(r"[0-2] of 2 networks oscillate with their input at 0( \(periods .*\))?", lines[8])
+    assert lines[9].startswith("at dt 0.05: velocities change by at most ")
     assert_png(tmp_path / "w.png")
+    assert_rendered(tmp_path, "w", "examples/legged_walker.py", argv, lines[4:])
+    recorded = examples.read(tmp_path / "results/examples/w.json")
+    assert recorded["summary"][0] == "optimal controller: 0.6264" and len(recorded["columns"]) == 9
 
 
 def test_pendulum(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The torque-0 baseline, a row per seed with its interval and upright count, the figure."""
     from cli_helpers import assert_png
 
-    pendulum.main(["--seeds", "1", "--population", "6", "--generations", "1", "--episodes", "1",
-                   "--out", str(tmp_path / "p.png")])
+    argv = ["--seeds", "1", "--population", "6", "--generations", "1", "--episodes", "1",
+            "--out", str(tmp_path / "p.png"), "--record", str(tmp_path / "results/examples/p.json")]
+    pendulum.main(argv)
     lines = capsys.readouterr().out.splitlines()
     assert re.fullmatch(r"torque 0 throughout: fresh mean return -\d+\.\d", lines[0])
-    assert re.fullmatch(r"\s+0\s+-?\d+\.\d \(\s*-?\d+\.\d to\s+-?\d+\.\d\)\s+\d+/100 "
-                        r"\(\d+%-\d+%\)\s+\d+", lines[2])
-    assert lines[3].startswith("median of the seeds' fresh mean returns: ")
+    row = re.fullmatch(r"\s+0\s+(-?\d+\.\d) \(\s*-?\d+\.\d to\s+-?\d+\.\d\)\s+(\d+)/100 "
+                       r"\(\d+%-\d+%\)\s+\d+", lines[2])
+    assert row is not None and len(lines) == 6
+    assert lines[3] == f"median of the seeds' fresh mean returns: {row[1]}"
+    idle = lines[0].split()[-1]
+    assert lines[4] == (f"{int(float(row[1]) > float(idle))} of 1 champions have a higher fresh mean return "
+                        f"than torque 0 throughout ({idle})")
+    assert lines[5] == f"fresh episodes that end within 10 degrees of upright: {row[2]} to {row[2]} of 100, by seed"
     assert_png(tmp_path / "p.png")
+    assert_rendered(tmp_path, "p", "examples/pendulum.py", argv, lines[3:])
 
 
 def test_legged_walker_without_its_sensor(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -167,8 +226,15 @@ def test_legged_walker_without_its_sensor(tmp_path: Path, capsys: pytest.Capture
     figure draws its one gait."""
     from cli_helpers import assert_png
 
-    legged_walker.main(["--seeds", "1", "--population", "6", "--generations", "1",
-                        "--episodes", "1", "--no-sensor", "--out", str(tmp_path / "w.png")])
-    row = capsys.readouterr().out.splitlines()[2]
-    assert row.endswith(("does not walk", "central"))
+    from dnnevo.experiments import examples
+
+    legged_walker.main(["--seeds", "1", "--population", "6", "--generations", "1", "--episodes", "1",
+                        "--no-sensor", "--out", str(tmp_path / "w.png"), "--record", str(tmp_path / "w.json")])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[2].endswith(("does not walk", "central"))
+    assert re.fullmatch(r"[01] of 1 seeds walk in at least 90% of fresh starts \(95% interval \d+%-\d+%\)",
+                        lines[3])
+    assert not any(line.startswith("with the sensor cut") for line in lines)
     assert_png(tmp_path / "w.png")
+    recorded = examples.read(tmp_path / "w.json")
+    assert "sensor cut" not in recorded["columns"] and len(recorded["rows"][0]) == 7

@@ -2,7 +2,8 @@
 are made from them by a command, never typed.
 
 A script run with ``--record docs/results/examples/NAME.json`` writes its table there with the
-command that made it and the machine it ran on (:func:`write`); ``python -m
+command that made it (:func:`command`: its own command line without the ``--record``) and the
+machine it ran on (:func:`write`); ``python -m
 dnnevo.experiments.results render`` then fills every ``<!-- results:example:NAME:begin -->`` ...
 ``<!-- results:example:NAME:end -->`` pair of the docs from that file (:func:`blocks`), and
 ``render --check`` fails when a page differs from it.
@@ -27,6 +28,8 @@ from __future__ import annotations
 
 import json
 import platform
+import shlex
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -35,12 +38,36 @@ from dnnevo import _core
 from dnnevo.experiments import report
 from dnnevo.runs.files import RunFileError, read_json, write_atomic
 
-__all__ = ["EXAMPLES_DIR", "blocks", "markdown", "read", "write"]
+__all__ = ["EXAMPLES_DIR", "blocks", "command", "markdown", "read", "write"]
 
 EXAMPLES_DIR = Path("examples")
 """Where, under the results folder (``docs/results``), the examples' results live."""
 
 FORMAT = "dnnevo-example-results/1"
+
+
+def command(script: str, argv: Sequence[str] | None = None) -> str:
+    """The command line that ran ``script`` with ``argv`` (default ``sys.argv[1:]``), without
+    its ``--record JSON`` (or ``--record=JSON``, or an abbreviation argparse accepted, such as
+    ``--rec``): the command that makes the table, wherever the table was written.
+
+    >>> command("examples/demo.py", ["--seeds", "2", "--record", "x.json", "--out", "a b.png"])
+    "python examples/demo.py --seeds 2 --out 'a b.png'"
+    >>> command("examples/demo.py", ["--rec=x.json", "--seeds", "2"])
+    'python examples/demo.py --seeds 2'
+    """
+    given = list(sys.argv[1:] if argv is None else argv)
+    kept, skip = [], False
+    for arg in given:
+        if skip:
+            skip = False
+            continue
+        name, eq, _ = arg.partition("=")
+        if len(name) > 2 and "--record".startswith(name):
+            skip = not eq  # the path is the next argument unless given with "="
+            continue
+        kept.append(arg)
+    return shlex.join(["python", script, *kept])
 
 
 def write(path: Path, *, command: str, columns: Sequence[str], rows: Sequence[Sequence[Any]],

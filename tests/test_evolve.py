@@ -8,7 +8,6 @@ import os
 import signal
 import subprocess
 import sys
-import textwrap
 import time
 import tomllib
 from pathlib import Path
@@ -293,3 +292,18 @@ def test_founders_start_the_population_and_seeds_is_its_deprecated_name() -> Non
     assert np.array_equal(old.ask()[0], dnnevo.GeneticAlgorithm(SMALL, seed=0, founders=[founder]).ask()[0])
     with pytest.raises(dnnevo.ConfigError, match="not both"):
         dnnevo.GeneticAlgorithm(SMALL, seed=0, founders=[founder], seeds=[founder])
+
+
+def test_evaluate_scores_a_python_task_preset_as_its_run_does(tmp_path: Path) -> None:
+    """A preset of a task written in Python is scored by its closed-loop fitness, with the
+    scores of generation 0 inside a run of that preset."""
+    config = dataclasses.replace(dnnevo.presets.get("legged-walker", quick=True), generations=1)
+    genomes, networks = dnnevo.GeneticAlgorithm(config, seed=11).ask()
+    from_genomes = dnnevo.evaluate("legged-walker", genomes, generation=0, seed=11)
+    from_networks = dnnevo.evaluate("legged-walker", networks, generation=0, seed=11, config=config)
+    np.testing.assert_array_equal(from_genomes, from_networks)
+    run = dnnevo.evolve("legged-walker", config, seed=11, out=tmp_path / "run", progress=False)
+    assert run.history["best"][0] == from_genomes.max()
+    assert run.history["mean"][0] == from_genomes.mean()
+    with pytest.raises(dnnevo.errors.InvalidArgumentError, match="genomes must be"):
+        dnnevo.evaluate("legged-walker", genomes[0], generation=0, seed=11)

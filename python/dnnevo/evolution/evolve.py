@@ -28,7 +28,7 @@ from dnnevo._checks import nonnegative
 from dnnevo.closedloop import named
 from dnnevo.closedloop.fitness import ClosedLoop
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
-from dnnevo.errors import ConfigError, DnnevoError, FitnessError, did_you_mean
+from dnnevo.errors import ConfigError, DnnevoError, FitnessError, InvalidArgumentError, did_you_mean
 from dnnevo.evolution.ga import GeneticAlgorithm, Validate, founders_argument
 from dnnevo.evolution.progress import Progress
 from dnnevo.runs import RunDir, RunFileError, first_difference, short
@@ -84,9 +84,20 @@ def evaluate(
     config: EvolutionConfig | None = None,
     threads: int | None = None,
 ) -> npt.NDArray[np.float64]:
-    """Scores genomes (P, G) or networks with a built-in task: a pure function of (task config,
-    genomes, generation, seed), bit-identical to the scores inside :func:`evolve`."""
+    """Scores genomes (P, G) or networks with a built-in task or a preset: a pure function of
+    (task config, genomes, generation, seed), bit-identical to the scores inside :func:`evolve`.
+    A preset of a task written in Python (``legged-walker``, ``double-pole``, ...) is scored by
+    its :class:`~dnnevo.closedloop.ClosedLoop` fitness; ``threads`` does not apply to it."""
     config = _task_config(task, config)
+    if named.is_python_task(config.task):
+        if isinstance(genomes, Sequence) and all(isinstance(g, _core.Network) for g in genomes):
+            networks = list(genomes)
+        else:
+            rows = np.asarray(genomes, dtype=np.float64)
+            if rows.ndim != 2:
+                raise InvalidArgumentError(f"genomes must be an array (P, G) or a list of networks; got shape {rows.shape}")
+            networks = [_core.decode(config.size, config.n_inputs, row) for row in rows]
+        return named.closed_loop(config)(networks, generation=generation, seed=seed)
     return _core.evaluate(
         config.native,
         genomes,

@@ -1,5 +1,5 @@
 """Predator avoidance (dnnevo.robots.Pursuit): its reward and success rule on hand-built cases,
-the baselines, and a short evolution."""
+the baselines, a short evolution, and the preset from the command line."""
 
 from __future__ import annotations
 
@@ -162,7 +162,7 @@ def test_the_escape_rule_turns_away_from_a_pursuer_and_from_a_wall() -> None:
 
 
 # ---------------------------------------------------------------------------------------------
-# evolution
+# evolution and the preset
 
 
 def test_a_champion_evolves_past_random_networks() -> None:
@@ -177,3 +177,19 @@ def test_a_champion_evolves_past_random_networks() -> None:
     fresh = rollout([result.best, *nets], Pursuit(steps=200), episodes=16, max_steps=200, seed=5,
                     purpose="evaluate")
     assert fresh.fitness[0] > fresh.fitness[1:].max(), fresh.fitness
+
+
+def test_the_preset_runs_resumes_and_is_judged_from_the_command_line(tmp_path: Path) -> None:
+    from cli_helpers import run_cli
+
+    run_dir = tmp_path / "pursuit"
+    r = run_cli("run", "predator-avoidance", "--quick", "--set", "generations=2", "--set", "population=8",
+                "--set", "task_params.episodes=2", "--set", "task_params.validation_episodes=4",
+                "--out", run_dir)
+    assert r.returncode == 0, r.stderr
+    config = (run_dir / "config.toml").read_text()
+    assert 'task = "python:dnnevo.robots.pursuit.Pursuit"' in config and "validation_candidates = 5" in config
+    r = run_cli("resume", run_dir, "--generations", "3")
+    assert r.returncode == 0 and "3 generations" in r.stdout, r.stdout + r.stderr
+    r = run_cli("assess", run_dir, "--trials", "10")
+    assert r.returncode in (0, 1) and "success needs >= 80%" in r.stdout, r.stdout + r.stderr

@@ -235,6 +235,19 @@ PRESETS: dict[str, Preset] = {
             integrator=IntegratorConfig(), validation_candidates=10),
         PYTHON_QUICK,
     ),
+    # Paper §3.2, whose details are Yamauchi (1993)'s: our choices are dnnevo.robots.pursuit's
+    # (docs/paper.md, "Predator avoidance"). The paper's landmark GA (crossover 0.5, mutation
+    # 0.025), with rank selection and 5 elites as for the classic tasks; the champion is chosen
+    # among the 5 best of each generation on 20 validation episodes.
+    "predator-avoidance": Preset(
+        "paper §3.2: a robot escapes two pursuers while avoiding static obstacles (docs/robots.md); "
+        "6 neurons, 100 x 400, 6 random starts, champions validated on 20 others",
+        EvolutionConfig(task=f"{PYTHON_TASK}dnnevo.robots.pursuit.Pursuit", population=100, generations=400,
+                        crossover_rate=0.5, mutation_rate=0.025, selection="rank", elitism=5,
+                        validation_candidates=5, size=6, n_inputs=12,
+                        task_params={"episodes": 6, "max_steps": 450, "validation_episodes": 20}),
+        PYTHON_QUICK,
+    ),
     "categorical-perception": Preset(
         "Beer's categorical perception: catch circles, avoid diamonds (docs/classic.md); "
         "7 neurons, 100 x 300, 16 falls",

@@ -1,7 +1,11 @@
 """Predator avoidance (dnnevo.robots.Pursuit): its reward and success rule on hand-built cases,
-the baselines, a short evolution, and the preset from the command line."""
+the baselines, a short evolution, the preset from the command line, and the example script
+with its record."""
 
 from __future__ import annotations
+
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,6 +15,11 @@ from dnnevo.closedloop import ClosedLoop, rollout
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.robots import Pursuit
 from dnnevo.robots.pursuit import ARENA, PURSUERS, TRANSFER, drive, escape
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "examples"))
+
+import predator_avoidance  # noqa: E402
 
 STILL = np.array([[0.5, 0.5]])  # rates of 0.5: both wheels at 0 m/s
 AHEAD = np.array([[1.0, 1.0]])  # full speed ahead
@@ -193,3 +202,50 @@ def test_the_preset_runs_resumes_and_is_judged_from_the_command_line(tmp_path: P
     assert r.returncode == 0 and "3 generations" in r.stdout, r.stdout + r.stderr
     r = run_cli("assess", run_dir, "--trials", "10")
     assert r.returncode in (0, 1) and "success needs >= 80%" in r.stdout, r.stdout + r.stderr
+
+
+def test_the_example_runs_and_records(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from cli_helpers import assert_png
+
+    from dnnevo.experiments import examples, results
+
+    record = tmp_path / "results" / "examples" / "predator-avoidance.json"
+    argv = ["--seeds", "2", "--workers", "2", "--set", "population=8", "--set", "generations=2",
+            "--set", "task_params.episodes=2", "--set", "task_params.validation_episodes=4",
+            "--fresh", "6", "--random", "2", "--figure", str(tmp_path / "p.png"),
+            "--animation", str(tmp_path / "p.gif"), "--champions", str(tmp_path / "nets"),
+            "--record", str(record)]
+    predator_avoidance.main(argv)
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("seed") and [line.split()[0] for line in lines[1:3]] == ["0", "1"]
+    assert all("/6 (" in line for line in lines[1:3])
+    summary = lines[3:]
+    assert summary[0].startswith("champions that meet the success rule") and "of 2 seeds" in summary[0]
+    assert any(line.startswith("fresh episodes escaped in the transfer world, pooled: champions ")
+               and "; escape rule " in line and "/6 (" in line and "; random networks " in line
+               and "/12 (" in line for line in summary)
+    assert summary[-1].startswith("seeds whose champion keeps its escape rate at half the step")
+    assert_png(tmp_path / "p.png")
+    assert (tmp_path / "p.gif").read_bytes()[:6] == b"GIF89a"
+    assert dnnevo.Network.load(tmp_path / "nets" / "seed-1.json").n_inputs == 12
+    doc = examples.read(record)
+    given = argv[:argv.index("--record")]
+    assert doc["command"] == " ".join(["python", "examples/predator_avoidance.py", *given])
+    assert doc["summary"] == summary and len(doc["rows"]) == 2
+    page = tmp_path / "page.md"
+    page.write_text("<!-- results:example:predator-avoidance:begin -->\nold\n"
+                    "<!-- results:example:predator-avoidance:end -->\n")
+    assert results.render(tmp_path, results_dir=tmp_path / "results", files=[page]) == [page]
+    text = page.read_text()
+    assert "old" not in text and all("| " + " | ".join(row) + " |" in text for row in doc["rows"])
+    assert results.render(tmp_path, results_dir=tmp_path / "results", files=[page], check=True) == []
+
+
+def test_the_examples_counts_and_comparisons() -> None:
+    row = {"trained": {"successes": 18, "episodes": 20}, "half step": {"successes": 12, "episodes": 20}}
+    assert not predator_avoidance.kept(row)  # 60% lies outside 90%'s interval (70%-97%)
+    row["half step"]["successes"] = 16
+    assert predator_avoidance.kept(row)
+    assert predator_avoidance.beats({"successes": 18, "episodes": 20}, {"successes": 2, "episodes": 20})
+    assert not predator_avoidance.beats({"successes": 12, "episodes": 20}, {"successes": 8, "episodes": 20})
+    assert predator_avoidance.rate(3, 10) == "3/10 (30%, 11%-60%)"

@@ -1,0 +1,367 @@
+"""Predator avoidance (paper §3.2): do evolved CTRNNs escape two pursuers while avoiding static
+obstacles, better than a random network and a hand-written escape rule, in the world they
+trained in and in one they never saw?
+
+Each seed runs the ``predator-avoidance`` preset (``dnnevo presets``; change it with ``--set
+key=value``) on :class:`dnnevo.robots.Pursuit`: its champion is the network that did best on the
+run's validation set. Every champion is then judged on ``--fresh`` fresh episodes drawn from a
+seed that no run used (``FRESH_SEED``, ``purpose="evaluate"``), on the same episodes as two
+baselines, all over the same sensors:
+
+- **random networks**: ``--random`` networks drawn as a first generation is, pooled;
+- **the escape rule** (:func:`dnnevo.robots.pursuit.escape`): away from the pursuers, away from
+  near obstacles.
+
+Each champion is also judged, on fresh episodes again,
+
+- **in transfer** (:data:`dnnevo.robots.pursuit.TRANSFER`): another room and boxes, faster and
+  sharper-turning pursuers, noise on both sensors; the baselines too;
+- **with lost echoes** (``LOST_ECHOES``): the training world with a sonar whose oblique echoes
+  are lost, as a real sonar's are; the baselines too;
+- **at half the step**: the world's step and the network's Euler step both halved (twice the
+  steps, the same starts), so that a behaviour that lives in the step's error shows itself::
+
+    python examples/predator_avoidance.py --seeds 10 --workers 2 \\
+        --figure docs/img/predator-avoidance.png --animation docs/img/predator-avoidance.gif
+
+prints one row per seed (escapes of the fresh episodes with their 95% Wilson interval, mean
+return, whether the champion meets the task's success rule, escapes in the transfer world, with
+lost echoes and at half the step, seconds), then the summary: seeds whose champions meet the rule, pooled rates
+of the champions and of the baselines, and seeds whose champion beats each baseline with
+intervals apart. ``--figure`` and ``--animation`` draw the best seed's champion in its first
+fresh episode, and ``--champions DIR`` saves every champion.
+"""
+
+from __future__ import annotations
+
+import argparse
+import concurrent.futures
+import multiprocessing
+import shlex
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import dnnevo
+from dnnevo import plot, presets
+from dnnevo.closedloop import ClosedLoop, named, rollout
+from dnnevo.config import EvolutionConfig
+from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
+from dnnevo.robots import Pursuit
+from dnnevo.robots.pursuit import TRANSFER, drive, escape
+from dnnevo.runs import save_figure
+
+PRESET = "predator-avoidance"
+FRESH_SEED = 1_000_003
+"""The seed of the fresh episodes: far above any seed a run here uses."""
+
+LOST_ECHOES = {"specular_max_incidence_deg": 70.0}
+"""A harsher sonar, alone in the training world: a ray that meets a surface more than 70
+degrees from its normal is lost (reads nothing), as a real sonar's specular reflections are."""
+
+
+def _loop(env: Pursuit, cfg: EvolutionConfig, *, finer: int = 1) -> ClosedLoop:
+    """``env`` as the run integrates it; with ``finer`` > 1, the network's step ``finer`` times
+    shorter for a world stepped as many times more often (``env`` made so)."""
+    i = cfg.integrator
+    return ClosedLoop(env, episodes=1, max_steps=env.steps, dt=i.dt / finer, substeps=i.substeps,
+                      method=i.method)
+
+
+def worlds(cfg: EvolutionConfig) -> dict[str, ClosedLoop]:
+    """The judged worlds: the run's (``trained``), the transfer world and the run's at half the
+    step, and the training world with :data:`LOST_ECHOES`; each a closed loop integrated as the
+    run was."""
+    steps = int(cfg.task_params["max_steps"])
+    dt = Pursuit().settings["dt"]
+    return {"trained": _loop(Pursuit(steps=steps), cfg),
+            "transfer": _loop(Pursuit(**TRANSFER, steps=steps), cfg),
+            "lost echoes": _loop(Pursuit(sonar=LOST_ECHOES, steps=steps), cfg),
+            "half step": _loop(Pursuit(steps=2 * steps, dt=dt / 2), cfg, finer=2)}
+
+
+def one_seed(seed: int, overrides: Sequence[str], fresh: int) -> dict[str, Any]:
+    """Evolves one seed and judges its champion on fresh episodes in every world."""
+    started = time.perf_counter()
+    cfg = presets.get(PRESET, overrides=list(overrides))
+    fitness = named.closed_loop(cfg)
+    result = dnnevo.evolve(fitness, cfg, seed=seed, progress=False)
+    if result.interrupted:  # Ctrl-C or SIGTERM stops evolve after a generation; stop here too
+        raise KeyboardInterrupt
+    out: dict[str, Any] = {"seed": seed, "network": result.best}
+    for name, loop in worlds(cfg).items():
+        ok, threshold, judged = loop.judged(result.best, fresh, FRESH_SEED, "evaluate")
+        out[name] = {"successes": int(ok.sum()), "episodes": len(ok), "meets": bool(ok.mean() >= threshold),
+                     "return": float(judged.returns.mean())}
+    out["seconds"] = time.perf_counter() - started
+    return out
+
+
+def seeds_run(seeds: int, workers: int, overrides: Sequence[str], fresh: int) -> Iterator[dict[str, Any]]:
+    """Each seed's result, in seed order, as it comes: one after another here, or ``workers`` at
+    a time in processes of their own (the same results either way)."""
+    if workers <= 1:
+        for seed in range(seeds):
+            yield one_seed(seed, overrides, fresh)
+        return
+    # Spawned, not forked: a fork of a process that runs threads (rayon's, a test runner's) can
+    # inherit a lock held by one of them and hang.
+    spawn = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=spawn) as pool:
+        running = [pool.submit(one_seed, seed, overrides, fresh) for seed in range(seeds)]
+        try:
+            for future in running:
+                yield future.result()
+        except BaseException:  # Ctrl-C: the seeds not yet started never start
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+
+
+def baselines(cfg: EvolutionConfig, fresh: int, randoms: int) -> dict[str, dict[str, dict[str, int]]]:
+    """The escape rule's and ``randoms`` random networks' (pooled) escapes on the fresh
+    episodes of each world."""
+    nets = [dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=FRESH_SEED + k) for k in range(randoms)]
+    out: dict[str, dict[str, dict[str, int]]] = {"escape rule": {}, "random networks": {}}
+    for name, loop in worlds(cfg).items():
+        env = loop.env
+        assert isinstance(env, Pursuit)
+        r = drive(escape(env), env, episodes=fresh, max_steps=env.steps, seed=FRESH_SEED, purpose="evaluate")
+        ok = env.success(r.returns.ravel(), r.lengths.ravel())
+        out["escape rule"][name] = {"successes": int(ok.sum()), "episodes": len(ok)}
+        i = cfg.integrator
+        finer = 2 if name == "half step" else 1
+        r = rollout(nets, env, episodes=fresh, max_steps=env.steps, dt=i.dt / finer, substeps=i.substeps,
+                    method=i.method, seed=FRESH_SEED, purpose="evaluate")
+        ok = env.success(r.returns.ravel(), r.lengths.ravel())
+        out["random networks"][name] = {"successes": int(ok.sum()), "episodes": len(ok)}
+    return out
+
+
+def pct(x: float) -> str:
+    """A percentage, whole unless that would hide a fraction of a percent from 0 or 100."""
+    return f"{x:.1%}" if 0 < x < 0.01 or 0.99 < x < 1 else f"{x:.0%}"
+
+
+def rate(k: int, n: int) -> str:
+    """``k/n (rate, lo-hi)`` with the 95% Wilson interval."""
+    lo, hi = wilson(k, n)
+    return f"{k}/{n} ({pct(k / n)}, {pct(lo)}-{pct(hi)})"
+
+
+def beats(a: dict[str, int], b: dict[str, int]) -> bool:
+    """Whether ``a``'s escape rate is above ``b``'s with their 95% intervals apart."""
+    return wilson(a["successes"], a["episodes"])[0] > wilson(b["successes"], b["episodes"])[1]
+
+
+def kept(row: dict[str, Any]) -> bool:
+    """Whether the champion's escapes at half the step lie within the 95% interval of its
+    escapes at the run's step (on the same starts)."""
+    lo, hi = wilson(row["trained"]["successes"], row["trained"]["episodes"])
+    half = row["half step"]
+    return lo <= half["successes"] / half["episodes"] <= hi
+
+
+def summarize(rows: list[dict[str, Any]], base: dict[str, dict[str, dict[str, int]]]) -> list[str]:
+    """The summary lines: counts with their intervals."""
+    n = len(rows)
+    lines = []
+    meets = sum(r["trained"]["meets"] for r in rows)
+    lo, hi = wilson(meets, n)
+    lines.append(f"champions that meet the success rule ({Pursuit.success_rate:.0%} of fresh episodes "
+                 f"escaped): {meets} of {n} seeds (95% interval {lo:.0%}-{hi:.0%})")
+    for world, where in (("trained", "in the training world"), ("transfer", "in the transfer world"),
+                         ("lost echoes", "with lost echoes")):
+        pooled = {k: sum(r[world][k] for r in rows) for k in ("successes", "episodes")}
+        parts = [f"champions {rate(pooled['successes'], pooled['episodes'])}"]
+        parts += [f"{name} {rate(b[world]['successes'], b[world]['episodes'])}" for name, b in base.items()]
+        lines.append(f"fresh episodes escaped {where}, pooled: " + "; ".join(parts))
+        for name, b in base.items():
+            k = sum(beats(r[world], b[world]) for r in rows)
+            lo, hi = wilson(k, n)
+            lines.append(f"seeds whose champion beats the {name} {where} (95% intervals apart): "
+                         f"{k} of {n} ({lo:.0%}-{hi:.0%})")
+    k = sum(kept(r) for r in rows)
+    lo, hi = wilson(k, n)
+    lines.append(f"seeds whose champion keeps its escape rate at half the step (within its 95% "
+                 f"interval at the run's step): {k} of {n} ({lo:.0%}-{hi:.0%})")
+    return lines
+
+
+class Traced(Pursuit):
+    """:class:`Pursuit` keeping every step's robot and pursuer poses."""
+
+    def reset(self, episodes: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        obs = super().reset(episodes, rng)
+        self.trace = [(self.fleet.poses, self.fleet.pursuers)]
+        return obs
+
+    def step(self, rates: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        out = super().step(rates, active)
+        if active[0]:
+            self.trace.append((self.fleet.poses, self.fleet.pursuers))
+        return out
+
+
+def trace(network: dnnevo.Network, cfg: EvolutionConfig) -> tuple[Traced, np.ndarray, np.ndarray]:
+    """The champion's first fresh episode: the environment, the robot's poses (T, 3) and the
+    pursuers' (T, K, 3)."""
+    steps = int(cfg.task_params["max_steps"])
+    env = Traced(steps=steps)
+    i = cfg.integrator
+    rollout([network], env, episodes=1, max_steps=steps, dt=i.dt, substeps=i.substeps, method=i.method,
+            seed=FRESH_SEED, purpose="evaluate")
+    robot = np.array([p[0] for p, _ in env.trace])
+    chasers = np.array([q[0] for _, q in env.trace])
+    return env, robot, chasers
+
+
+def _room(ax: Any, env: Pursuit) -> None:
+    from matplotlib.patches import Rectangle
+
+    w, h = env.world["room"]
+    ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2, color="k"))
+    for b in env.world.get("boxes", []):
+        (cx, cy), (bw, bh), angle = b["center"], b["size"], b.get("angle_deg", 0.0)
+        a = np.deg2rad(angle)
+        corner = (cx - 0.5 * (bw * np.cos(a) - bh * np.sin(a)), cy - 0.5 * (bw * np.sin(a) + bh * np.cos(a)))
+        ax.add_patch(Rectangle(corner, bw, bh, angle=angle, color="0.45"))
+    ax.set_xlim(-0.1, w + 0.1)
+    ax.set_ylim(-0.1, h + 0.1)
+    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+
+
+def _title(env: Traced, robot: np.ndarray, seed: int) -> str:
+    seconds = (len(robot) - 1) * env.settings["dt"]
+    end = "caught" if env.caught[0] else "escaped"
+    return f"seed {seed}'s champion, fresh episode 0: {end} after {seconds:.1f} s"
+
+
+def draw_paths(path: Path, env: Traced, robot: np.ndarray, chasers: np.ndarray, seed: int) -> None:
+    """The top-down view: the room, the robot's and the pursuers' paths."""
+    fig, ax = plot.subplots(figsize=(7, 5.6), layout="constrained")
+    _room(ax, env)
+    ax.plot(robot[:, 0], robot[:, 1], color="tab:blue", lw=1.5, label="robot")
+    ax.plot(*robot[0, :2], "o", color="tab:blue", ms=7)
+    ax.plot(*robot[-1, :2], "s", color="tab:blue", ms=7)
+    for k in range(chasers.shape[1]):
+        ax.plot(chasers[:, k, 0], chasers[:, k, 1], color="tab:red", lw=1, ls="--",
+                label="pursuers" if k == 0 else None)
+        ax.plot(*chasers[0, k, :2], "o", color="tab:red", ms=5)
+        ax.plot(*chasers[-1, k, :2], "s", color="tab:red", ms=5)
+    ax.set_title(_title(env, robot, seed) + " (circle: start, square: end)", fontsize=9)
+    ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
+    save_figure(fig, path)
+    plot.close(fig)
+
+
+def animate(path: Path, env: Traced, robot: np.ndarray, chasers: np.ndarray, seed: int, *,
+            every: int = 3) -> None:
+    """An animated GIF of the episode (every ``every``-th step, at its own pace)."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.patches import Circle
+
+    fig, ax = plot.subplots(figsize=(4.4, 3.6), layout="constrained")
+    _room(ax, env)
+    ax.set_title(_title(env, robot, seed), fontsize=7)
+    r, pr = env.settings["robot"]["radius"], env.settings["pursuers"]["radius"]
+    (trail,) = ax.plot([], [], color="tab:blue", lw=0.8, alpha=0.6)
+    body = ax.add_patch(Circle(tuple(robot[0, :2]), r, color="tab:blue"))
+    (nose,) = ax.plot([], [], color="w", lw=1.5)
+    chaser_bodies = [ax.add_patch(Circle(tuple(chasers[0, k, :2]), pr, color="tab:red"))
+                     for k in range(chasers.shape[1])]
+    clock = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", fontsize=7)
+    frames = list(range(0, len(robot), every))
+    if frames[-1] != len(robot) - 1:
+        frames.append(len(robot) - 1)
+
+    def update(t: int) -> list[Any]:
+        x, y, h = robot[t]
+        trail.set_data(robot[:t + 1, 0], robot[:t + 1, 1])
+        body.center = (x, y)
+        nose.set_data([x, x + r * np.cos(h)], [y, y + r * np.sin(h)])
+        for k, c in enumerate(chaser_bodies):
+            c.center = tuple(chasers[t, k, :2])
+        clock.set_text(f"{t * env.settings['dt']:.1f} s")
+        return [trail, body, nose, *chaser_bodies, clock]
+
+    anim = FuncAnimation(fig, update, frames=frames, blit=False)
+    step = env.settings["dt"] * every
+    path.parent.mkdir(parents=True, exist_ok=True)
+    anim.save(path, writer=PillowWriter(fps=round(1 / step)), dpi=70)
+    plot.close(fig)
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1")
+    return value
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--seeds", type=_positive, default=10, help="seeds 0 .. N-1 (default 10)")
+    p.add_argument("--workers", type=_positive, default=1,
+                   help="run this many seeds at once, each in a process of its own (default 1)")
+    p.add_argument("--fresh", type=_positive, default=200, help="fresh episodes per world (default 200)")
+    p.add_argument("--random", type=_positive, default=10, help="random networks in the baseline (default 10)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a setting of the preset (repeatable), as for dnnevo run")
+    p.add_argument("--figure", type=Path, help="draw the best seed's paths here (PNG)")
+    p.add_argument("--animation", type=Path, help="animate the best seed's episode here (GIF)")
+    p.add_argument("--champions", type=Path, metavar="DIR",
+                   help="save each seed's champion here, as seed-N.json")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs "
+                        "(docs/results/examples/predator-avoidance.json)")
+    args = p.parse_args(argv)
+    cfg = presets.get(PRESET, overrides=args.set)  # a bad --set fails here, before any run
+    rows = []
+    print("seed  fresh episodes escaped    mean return  rule  transfer world            "
+          "lost echoes               half step                 seconds")
+    for r in seeds_run(args.seeds, args.workers, args.set, args.fresh):
+        rows.append(r)
+        if args.champions:
+            args.champions.mkdir(parents=True, exist_ok=True)
+            r["network"].save(args.champions / f"seed-{r['seed']}.json")
+        cells = [rate(r[w]["successes"], r[w]["episodes"]) for w in ("transfer", "lost echoes", "half step")]
+        print(f"{r['seed']:4d}  {rate(r['trained']['successes'], r['trained']['episodes']):24}  "
+              f"{r['trained']['return']:11.3f}  {'met' if r['trained']['meets'] else 'no':4}  "
+              + "".join(f"{c:26}" for c in cells) + f"{r['seconds']:7.0f}", flush=True)
+    base = baselines(cfg, args.fresh, args.random)
+    summary = summarize(rows, base)
+    print("\n".join(summary))
+    if args.record:
+        given = list(sys.argv[1:] if argv is None else argv)
+        if "--record" in given:  # the command that makes the table, without where it was written
+            del given[given.index("--record"):given.index("--record") + 2]
+        given = [a for a in given if not a.startswith("--record=")]
+        table = [[r["seed"], rate(r["trained"]["successes"], r["trained"]["episodes"]),
+                  f"{r['trained']['return']:.3f}", "yes" if r["trained"]["meets"] else "no",
+                  *(rate(r[w]["successes"], r[w]["episodes"]) for w in ("transfer", "lost echoes", "half step"))]
+                 for r in rows]
+        examples.write(args.record, command=shlex.join(["python", "examples/predator_avoidance.py", *given]),
+                       columns=["seed", "fresh episodes escaped (95% interval)", "mean return",
+                                f"meets the rule ({Pursuit.success_rate:.0%})", "transfer world",
+                                "lost echoes", "half step"], rows=table, summary=summary)
+    if args.figure or args.animation:
+        best = max(rows, key=lambda r: (r["trained"]["successes"], r["trained"]["return"]))
+        env, robot, chasers = trace(best["network"], cfg)
+        if args.figure:
+            draw_paths(args.figure, env, robot, chasers, best["seed"])
+        if args.animation:
+            animate(args.animation, env, robot, chasers, best["seed"])
+
+
+if __name__ == "__main__":
+    main()

@@ -241,8 +241,8 @@ PRESETS: dict[str, Preset] = {
     # among the 5 best of each generation on 20 validation episodes.
     "predator-avoidance": Preset(
         "paper §3.2: a robot escapes two pursuers while avoiding static obstacles (docs/robots.md); "
-        "6 neurons, 100 x 400, 6 random starts, champions validated on 20 others",
-        EvolutionConfig(task=f"{PYTHON_TASK}dnnevo.robots.pursuit.Pursuit", population=100, generations=400,
+        "6 neurons, 100 x 200, 6 random starts, champions validated on 20 others",
+        EvolutionConfig(task=f"{PYTHON_TASK}dnnevo.robots.pursuit.Pursuit", population=100, generations=200,
                         crossover_rate=0.5, mutation_rate=0.025, selection="rank", elitism=5,
                         validation_candidates=5, size=6, n_inputs=12,
                         task_params={"episodes": 6, "max_steps": 450, "validation_episodes": 20}),

@@ -58,7 +58,7 @@ def test_doctests(module: Any) -> None:
 
 
 def test_the_graph_puts_every_job_after_what_it_needs() -> None:
-    order = plan.jobs([0, 1, 2])
+    order = plan.jobs([0, 1, 2], only=plan.FAMILIES)
     seen: set[str] = set()
     for job in order:
         assert set(job.needs) <= seen, job.id
@@ -220,6 +220,34 @@ def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path)
     assert_one_line_error(other, "eval_trials", "= 10, not 11")
 
 
+def test_without_only_the_paper_is_reproduced_and_the_classic_tasks_are_a_family() -> None:
+    assert {j.spec.family for j in plan.jobs([0])} == set(plan.PAPER_FAMILIES)
+    classic = plan.jobs([0], only=["classic"])
+    assert {j.experiment for j in classic} == {"legged-walker", "categorical-perception", "double-pole"}
+    assert all(QUICK.config(j.spec).task.startswith("python:dnnevo.classic.") for j in classic)
+
+
+def test_experiments_added_since_a_reproduction_began_join_it(tmp_path: Path) -> None:
+    out = tmp_path / "repro"
+    args = ["reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
+            "--no-dt-check", "--in-process", "--out", out]
+    assert run_cli(*args).returncode == 0
+    manifest = out / "reproduce.json"
+    full = json.loads(manifest.read_text())
+    # A folder begun before an experiment existed has no config for it: it is added.
+    manifest.write_text(json.dumps({**full, "configs": {k: v for k, v in full["configs"].items()
+                                                          if k != "double-pole"}}))
+    again = run_cli(*args)
+    assert again.returncode == 0 and "(3 already done)" in again.stdout, again.stderr
+    assert json.loads(manifest.read_text()) == full
+    # A recorded experiment whose config differs is refused, and the folder is left as it was.
+    walker = {**full["configs"]["legged-walker"], "population": 7}
+    manifest.write_text(json.dumps({**full, "configs": {**full["configs"], "legged-walker": walker}}))
+    before = manifest.read_bytes()
+    assert_one_line_error(run_cli(*args), "configs.legged-walker.population")
+    assert manifest.read_bytes() == before
+
+
 #: The command, checkpointing every generation, with Ctrl-C's default handler (a test's
 #: background process may start with SIGINT ignored).
 FREQUENT = ("import signal, sys, dnnevo; signal.signal(signal.SIGINT, signal.default_int_handler); "
@@ -275,14 +303,16 @@ def dask() -> Any:
 
 def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_path: Path) -> None:
     dask()
-    args = ["reproduce", "--seeds", "0", "--quick", "--eval-trials", "10", "--no-dt-check"]
+    # Every family, the classic benchmarks (tasks written in Python) too.
+    args = ["reproduce", "--seeds", "0", "--quick", "--eval-trials", "10", "--no-dt-check",
+            "--only", ",".join(plan.FAMILIES)]
     assert run_cli(*args, "--in-process", "--out", tmp_path / "here").returncode == 0
     r = run_cli(*args, "--workers", "2", "--out", tmp_path / "dask")
     assert r.returncode == 0, r.stderr
     assert "a local Dask cluster of 2 workers" in r.stdout
     n = len(plan.EXPERIMENTS)
     assert f"[{n}/{n}] done" in r.stderr  # not a terminal: one line per run
-    for job in plan.jobs([0]):
+    for job in plan.jobs([0], only=plan.FAMILIES):
         here = json.loads(jobs.result_path(tmp_path / "here", job).read_text())
         there = json.loads(jobs.result_path(tmp_path / "dask", job).read_text())
         assert without_wall(here) == without_wall(there), job.id

@@ -18,7 +18,8 @@ from dnnevo.experiments import plan
 from dnnevo.experiments import report
 from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.runs import LOCK_NAME, RunDir, check_settings, write_atomic
+from dnnevo.runs import LOCK_NAME, RunDir, RunFileError, check_settings, write_atomic
+from dnnevo.runs.files import read_json
 from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "reproduce.json"
@@ -30,14 +31,17 @@ Run every experiment of the paper over seeds and write a report: landmark recogn
 training, then the robot-like test of the champions), one-dimensional navigation (the three
 subnetworks, the goal seekers evolved on chains, both integrated systems, the single network) and
 sequence learning (1-bit, alternating, the incremental 2-bit route from those two runs, direct
-2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). Each evolution has its own run
-folder OUT/EXPERIMENT/seed-N and its result in OUT/EXPERIMENT/seed-N.json (the robot-like test
-and the integrated systems are tests of other runs and have only the result). The report, OUT/report.md and OUT/report.html, covers the seeds
-and families of the command that wrote it."""
+2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). --only classic runs the
+field's benchmarks written as Python tasks instead (walker, categorical perception, double pole).
+Each evolution has its own run folder OUT/EXPERIMENT/seed-N and its result in
+OUT/EXPERIMENT/seed-N.json (the robot-like test and the integrated systems are tests of other runs
+and have only the result). The report, OUT/report.md and OUT/report.html, covers the seeds and
+families of the command that wrote it."""
 
 EXAMPLE = """examples:
   dnnevo reproduce --quick --seeds 0-1 --out runs/repro-quick     about a minute on 2 cores
   dnnevo reproduce --only sequence --seeds 0-4 --out runs/repro-seq
+  dnnevo reproduce --only classic --quick --seeds 0 --out runs/repro-classic
   dnnevo reproduce --out reproduce --workers 4 --threads-per-worker 2
   dnnevo reproduce --out /shared/reproduce --scheduler tcp://HOST:8786
 
@@ -57,8 +61,9 @@ def add_parser(sub: Any, parse_seeds: Any, positive: Any) -> None:
                        description=DESCRIPTION, epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("0-9"), help="e.g. 0-9 or 1,4,7 (default 0-9)")
     p.add_argument("--quick", action="store_true", help="each preset's quick variant: small populations, few generations")
-    p.add_argument("--only", type=_families, default=plan.FAMILIES,
-                   metavar="FAMILIES", help=f"comma-separated, from {','.join(plan.FAMILIES)} (default all)")
+    p.add_argument("--only", type=_families, default=plan.PAPER_FAMILIES, metavar="FAMILIES",
+                   help=f"comma-separated, from {','.join(plan.FAMILIES)} (default the paper's: "
+                        f"{','.join(plan.PAPER_FAMILIES)})")
     p.add_argument("--out", type=Path, default=Path("reproduce"), help="the reproduction's folder (default reproduce)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a setting for every evolution, after its preset's, e.g. population=200")
@@ -150,7 +155,7 @@ def _command(args: argparse.Namespace) -> str:
     """The command that makes this reproduction, for its report."""
     words = ["dnnevo", "reproduce", "--seeds", ",".join(map(str, args.seeds)), "--out", str(args.out)]
     words += ["--quick"] if args.quick else []
-    words += ["--only", ",".join(args.only)] if tuple(args.only) != plan.FAMILIES else []
+    words += ["--only", ",".join(args.only)] if tuple(args.only) != plan.PAPER_FAMILIES else []
     words += ["--eval-trials", str(args.eval_trials)] if args.eval_trials is not None else []
     words += [] if args.dt_check else ["--no-dt-check"]
     words += [w for kv in args.set for w in ("--set", kv)]
@@ -162,7 +167,20 @@ def _begin(root: Path, settings: jobs.Settings) -> None:
     manifest = root / SETTINGS_FILE
     wanted = settings.to_dict()
     if manifest.exists() or manifest.is_symlink():
-        check_settings(manifest, wanted, what="reproduction", force=False)
+        # Experiments added to dnnevo since the folder was begun join it; the others must match.
+        try:
+            found = read_json(manifest)
+            recorded = found["configs"]
+        except (RunFileError, TypeError, KeyError):
+            recorded = None  # check_settings names what is wrong
+        if not isinstance(recorded, dict):
+            check_settings(manifest, wanted, what="reproduction", force=False)
+            return
+        check_settings(manifest, {**wanted, "configs": {k: v for k, v in wanted["configs"].items() if k in recorded}},
+                       what="reproduction", force=False)
+        added = {k: v for k, v in wanted["configs"].items() if k not in recorded}
+        if added:
+            write_atomic(manifest, json.dumps({**found, "configs": {**recorded, **added}}, indent=1) + "\n")
         return
     if any(p.name != LOCK_NAME for p in root.iterdir()):
         raise DnnevoError(f"{root} holds files but no {SETTINGS_FILE}; choose another --out")

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo import tasks
-from dnnevo.tasks import nav1d
+from dnnevo.tasks import nav1d, registry
 from dnnevo.experiments import plan
 from dnnevo import presets
 from dnnevo.evaluation import stats
@@ -89,7 +89,7 @@ class Settings:
 
     def trials(self, task: str) -> int:
         """The fresh trials judging a champion of ``task``."""
-        return self.eval_trials if self.eval_trials is not None else tasks.DEFAULT_TRIALS[task]
+        return self.eval_trials if self.eval_trials is not None else registry.get(task).DEFAULT_TRIALS
 
     def to_dict(self) -> dict[str, Any]:
         """The settings and every evolution's config, as plain JSON types."""

@@ -20,10 +20,15 @@ from dataclasses import dataclass
 
 from dnnevo.errors import ConfigError, did_you_mean
 
-__all__ = ["FAMILIES", "EXPERIMENTS", "Experiment", "Job", "jobs", "experiment"]
+__all__ = ["FAMILIES", "PAPER_FAMILIES", "EXPERIMENTS", "Experiment", "Job", "jobs", "experiment"]
 
-FAMILIES = ("landmark", "nav1d", "sequence")
-"""The paper's three experiment families, in the paper's order; ``--only`` picks among them."""
+PAPER_FAMILIES = ("landmark", "nav1d", "sequence")
+"""The paper's three experiment families, in the paper's order: what ``dnnevo reproduce`` runs
+unless ``--only`` says otherwise."""
+
+FAMILIES = (*PAPER_FAMILIES, "classic")
+"""Every family; ``--only`` picks among them. ``classic`` is the field's benchmarks written as
+Python tasks (:mod:`dnnevo.classic`), which the paper does not have."""
 
 EVOLVE, ROBOT_LIKE, SYSTEM = "evolve", "robot-like", "nav1d-system"
 """The kinds of job: an evolution run, the landmark robot-like test, the integrated system."""
@@ -126,6 +131,17 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                     "and at dt/10"),
     Experiment("sequence-3bit", "sequence", EVOLVE, "§5.4: 1 success, at generation 700",
                preset="sequence-3bit"),
+    Experiment("legged-walker", "classic", EVOLVE, "not in the paper", preset="legged-walker",
+               note="Beer and Gallagher's one-legged walker, a task written in Python "
+                    "(dnnevo.classic.walker)"),
+    Experiment("categorical-perception", "classic", EVOLVE, "not in the paper",
+               preset="categorical-perception",
+               note="Beer's categorical perception, a task written in Python "
+                    "(dnnevo.classic.categorical)"),
+    Experiment("double-pole", "classic", EVOLVE, "not in the paper", preset="double-pole",
+               note="double-pole balancing without velocities, trained on random starts, for the "
+                    "preset's generations; the benchmark's own test of episodes to solve is "
+                    "examples/double_pole.py"),
 )
 """Every experiment, in the report's order; each one's needs come before it."""
 
@@ -166,9 +182,9 @@ def job_id(name: str, seed: int) -> str:
 
 
 def families(only: Iterable[str] | None) -> tuple[str, ...]:
-    """The families ``--only`` names (all when None), checked."""
+    """The families ``--only`` names (the paper's when None), checked."""
     if only is None:
-        return FAMILIES
+        return PAPER_FAMILIES
     picked = tuple(dict.fromkeys(only))
     unknown = [f for f in picked if f not in FAMILIES]
     if unknown or not picked:
@@ -177,8 +193,8 @@ def families(only: Iterable[str] | None) -> tuple[str, ...]:
 
 
 def jobs(seeds: Sequence[int], only: Iterable[str] | None = None) -> list[Job]:
-    """The jobs of the families ``only`` (default all) over ``seeds``, each after the jobs it
-    needs."""
+    """The jobs of the families ``only`` (default the paper's) over ``seeds``, each after the jobs
+    it needs."""
     chosen = families(only)
     if not seeds or any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
         raise ConfigError(f"seeds must be distinct and >= 0, at least one; got {list(seeds)[:10]}"

@@ -97,9 +97,15 @@ class Results:
         return [int(s) for s in self.provenance.get("seeds", DEFAULT_SEEDS)]
 
     @property
+    def families(self) -> tuple[str, ...]:
+        """The families the tables cover: the paper's, and any other whose runs were collected."""
+        collected = self.provenance.get("families", {})
+        return tuple(f for f in plan.FAMILIES if f in plan.PAPER_FAMILIES or f in collected)
+
+    @property
     def order(self) -> list[plan.Job]:
-        """Every job of the plan over the seeds, done or not."""
-        return plan.jobs(self.seeds)
+        """Every job of those families over the seeds, done or not."""
+        return plan.jobs(self.seeds, self.families)
 
     def outcomes(self) -> dict[str, Outcome]:
         """Each job's outcome: ``done`` with its result, or :data:`NOT_RUN`."""
@@ -309,7 +315,7 @@ def _summary(results: Results, family: str | None) -> list[report.Block]:
     order, outcomes = results.order, results.outcomes()
     rows = []
     for e in plan.EXPERIMENTS:
-        if family is not None and e.family != family:
+        if e.family not in results.families or (family is not None and e.family != family):
             continue
         row = report.summary_row(e, order, outcomes)
         if not any(j.experiment == e.name and j.id in results.found for j in order):
@@ -359,7 +365,7 @@ def _machine(results: Results) -> list[report.Block]:
     rows: list[tuple[str, ...]] = []
     families = prov.get("families", {})
     total_run = total_elapsed = 0.0
-    for family in plan.FAMILIES:
+    for family in results.families:
         fam_run, fam_rows = 0.0, []
         for e in (e for e in plan.EXPERIMENTS if e.family == family):
             walls = [float(results.found[j.id]["wall_s"]) for j in results.order

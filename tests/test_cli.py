@@ -45,6 +45,13 @@ def test_run_show_assess_resume_sweep(tmp_path: Path) -> None:
     assert r.returncode == 0, r.stderr
     assert r.stdout.startswith(f"nothing to resume: {out} has run all its 8 generations; to run it "
                                f"longer: dnnevo resume {out} --generations N (N > 8)\n"), r.stdout
+    # A finished run whose checkpoint is damaged gets the error alone, not "nothing to resume".
+    checkpoint = out / "checkpoint.json"
+    whole = checkpoint.read_bytes()
+    checkpoint.write_bytes(whole[: len(whole) // 2])
+    r = dnnevo("resume", str(out))
+    assert r.returncode == 2 and r.stdout == "" and "checkpoint.json" in r.stderr, (r.stdout, r.stderr)
+    checkpoint.write_bytes(whole)
     r = dnnevo("resume", str(out), "--generations", "9")
     assert r.returncode == 0 and "nothing to resume" not in r.stdout, r.stdout
     assert r.stdout.startswith("9 generations in "), r.stdout

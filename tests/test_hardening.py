@@ -180,6 +180,9 @@ def test_log_damage_in_show_and_plot(pristine: Path, tmp_path: Path) -> None:
         "short row": "\n".join([header, rows[0], rows[1].rsplit(",", 1)[0]]) + "\n",
         "other columns": text.replace("generation", "gen", 1),
         "non-numeric": text.replace(rows[1].split(",")[1], "abc", 1),
+        # Python's float() takes these; no log holds them
+        "underscored": "\n".join([header, rows[0], rows[1].replace(rows[1].split(",")[1], "1_0", 1)]) + "\n",
+        "spaced": "\n".join([header, rows[0], rows[1].replace(rows[1].split(",")[1], " 0.5", 1)]) + "\n",
         "inf": "\n".join([header, rows[0], rows[1].replace(rows[1].split(",")[1], "inf", 1)]) + "\n",
         "duplicated row": "\n".join([header, rows[0], rows[0], *rows[1:]]) + "\n",
     }

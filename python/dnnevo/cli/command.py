@@ -246,10 +246,12 @@ def _report(result: dnnevo.EvolutionResult) -> int:
 
 def _cmd_resume(args: argparse.Namespace) -> int:
     done = _finished(args.dir) if args.generations is None else None
+    # Resumed first: a finished run whose checkpoint is damaged gets the error alone.
+    result = dnnevo.resume(args.dir, threads=args.threads, generations=args.generations)
     if done is not None:
         print(f"nothing to resume: {args.dir} has run all its {done} generations; to run it "
               f"longer: dnnevo resume {args.dir} --generations N (N > {done})")
-    return _report(dnnevo.resume(args.dir, threads=args.threads, generations=args.generations))
+    return _report(result)
 
 
 def _finished(path: Path) -> int | None:

@@ -4,6 +4,7 @@ history passes when read (from the log or from a checkpoint)."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -78,6 +79,19 @@ def history_rows(path: Path, history: Any) -> list[dict[str, float]]:
         rows.append(row)
     check_history(path, rows, what="history")
     return rows
+
+
+NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf)")
+"""What a cell of log.csv may hold: a decimal number as ``repr`` writes it, ``nan`` or ``inf``
+(Python's ``float`` also takes ``1_0``, spaces and ``infinity``, which no log holds)."""
+
+
+def read_cell(cell: str) -> float:
+    """A cell of log.csv as a float; a ``ValueError`` when it is not a number :data:`NUMBER`
+    allows."""
+    if NUMBER.fullmatch(cell) is None:
+        raise ValueError(f"not a number: {cell!r}")
+    return float(cell)
 
 
 def log_cell(column: str, value: float) -> str:

@@ -43,7 +43,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FormatError
 from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
 from dnnevo.runs.files import FILE_MODE, RunFileError, checked, fail, read_json, read_text, short, write_atomic
-from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, log_cell, history_rows
+from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, history_rows, log_cell, read_cell
 from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth, first_difference
 
 __all__ = ["FIGURES", "LOCK_NAME", "RUN_FILES", "RunDir"]
@@ -314,7 +314,7 @@ class RunDir:
                 row = dict.fromkeys(LOG_COLUMNS, math.nan)
                 for k, cell in zip(header, cells, strict=True):
                     try:
-                        row[k] = float(cell)
+                        row[k] = read_cell(cell)
                     except ValueError:
                         raise fail(path, f"row {i + 1}: {k} is {short(cell)}; expected a number") from None
                 rows.append(row)

@@ -215,6 +215,9 @@ def test_config_validation_messages() -> None:
         ({"elitism": -1}, "elitism is -1; it must be at least 0"),
         ({"validation_candidates": -3}, "validation_candidates is -3; it must be at least 0"),
         ({"integrator": {"substeps": -2}}, "integrator.substeps is -2; it must be >= 1"),
+        # Beyond 64 bits the core cannot parse a count; the setting is still named.
+        ({"population": 10**29}, f"population is {10**29}; it must be at most {2**64 - 1}"),
+        ({"integrator": {"substeps": 2**64}}, f"integrator.substeps is {2**64}; it must be at most"),
         ({"population": 2.5}, "population is 2.5; expected an integer"),
         ({"population": True}, "population is True; expected an integer"),
         ({"crossover_rate": "high"}, "crossover_rate is 'high'; expected a number"),

@@ -148,7 +148,7 @@ class EvolutionConfig:
         object.__setattr__(self, "task_params", dict(self.task_params))
         d = self.to_dict()
         _check_finite(d, "")
-        _check_negative(d)
+        _check_counts(d)
         object.__setattr__(self, "_native", _core.RunConfig(json.dumps(d)))
         object.__setattr__(self, "_task_params", copy.deepcopy(self.task_params))
 
@@ -210,7 +210,7 @@ _TYPES: dict[str, type] = {
 
 def _check_type(obj: Any, name: str, kind: type, prefix: str = "") -> None:
     """``obj.name`` has the type ``kind``: a str; a bool; an int (not a bool; a negative one is
-    refused by :func:`_check_negative`); or a float, which an int may stand for."""
+    refused by :func:`_check_counts`); or a float, which an int may stand for."""
     value = getattr(obj, name)
     if kind is bool:
         ok = isinstance(value, bool)
@@ -228,15 +228,22 @@ def _check_type(obj: Any, name: str, kind: type, prefix: str = "") -> None:
         raise ConfigError(f"{prefix}{name} is {value!r}; expected {expected}")
 
 
-def _check_negative(d: dict[str, Any]) -> None:
-    """A negative count (which the Rust core cannot even parse) gets the message Rust gives for 0,
-    so that ``population = -5`` and ``population = 0`` read alike ("it must be at least 2")."""
+_LARGEST_PARSABLE = 2**64 - 1
+"""The largest count the Rust core can parse; any real limit is far lower, and the core names it."""
+
+
+def _check_counts(d: dict[str, Any]) -> None:
+    """A count the Rust core cannot even parse gets a message naming the setting: a negative one
+    the message Rust gives for 0, so that ``population = -5`` and ``population = 0`` read alike
+    ("it must be at least 2"), and one beyond 64 bits that it is too large."""
     counts: list[tuple[str, str | None]] = [(name, None) for name, kind in _TYPES.items() if kind is int]
     for name, sub in [*counts, ("integrator", "substeps")]:
         value = d[name] if sub is None else d[name][sub]
+        key = name if sub is None else f"{name}.{sub}"
+        if value > _LARGEST_PARSABLE:
+            raise ConfigError(f"{key} is {value}; it must be at most {_LARGEST_PARSABLE}")
         if value >= 0:
             continue
-        key = name if sub is None else f"{name}.{sub}"
         probe = {**d, name: 0 if sub is None else {**d[name], sub: 0}}
         rule = "it must be at least 0"
         try:

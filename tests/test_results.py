@@ -165,6 +165,30 @@ def test_collect_refuses_another_reproductions_folder(tmp_path: Path, reproducti
     assert not (dest / "landmark").exists()
 
 
+def test_collect_takes_in_experiments_added_since_and_refuses_a_changed_one(tmp_path: Path,
+                                                                            reproduction: Path) -> None:
+    """A family collected from a later reproduction, whose settings file has the configs of
+    experiments added to dnnevo since, joins the results; one whose config of an experiment
+    already collected differs is refused."""
+    dest = tmp_path / "results"
+    source = tmp_path / "source"
+    shutil.copytree(reproduction, source)
+    manifest = json.loads((source / "reproduce.json").read_text())
+    older = {**manifest, "configs": {k: v for k, v in manifest["configs"].items() if k != "predator-avoidance"}}
+    dest.mkdir()
+    (dest / "reproduce.json").write_text(json.dumps(older, indent=1) + "\n")
+    r = _results("collect", source, dest, "--seeds", "0", "--only", "landmark", "--commit", "abc1234")
+    assert r.returncode == 0, r.stderr
+    assert json.loads((dest / "reproduce.json").read_text()) == manifest
+    changed = {**manifest, "configs": {**manifest["configs"], "landmark": {**manifest["configs"]["landmark"],
+                                                                          "population": 3}}}
+    (dest / "reproduce.json").write_text(json.dumps(changed, indent=1) + "\n")
+    before = (dest / "reproduce.json").read_bytes()
+    r = _results("collect", source, dest, "--seeds", "0", "--only", "landmark", "--commit", "abc1234")
+    assert r.returncode == 2 and "another reproduction's settings" in r.stderr
+    assert (dest / "reproduce.json").read_bytes() == before
+
+
 def test_the_committed_tables_are_made_from_docs_results() -> None:
     """README.md and the docs say what docs/results holds: run
     ``python -m dnnevo.experiments.results render`` after collecting results."""

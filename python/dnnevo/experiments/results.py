@@ -240,6 +240,20 @@ def _command(seeds: Sequence[int], family: str, settings: jobs.Settings) -> str:
     return " ".join(words)
 
 
+def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
+    """The settings ``held`` by the results folder with the configs of experiments that only the
+    reproduction's settings ``found`` have (experiments added to dnnevo since the first family was
+    collected), or None when a setting or a config that both hold differs."""
+    mine, theirs = (held.get("configs") if isinstance(held, dict) else None), found.get("configs")
+    if not isinstance(mine, dict) or not isinstance(theirs, dict):
+        return None
+    if {k: v for k, v in held.items() if k != "configs"} != {k: v for k, v in found.items() if k != "configs"}:
+        return None
+    if any(mine[k] != theirs[k] for k in mine.keys() & theirs.keys()):
+        return None
+    return {**held, "configs": {**mine, **{k: v for k, v in theirs.items() if k not in mine}}}
+
+
 def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             seeds: Sequence[int] = DEFAULT_SEEDS, commit: str | None = None) -> list[str]:
     """Copies the finished results of ``families`` (default all) over ``seeds`` from the
@@ -250,9 +264,11 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
     if not settings_file.exists():
         raise DnnevoError(f"{source} holds no {SETTINGS_FILE}: not a reproduction's folder")
     manifest = _read_settings(settings_file)
-    if (dest / SETTINGS_FILE).exists() and read_json(dest / SETTINGS_FILE) != manifest:
-        raise DnnevoError(f"{dest / SETTINGS_FILE} holds another reproduction's settings than {settings_file}; "
-                          f"empty {dest} first to replace them")
+    if (dest / SETTINGS_FILE).exists():
+        manifest = _joined(read_json(dest / SETTINGS_FILE), manifest)
+        if manifest is None:
+            raise DnnevoError(f"{dest / SETTINGS_FILE} holds another reproduction's settings than {settings_file}; "
+                              f"empty {dest} first to replace them")
     dest.mkdir(parents=True, exist_ok=True)
     old = _read_provenance(dest / PROVENANCE_FILE)
     if old and old.get("seeds") != sorted(seeds):
@@ -286,7 +302,7 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             times[family] = {"command": _command(seeds, family, settings), "commit": named.group(1),
                              "runs": len(done), "planned": len(plan.jobs(list(seeds), [family])),
                              "elapsed_s": round(max(ends) - min(starts))}
-    write_atomic(dest / SETTINGS_FILE, settings_file.read_text(encoding="utf-8"))
+    write_atomic(dest / SETTINGS_FILE, json.dumps(manifest, indent=1) + "\n")
     families_done = {**old.get("families", {}), **times}
     provenance = {
         "seeds": sorted(seeds),

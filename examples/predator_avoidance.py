@@ -28,8 +28,9 @@ prints one row per seed (escapes of the fresh episodes with their 95% Wilson int
 return, whether the champion meets the task's success rule, escapes in the transfer world, with
 lost echoes and at half the step, seconds), then the summary: seeds whose champions meet the rule, pooled rates
 of the champions and of the baselines, and seeds whose champion beats each baseline with
-intervals apart. ``--figure`` and ``--animation`` draw the best seed's champion in its first
-fresh episode, and ``--champions DIR`` saves every champion.
+intervals apart. ``--figure`` and ``--animation`` draw the best seed's champion in the first
+fresh episode it escapes (``--episode E`` for another), and ``--champions DIR`` saves every
+champion; ``--draw NETWORK`` draws a saved champion without evolving anything.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ import shlex
 import sys
 import time
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -193,7 +195,7 @@ def summarize(rows: list[dict[str, Any]], base: dict[str, dict[str, dict[str, in
 
 
 class Traced(Pursuit):
-    """:class:`Pursuit` keeping every step's robot and pursuer poses."""
+    """:class:`Pursuit` keeping every step's robot and pursuer poses, row by row."""
 
     def reset(self, episodes: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         obs = super().reset(episodes, rng)
@@ -202,22 +204,53 @@ class Traced(Pursuit):
 
     def step(self, rates: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         out = super().step(rates, active)
-        if active[0]:
-            self.trace.append((self.fleet.poses, self.fleet.pursuers))
+        self.trace.append((self.fleet.poses, self.fleet.pursuers))
         return out
 
 
-def trace(network: dnnevo.Network, cfg: EvolutionConfig) -> tuple[Traced, np.ndarray, np.ndarray]:
-    """The champion's first fresh episode: the environment, the robot's poses (T, 3) and the
-    pursuers' (T, K, 3)."""
+@dataclass
+class Shown:
+    """One fresh episode of a champion, to draw."""
+
+    label: str
+    """Whose champion, for the title."""
+    episode: int
+    robot: np.ndarray
+    """The robot's poses, (T + 1, 3)."""
+    chasers: np.ndarray
+    """The pursuers' poses, (T + 1, K, 3)."""
+    caught: bool
+    contact_steps: int
+    env: Pursuit
+
+    @property
+    def title(self) -> str:
+        dt = self.env.settings["dt"]
+        seconds = (len(self.robot) - 1) * dt
+        if self.caught:
+            end = f"caught after {seconds:.1f} s"
+        else:
+            end = f"not caught in {seconds:.0f} s, touching a wall or box for {self.contact_steps * dt:.1f} s"
+        return f"{self.label}, fresh episode {self.episode}: {end}"
+
+
+def trace(network: dnnevo.Network, cfg: EvolutionConfig, label: str, *, episodes: int,
+          episode: int | None = None) -> Shown:
+    """The champion in fresh episode ``episode`` or, when None, in the first of ``episodes``
+    fresh episodes that it escapes by the success rule (episode 0 if none)."""
     steps = int(cfg.task_params["max_steps"])
     env = Traced(steps=steps)
     i = cfg.integrator
-    rollout([network], env, episodes=1, max_steps=steps, dt=i.dt, substeps=i.substeps, method=i.method,
-            seed=FRESH_SEED, purpose="evaluate")
-    robot = np.array([p[0] for p, _ in env.trace])
-    chasers = np.array([q[0] for _, q in env.trace])
-    return env, robot, chasers
+    run = episodes if episode is None else episode + 1
+    r = rollout([network], env, episodes=run, max_steps=steps, dt=i.dt, substeps=i.substeps, method=i.method,
+                seed=FRESH_SEED, purpose="evaluate")
+    if episode is None:
+        ok = env.success(r.returns[0], r.lengths[0])
+        episode = int(np.flatnonzero(ok)[0]) if ok.any() else 0
+    t = int(r.lengths[0, episode])
+    return Shown(label, episode, np.array([p[episode] for p, _ in env.trace[:t + 1]]),
+                 np.array([q[episode] for _, q in env.trace[:t + 1]]), bool(env.caught[episode]),
+                 int(env.contact_steps[episode]), env)
 
 
 def _room(ax: Any, env: Pursuit) -> None:
@@ -237,16 +270,11 @@ def _room(ax: Any, env: Pursuit) -> None:
     ax.set_yticks([])
 
 
-def _title(env: Traced, robot: np.ndarray, seed: int) -> str:
-    seconds = (len(robot) - 1) * env.settings["dt"]
-    end = "caught" if env.caught[0] else "escaped"
-    return f"seed {seed}'s champion, fresh episode 0: {end} after {seconds:.1f} s"
-
-
-def draw_paths(path: Path, env: Traced, robot: np.ndarray, chasers: np.ndarray, seed: int) -> None:
+def draw_paths(path: Path, shown: Shown) -> None:
     """The top-down view: the room, the robot's and the pursuers' paths."""
+    robot, chasers = shown.robot, shown.chasers
     fig, ax = plot.subplots(figsize=(7, 5.6), layout="constrained")
-    _room(ax, env)
+    _room(ax, shown.env)
     ax.plot(robot[:, 0], robot[:, 1], color="tab:blue", lw=1.5, label="robot")
     ax.plot(*robot[0, :2], "o", color="tab:blue", ms=7)
     ax.plot(*robot[-1, :2], "s", color="tab:blue", ms=7)
@@ -255,21 +283,21 @@ def draw_paths(path: Path, env: Traced, robot: np.ndarray, chasers: np.ndarray, 
                 label="pursuers" if k == 0 else None)
         ax.plot(*chasers[0, k, :2], "o", color="tab:red", ms=5)
         ax.plot(*chasers[-1, k, :2], "s", color="tab:red", ms=5)
-    ax.set_title(_title(env, robot, seed) + " (circle: start, square: end)", fontsize=9)
+    ax.set_title(shown.title + "\n(circle: start, square: end)", fontsize=9)
     ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
     save_figure(fig, path)
     plot.close(fig)
 
 
-def animate(path: Path, env: Traced, robot: np.ndarray, chasers: np.ndarray, seed: int, *,
-            every: int = 3) -> None:
+def animate(path: Path, shown: Shown, *, every: int = 3) -> None:
     """An animated GIF of the episode (every ``every``-th step, at its own pace)."""
     from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.patches import Circle
 
-    fig, ax = plot.subplots(figsize=(4.4, 3.6), layout="constrained")
+    robot, chasers, env = shown.robot, shown.chasers, shown.env
+    fig, ax = plot.subplots(figsize=(4.4, 3.8), layout="constrained")
     _room(ax, env)
-    ax.set_title(_title(env, robot, seed), fontsize=7)
+    ax.set_title(shown.title.replace(": ", ":\n", 1), fontsize=7)
     r, pr = env.settings["robot"]["radius"], env.settings["pursuers"]["radius"]
     (trail,) = ax.plot([], [], color="tab:blue", lw=0.8, alpha=0.6)
     body = ax.add_patch(Circle(tuple(robot[0, :2]), r, color="tab:blue"))
@@ -319,6 +347,10 @@ def main(argv: Sequence[str] | None = None) -> None:
                    help="override a setting of the preset (repeatable), as for dnnevo run")
     p.add_argument("--figure", type=Path, help="draw the best seed's paths here (PNG)")
     p.add_argument("--animation", type=Path, help="animate the best seed's episode here (GIF)")
+    p.add_argument("--episode", type=int, metavar="E",
+                   help="draw fresh episode E (default: the first the champion escapes)")
+    p.add_argument("--draw", type=Path, metavar="NETWORK",
+                   help="evolve nothing: draw this saved champion's episode (--figure, --animation)")
     p.add_argument("--champions", type=Path, metavar="DIR",
                    help="save each seed's champion here, as seed-N.json")
     p.add_argument("--record", type=Path, metavar="JSON",
@@ -326,6 +358,13 @@ def main(argv: Sequence[str] | None = None) -> None:
                         "(docs/results/examples/predator-avoidance.json)")
     args = p.parse_args(argv)
     cfg = presets.get(PRESET, overrides=args.set)  # a bad --set fails here, before any run
+    if args.draw:
+        if not (args.figure or args.animation):
+            p.error("--draw needs --figure or --animation")
+        network = dnnevo.Network.load(args.draw)
+        draw(trace(network, cfg, f"champion {args.draw.stem}", episodes=args.fresh, episode=args.episode),
+             args.figure, args.animation)
+        return
     rows = []
     print("seed  fresh episodes escaped    mean return  rule  transfer world            "
           "lost echoes               half step                 seconds")
@@ -356,11 +395,16 @@ def main(argv: Sequence[str] | None = None) -> None:
                                 "lost echoes", "half step"], rows=table, summary=summary)
     if args.figure or args.animation:
         best = max(rows, key=lambda r: (r["trained"]["successes"], r["trained"]["return"]))
-        env, robot, chasers = trace(best["network"], cfg)
-        if args.figure:
-            draw_paths(args.figure, env, robot, chasers, best["seed"])
-        if args.animation:
-            animate(args.animation, env, robot, chasers, best["seed"])
+        draw(trace(best["network"], cfg, f"seed {best['seed']}'s champion", episodes=args.fresh,
+                   episode=args.episode), args.figure, args.animation)
+
+
+def draw(shown: Shown, figure: Path | None, animation: Path | None) -> None:
+    """The figure and the animation of one episode, each when asked."""
+    if figure:
+        draw_paths(figure, shown)
+    if animation:
+        animate(animation, shown)
 
 
 if __name__ == "__main__":

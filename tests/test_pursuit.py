@@ -228,6 +228,12 @@ def test_the_example_runs_and_records(tmp_path: Path, capsys: pytest.CaptureFixt
     assert_png(tmp_path / "p.png")
     assert (tmp_path / "p.gif").read_bytes()[:6] == b"GIF89a"
     assert dnnevo.Network.load(tmp_path / "nets" / "seed-1.json").n_inputs == 12
+    # A saved champion drawn again, in a chosen episode, without evolving anything.
+    predator_avoidance.main(["--draw", str(tmp_path / "nets" / "seed-1.json"), "--episode", "2",
+                             "--figure", str(tmp_path / "again.png")])
+    assert_png(tmp_path / "again.png") and capsys.readouterr().out == ""
+    with pytest.raises(SystemExit):
+        predator_avoidance.main(["--draw", str(tmp_path / "nets" / "seed-1.json")])
     doc = examples.read(record)
     given = argv[:argv.index("--record")]
     assert doc["command"] == " ".join(["python", "examples/predator_avoidance.py", *given])
@@ -239,6 +245,32 @@ def test_the_example_runs_and_records(tmp_path: Path, capsys: pytest.CaptureFixt
     text = page.read_text()
     assert "old" not in text and all("| " + " | ".join(row) + " |" in text for row in doc["rows"])
     assert results.render(tmp_path, results_dir=tmp_path / "results", files=[page], check=True) == []
+
+
+def test_the_drawn_episode_is_the_first_the_champion_escapes() -> None:
+    from dnnevo import presets
+
+    # In 3 s no pursuer reaches the robot, so an episode is escaped when the robot touches
+    # nothing: this random network does so in some of the first six fresh episodes, not the first.
+    cfg = presets.get("predator-avoidance", overrides=["task_params.max_steps=30"])
+    net = dnnevo.Network.random(6, 12, seed=1)
+    env = Pursuit(steps=30)
+    i = cfg.integrator
+    r = rollout([net], env, episodes=6, max_steps=30, dt=i.dt, substeps=i.substeps, seed=predator_avoidance.FRESH_SEED,
+                purpose="evaluate")
+    ok = env.success(r.returns[0], r.lengths[0])
+    assert ok.any() and not ok[0]
+    shown = predator_avoidance.trace(net, cfg, "random", episodes=6)
+    assert shown.episode == int(np.flatnonzero(ok)[0]) and not shown.caught and shown.contact_steps == 0
+    assert len(shown.robot) == len(shown.chasers) == 31
+    assert shown.title == f"random, fresh episode {shown.episode}: not caught in 3 s, touching a wall or box for 0.0 s"
+    # The robot's path is the traced row's: it starts where that episode starts.
+    start = Pursuit(steps=30)
+    drive(escape(start), start, episodes=6, max_steps=0, seed=predator_avoidance.FRESH_SEED, purpose="evaluate")
+    assert np.array_equal(shown.robot[0], start.fleet.poses[shown.episode])
+    assert np.array_equal(shown.chasers[0], start.fleet.pursuers[shown.episode])
+    again = predator_avoidance.trace(net, cfg, "random", episodes=6, episode=0)
+    assert again.episode == 0 and again.contact_steps > 0
 
 
 def test_the_examples_counts_and_comparisons() -> None:

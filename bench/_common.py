@@ -52,8 +52,8 @@ def describe_machine() -> None:
         print(f"cpu: {model} ({vector})")
     except (OSError, StopIteration):
         pass
-    info = dnnevo.build_info()
-    print(f"dnnevo kernel: {info['kernel']} (this CPU can run {', '.join(info['kernels'])}; "
+    build = dnnevo.build_info()
+    print(f"dnnevo kernel: {build['kernel']} (this CPU can run {', '.join(build['kernels'])}; "
           f"DNNEVO_SIMD forces one)")
     print(f"threads: {threads()} usable by this process ({os.cpu_count()} logical CPUs)")
     for var in ("RAYON_NUM_THREADS", "OPENBLAS_CORETYPE", "OMP_NUM_THREADS"):
@@ -105,7 +105,7 @@ def interleaved_medians(fns: dict, repeats: int) -> dict:
     every call just after another contender's: after a call of the C anchor its OpenMP thread
     spins for a while on one core, and dnnevo at N = 5 measured 0.31x the anchor that way
     against 0.89x with warmed-up turns (2026-11-27, Zen 5)."""
-    times = {name: [] for name in fns}
+    times: dict[str, list[float]] = {name: [] for name in fns}
     while any(len(t) < repeats for t in times.values()):
         for name, fn in fns.items():
             calls = min(TURN_CALLS, repeats - len(times[name]))

@@ -5,7 +5,8 @@ obstacle avoidance, and :class:`Pursuit` another, the paper's predator avoidance
 (docs/robots.md)."""
 
 from dnnevo.robots.avoid import Avoid
+from dnnevo.robots.navigation import Navigate
 from dnnevo.robots.pursuit import Pursuit
 from dnnevo.robots.world import RobotWorld
 
-__all__ = ["Avoid", "Pursuit", "RobotWorld"]
+__all__ = ["Avoid", "Navigate", "Pursuit", "RobotWorld"]

@@ -14,8 +14,8 @@ import dnnevo
 from dnnevo.closedloop import rollout
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.robots import Navigate
-from dnnevo.robots.navigation import (INTEGRATOR, WORLDS, bearing, design, destination,
-                                      navigation_world, navigator)
+from dnnevo.robots.navigation import (INTEGRATOR, WORLDS, Detectors, bearing, design,
+                                      destination, looping, navigation_world, navigator, stuck)
 
 ONE = np.array([True])
 STILL = np.array([[0.5, 0.5]])  # rates of 0.5: both wheels at 0 m/s
@@ -120,3 +120,88 @@ def test_hand_designed_network_reaches_the_goal_in_the_open_room() -> None:
     result = rollout([dnnevo.Network.random(4, 11, seed=0)], env, episodes=6, max_steps=env.steps,
                      seed=3, purpose="evaluate", **INTEGRATOR)
     assert not env.success(result.returns[0], result.lengths[0]).all()
+
+
+def trajectories(steps: int = 200) -> np.ndarray:
+    """Three hand-built tracks of 0.1 s steps (3, steps + 1, 2): a robot that stays within a
+    few centimetres of one spot, one that circles (radius 0.5 m at 0.5 m/s: a lap in 6.3 s)
+    and one that drives straight at 0.5 m/s."""
+    t = np.arange(steps + 1) * 0.1
+    rng = np.random.default_rng(0)
+    still = np.array([2.0, 2.0]) + rng.uniform(-0.03, 0.03, (steps + 1, 2))
+    circle = np.stack([2.0 + 0.5 * np.cos(t), 2.0 + 0.5 * np.sin(t)], axis=1)
+    straight = np.stack([0.5 + 0.5 * t, np.full_like(t, 1.0)], axis=1)
+    return np.stack([still, circle, straight])
+
+
+def test_static_detector_fires_on_a_stuck_robot_only() -> None:
+    track = trajectories()
+    assert stuck(track, 30, 0.2).tolist() == [True, False, False]
+    assert stuck(track[:, :20], 30, 0.2).tolist() == [False] * 3  # not yet 3 s of track
+    gone = track.copy()
+    gone[0, -25] = np.nan  # a gap in the record (the memory was cleared): not stuck yet
+    assert stuck(gone, 30, 0.2).tolist() == [False, False, False]
+    # Slow but steady: 0.05 m/s for 3 s is 0.15 m, under 0.2 m; 0.1 m/s is not.
+    slow = track[2:] * np.array([0.1, 1.0])
+    assert stuck(slow, 30, 0.2).tolist() == [True]
+    assert stuck(track[2:] * np.array([0.2, 1.0]), 30, 0.2).tolist() == [False]
+
+
+def test_cyclic_detector_fires_on_a_circling_robot_not_a_straight_one() -> None:
+    track = trajectories()
+    assert looping(track[:, -300:], 60, 0.3).tolist() == [True, True, False]
+    # Looking back 7 to 8 s only, the circling robot is 0.7 to 1.7 rad past where it was.
+    assert looping(track[:, 120:], 70, 0.3).tolist() == [True, False, False]
+    # A lap of 12.6 s (radius 1 m) is a loop only once the detector looks back that far.
+    t = np.arange(301) * 0.1
+    wide = np.stack([1.0 * np.cos(0.5 * t), 1.0 * np.sin(0.5 * t)], axis=1)[None]
+    assert looping(wide[:, -100:], 60, 0.3).tolist() == [False]
+    assert looping(wide, 60, 0.3).tolist() == [True]
+
+
+def test_detectors_fire_and_the_frustration_input_follows() -> None:
+    # A robot held still fires the static detector after 3 s, and frustration turns on.
+    env = placed([1.0, 1.0, 0.0], detectors=True)
+    for _ in range(29):
+        obs, _, _ = env.step(STILL, ONE)
+    assert obs[0, 10] == 0.0 and env.fired.tolist() == [[0, 0]]
+    obs, _, _ = env.step(STILL, ONE)
+    assert obs[0, 10] == 1.0 and env.fired.tolist() == [[1, 0]] and env.escapes.tolist() == [1]
+    # Held still, the escape lasts escape_seconds (40 s) and then the memory starts again.
+    for _ in range(400):
+        obs, _, _ = env.step(STILL, ONE)
+    assert obs[0, 10] == 0.0
+    # Driving round in a circle (wheels 0.25 and 0.75 m/s: radius 0.45 m) fires the cyclic one.
+    env = placed([1.5, 1.5, 0.0], detectors=True)
+    turn = np.array([[0.625, 0.875]])
+    fired = [env.step(turn, ONE)[0][0, 10] for _ in range(100)]
+    assert env.fired.tolist() == [[0, 1]] and 55 <= fired.index(1.0) <= 80  # a lap is about 5.7 s
+    # Driving straight across the open room fires neither, and without detectors nothing fires.
+    env = placed([0.5, 0.8, 0.0], detectors=True)
+    for _ in range(60):
+        obs, _, _ = env.step(np.array([[0.75, 0.75]]), ONE)
+    assert env.fired.tolist() == [[0, 0]] and obs[0, 10] == 0.0
+    env = placed([1.0, 1.0, 0.0])
+    for _ in range(100):
+        obs, _, _ = env.step(STILL, ONE)
+    assert env.fired.tolist() == [[0, 0]] and obs[0, 10] == 0.0
+
+
+def test_detectors_turn_u_trap_failures_into_arrivals() -> None:
+    ok = {}
+    for detectors in (False, True):
+        env = Navigate("u-trap", detectors=detectors)
+        result = rollout([navigator()], env, episodes=8, max_steps=env.steps, seed=0, purpose="evaluate",
+                         **INTEGRATOR)
+        ok[detectors] = env.success(result.returns[0], result.lengths[0])
+        if detectors:
+            assert env.escapes[~ok[False]].min() >= 1  # every rescued start needed an escape
+    assert (~ok[False]).sum() >= 3  # the network alone is caught in the trap
+    assert (ok[True] & ~ok[False]).sum() >= 3  # ... and the detectors get it out
+
+
+def test_bad_detector_settings_are_named() -> None:
+    with pytest.raises(InvalidArgumentError, match="static_seconds is 0; expected a number in"):
+        Detectors(static_seconds=0)
+    with pytest.raises(InvalidArgumentError, match="cycle_window is 5.0; it must be longer than cycle_after"):
+        Detectors(cycle_window=5.0)

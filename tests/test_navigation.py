@@ -5,7 +5,9 @@ static and cyclic detectors on hand-built trajectories and in the U-shaped trap.
 from __future__ import annotations
 
 import json
+import sys
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,9 +15,15 @@ import pytest
 import dnnevo
 from dnnevo.closedloop import rollout
 from dnnevo.errors import InvalidArgumentError
+from dnnevo.experiments import examples
 from dnnevo.robots import Navigate
 from dnnevo.robots.navigation import (INTEGRATOR, WORLDS, Detectors, bearing, design,
                                       destination, looping, navigation_world, navigator, stuck)
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "examples"))
+
+import reactive_navigation  # noqa: E402
 
 ONE = np.array([True])
 STILL = np.array([[0.5, 0.5]])  # rates of 0.5: both wheels at 0 m/s
@@ -205,3 +213,16 @@ def test_bad_detector_settings_are_named() -> None:
         Detectors(static_seconds=0)
     with pytest.raises(InvalidArgumentError, match="cycle_window is 5.0; it must be longer than cycle_after"):
         Detectors(cycle_window=5.0)
+
+
+def test_example_runs_with_tiny_settings_and_records(tmp_path: Path) -> None:
+    record, png = tmp_path / "reactive.json", tmp_path / "paths.png"
+    assert reactive_navigation.main(["--starts", "3", "--steps", "40", "--paths", "2",
+                                     "--figure", str(png), "--record", str(record)]) == 0
+    doc = examples.read(record)
+    assert doc["command"] == "python examples/reactive_navigation.py --starts 3 --steps 40 --paths 2 " \
+                             f"--figure {png}"
+    assert len(doc["rows"]) == 12 and len(doc["summary"]) == 6
+    assert [r[:3] for r in doc["rows"][:2]] == [["open-room", "off", "0.1 s"], ["open-room", "on", "0.1 s"]]
+    assert all(r[3].endswith("%)") and "/3 (" in r[3] for r in doc["rows"])
+    assert png.stat().st_size > 1000

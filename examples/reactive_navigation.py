@@ -1,0 +1,164 @@
+"""Reactive navigation (paper §3.2): does the hand-designed network reach the goal, and do the
+static and cyclic detectors turn its failures in traps into arrivals without hurting it where it
+needs no help?
+
+Nothing is evolved. The hand-designed network (:func:`dnnevo.robots.navigation.navigator`,
+shipped as ``dnnevo/robots/data/navigator.json``) drives :class:`dnnevo.robots.Navigate` in the
+three shipped worlds (an open room, a U-shaped trap and a cul-de-sac), from ``--starts`` random
+start poses drawn from a seed no run uses (``FRESH_SEED``, ``purpose="evaluate"``), without and
+with the detectors, on the same starts. Every row is run again at half the step (the world's
+0.05 s instead of 0.1 s and the network's Euler step 0.01 instead of 0.02, twice the steps):
+a behaviour that vanishes at a finer step is an artefact of the step::
+
+    python examples/reactive_navigation.py --starts 200 --figure docs/img/reactive-u-trap.png \\
+        --record docs/results/examples/reactive-navigation.json
+
+prints one row per world, detectors and step (arrivals with their 95% Wilson interval, the mean
+time to arrive, the fraction of steps pressed against a wall or box, the detectors' firings per
+start), then, for each world and step, whether the detectors changed the rate with intervals
+apart. ``--figure`` draws the paths of the first ``--paths`` starts in the U-trap, without and
+with the detectors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import dnnevo
+from dnnevo import plot
+from dnnevo.closedloop import rollout
+from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
+from dnnevo.robots import Navigate
+from dnnevo.robots.navigation import INTEGRATOR, WORLDS, navigator
+from dnnevo.runs import save_figure
+
+FRESH_SEED = 2_000_003
+"""The seed of the start poses: used by no run, and not by the predator example's 1_000_003."""
+
+
+def judged(world: str, detectors: bool, starts: int, *, finer: int = 1, steps: int = 1200) -> dict[str, Any]:
+    """The hand-designed network on ``starts`` fresh starts of ``world``; with ``finer`` > 1 the
+    world's and the network's steps ``finer`` times shorter (as many more steps)."""
+    env = Navigate(world, detectors=detectors, dt=0.1 / finer, steps=steps * finer)
+    started = time.perf_counter()
+    r = rollout([navigator()], env, episodes=starts, max_steps=env.steps, seed=FRESH_SEED, purpose="evaluate",
+                dt=INTEGRATOR["dt"] / finer, substeps=INTEGRATOR["substeps"], method=INTEGRATOR["method"])
+    ok = env.success(r.returns[0], r.lengths[0])
+    seconds = r.lengths[0] * env.settings["dt"]
+    return {"world": world, "detectors": detectors, "dt": env.settings["dt"], "arrived": int(ok.sum()),
+            "starts": starts, "time": float(seconds[ok].mean()) if ok.any() else float("nan"),
+            "contact": float(env.contact_steps.sum() / r.lengths.sum()),
+            "static": float(env.fired[:, 0].mean()), "cyclic": float(env.fired[:, 1].mean()),
+            "wall": time.perf_counter() - started}
+
+
+def rate(k: int, n: int) -> str:
+    lo, hi = wilson(k, n)
+    return f"{k}/{n} ({lo:.0%}-{hi:.0%})"
+
+
+def paths(world: str, detectors: bool, starts: int, steps: int = 1200) -> tuple[Navigate, list[np.ndarray], np.ndarray]:
+    """The first ``starts`` fresh starts' paths (each (T, 2)) and which arrived."""
+    env = Navigate(world, detectors=detectors, steps=steps)
+    rng = np.random.default_rng(dnnevo._core.condition_seed(FRESH_SEED, 0, "evaluate"))
+    obs = env.reset(np.arange(starts, dtype=np.int64), rng)
+    batch = dnnevo.Batch([navigator()], replicas=starts, dt=INTEGRATOR["dt"], substeps=INTEGRATOR["substeps"])
+    batch.reset()
+    rates = np.empty((starts, batch.size))
+    active = np.ones(starts, dtype=bool)
+    trail = [env.fleet.poses[:, :2].copy()]
+    ends = np.full(starts, steps)
+    for t in range(steps):
+        batch.step(obs, active=active, out=rates)
+        obs, _, done = env.step(rates, active)
+        trail.append(env.fleet.poses[:, :2].copy())
+        ends[active & done] = t + 1
+        active &= ~done
+        if not active.any():
+            break
+    track = np.stack(trail, axis=1)
+    return env, [track[i, :ends[i] + 1] for i in range(starts)], env.arrived.copy()
+
+
+def figure(out: Path, starts: int) -> None:
+    """The U-trap seen from above: the first ``starts`` fresh starts' paths without and with the
+    detectors."""
+    from matplotlib.patches import Circle, Rectangle
+    fig, axes = plot.subplots(1, 2, figsize=(10, 4.2), sharey=True)
+    for ax, detectors in zip(axes, (False, True)):
+        env, tracks, arrived = paths("u-trap", detectors, starts)
+        w, h = env.world["room"]
+        ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2))
+        for box in env.world.get("boxes", []):
+            (cx, cy), (bw, bh) = box["center"], box["size"]
+            ax.add_patch(Rectangle((cx - bw / 2, cy - bh / 2), bw, bh, angle=box.get("angle_deg", 0.0),
+                                   rotation_point="center", color="0.4"))
+        ax.add_patch(Circle(tuple(env.goal), env.goal_radius, color="tab:green", alpha=0.4))
+        for track, ok in zip(tracks, arrived):
+            ax.plot(track[:, 0], track[:, 1], lw=0.9, color="tab:blue" if ok else "tab:red", alpha=0.8)
+            ax.plot(*track[0], "k.", ms=4)
+        ax.set_aspect("equal")
+        ax.set_xlim(0, w)
+        ax.set_ylim(0, h)
+        ax.set_title(f"{'with' if detectors else 'without'} detectors: {arrived.sum()} of {starts} arrive")
+        ax.set_xlabel("x (m)")
+    axes[0].set_ylabel("y (m)")
+    fig.tight_layout()
+    save_figure(fig, out)
+    plot.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--starts", type=int, default=200, help="fresh start poses per world (default 200)")
+    p.add_argument("--steps", type=int, default=1200, help="steps of 0.1 s per trial (default 1200: 120 s)")
+    p.add_argument("--figure", type=Path, help="draw the U-trap's paths as this PNG")
+    p.add_argument("--paths", type=int, default=12, help="start poses drawn in the figure (default 12)")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="write the table as an example's results (docs/results/examples/NAME.json)")
+    args = p.parse_args(argv)
+    if args.starts < 1 or args.steps < 1 or args.paths < 1:
+        p.error("--starts, --steps and --paths must be at least 1")
+    rows, results = [], {}
+    columns = ["world", "detectors", "step", "arrived (95% interval)", "mean time to arrive",
+               "steps in contact", "static / cyclic firings per start"]
+    print(" | ".join(columns))
+    for world in WORLDS:
+        for finer in (1, 2):
+            for detectors in (False, True):
+                r = judged(world, detectors, args.starts, finer=finer, steps=args.steps)
+                results[world, finer, detectors] = r
+                row = [world, "on" if detectors else "off", f"{r['dt']:g} s", rate(r["arrived"], r["starts"]),
+                       "-" if np.isnan(r["time"]) else f"{r['time']:.1f} s", f"{r['contact']:.1%}",
+                       f"{r['static']:.2f} / {r['cyclic']:.2f}" if detectors else "-"]
+                rows.append(row)
+                print(" | ".join(row), f"({r['wall']:.1f} s)", flush=True)
+    summary = []
+    for world in WORLDS:
+        for finer in (1, 2):
+            off, on = results[world, finer, False], results[world, finer, True]
+            lo_off, hi_off = wilson(off["arrived"], off["starts"])
+            lo_on, hi_on = wilson(on["arrived"], on["starts"])
+            verdict = ("higher, intervals apart" if lo_on > hi_off else "lower, intervals apart" if hi_on < lo_off
+                       else "intervals overlap")
+            summary.append(f"{world} at {off['dt']:g} s: without detectors {rate(off['arrived'], off['starts'])}, "
+                           f"with {rate(on['arrived'], on['starts'])}: {verdict}.")
+    for line in summary:
+        print(line)
+    if args.figure:
+        figure(args.figure, args.paths)
+    if args.record:
+        examples.write(args.record, command=examples.command("examples/reactive_navigation.py", argv),
+                       columns=columns, rows=rows, summary=summary)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

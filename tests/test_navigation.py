@@ -175,10 +175,23 @@ def test_detectors_fire_and_the_frustration_input_follows() -> None:
     assert obs[0, 10] == 0.0 and env.fired.tolist() == [[0, 0]]
     obs, _, _ = env.step(STILL, ONE)
     assert obs[0, 10] == 1.0 and env.fired.tolist() == [[1, 0]] and env.escapes.tolist() == [1]
-    # Held still, the escape lasts escape_seconds (40 s) and then the memory starts again.
-    for _ in range(400):
-        obs, _, _ = env.step(STILL, ONE)
-    assert obs[0, 10] == 0.0
+    # Held still, the escape is stuck too: after 3 s more it turns to the other side, and back.
+    sides = [env.step(STILL, ONE)[0][0, 10] for _ in range(61)]
+    assert sides[:29] == [1.0] * 29 and sides[29:59] == [-1.0] * 30 and sides[59:] == [1.0] * 2
+    assert env.fired.tolist() == [[3, 0]] and env.escapes.tolist() == [3]
+    # Free to move, an escape ends after escape_seconds at most, and the memory starts again.
+    env = placed([3.0, 3.0, 0.0], detectors=Detectors(escape_seconds=2.0))
+    seen = [env.step(STILL, ONE)[0][0, 10] for _ in range(30)]
+    back = np.array([[0.3, 0.3]])  # backwards at 0.4 m/s, away from the goal at (7, 3)
+    seen += [env.step(back, ONE)[0][0, 10] for _ in range(25)]
+    assert seen[29:49] == [1.0] * 20 and seen[49:] == [0.0] * 6
+    assert env.fired.tolist() == [[1, 0]]
+    # An escape ends as soon as the robot is 0.1 m nearer the goal than it ever was (4 m here).
+    env = placed([3.0, 3.0, 0.0], detectors=True)
+    for _ in range(30):
+        env.step(STILL, ONE)
+    ahead = [env.step(np.array([[0.75, 0.75]]), ONE)[0][0, 10] for _ in range(5)]  # 0.05 m a step
+    assert ahead == [1.0, 1.0, 0.0, 0.0, 0.0]
     # Driving round in a circle (wheels 0.25 and 0.75 m/s: radius 0.45 m) fires the cyclic one.
     env = placed([1.5, 1.5, 0.0], detectors=True)
     turn = np.array([[0.625, 0.875]])

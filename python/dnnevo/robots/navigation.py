@@ -12,8 +12,8 @@ The paper gives no details; these are dnnevo's (docs/reactive-navigation.md says
   sensor of two inputs, the bearing ``b`` of the goal from the robot's heading (counter-clockwise
   positive, in ``(-pi, pi]``) as ``max(0, b) / pi`` (goal on the left) and ``max(0, -b) / pi``
   (on the right), computed from the robot's pose as perfect odometry would; and the
-  **frustration** input, 1 while the detectors make the robot escape, else 0 (always 0 without
-  detectors).
+  **frustration** input, +1 or -1 while the detectors make the robot escape (bending right or
+  left), else 0 (always 0 without detectors).
 - **Trial**: :attr:`Navigate.steps` steps of 0.1 s (120 s by default); it ends when the robot's
   centre comes within ``goal_radius`` of the goal (**success**).
 - **Fitness** (for an evolved comparison): the progress towards the goal, ``(d_start - d_end) /
@@ -22,9 +22,11 @@ The paper gives no details; these are dnnevo's (docs/reactive-navigation.md says
 - **Detectors** (:class:`Detectors`, on with ``detectors=True``): **static** (:func:`stuck`) fires
   when every position of the last 3 s lies within 0.2 m of the current one; **cyclic**
   (:func:`looping`) when the robot comes back within 0.3 m of where it was 6 to 30 s before.
-  When one fires, the frustration input turns on until the robot is nearer the goal than it
-  ever was before (by 0.1 m), or for at most 40 s; the detectors then start again with an empty
-  memory.
+  When one fires, the frustration input turns on, to the other side from the last escape (the
+  first bends right), until the robot is nearer the goal than it ever was before (by 0.1 m), or
+  for at most 40 s; the detectors then start again with an empty memory. An escape that is
+  itself stuck (the static detector, watching the escape's own track) is replaced by one to the
+  other side.
 
 :func:`navigator` is the hand-designed network, loaded from ``dnnevo/robots/data/navigator.json``;
 :func:`design` builds the same network from the documented weights.
@@ -249,7 +251,8 @@ class Navigate(RobotWorld):
         self.contact_steps = np.zeros(b, dtype=np.int64)
         """How many steps a wall or box stopped each row's robot."""
         self.frustration = np.zeros(b)
-        """The frustration input (B,): 1 while a row's robot escapes."""
+        """The frustration input (B,): 0 while a row's robot seeks the goal, +1 or -1 while it
+        escapes (bending right or left)."""
         self.escapes = np.zeros(b, dtype=np.int64)
         """How many times the detectors fired in each row (static or cyclic)."""
         self.fired = np.zeros((b, 2), dtype=np.int64)
@@ -309,26 +312,33 @@ class Navigate(RobotWorld):
         return self.observe(), reward, done
 
     def _detect(self, running: npt.NDArray[np.bool_]) -> None:
+        assert self.detectors is not None
         t, d = self.t, self.distance()
         self.track[:, t] = self.fleet.poses[:, :2]
-        escaping = self.frustration > 0
-        over = escaping & running & ((d < self._until) | (t - self._escaping_since >= self._escape_steps))
+        escaping = self.frustration != 0
+        recent = self.track[:, max(0, t - self._static):t + 1]
+        # An escape that is itself stuck is replaced by one to the other side.
+        restuck = escaping & running & stuck(recent, self._static, self.detectors.static_distance)
+        over = escaping & running & ~restuck & ((d < self._until)
+                                                | (t - self._escaping_since >= self._escape_steps))
         if over.any():  # the escape ends; the detectors start again with an empty memory
             self.frustration[over] = 0.0
             self.track[over, :t] = np.nan
         seeking = running & ~escaping
-        static = seeking & stuck(self.track[:, max(0, t - self._static):t + 1], self._static,
-                                 self.detectors.static_distance)  # type: ignore[union-attr]
+        static = seeking & stuck(recent, self._static, self.detectors.static_distance)
         cyclic = seeking & ~static & looping(self.track[:, max(0, t + 1 - self._window):t + 1],
-                                             self._after, self.detectors.cycle_radius)  # type: ignore[union-attr]
-        fire = static | cyclic
+                                             self._after, self.detectors.cycle_radius)
+        fire = static | cyclic | restuck
         if fire.any():
-            self.fired[:, 0] += static
+            self.fired[:, 0] += static | restuck
             self.fired[:, 1] += cyclic
             self.escapes += fire
-            self.frustration[fire] = 1.0
-            self._until[fire] = self.best[fire] - self.detectors.escape_margin  # type: ignore[union-attr]
+            new = fire & ~escaping
+            self.frustration[new] = 1.0
+            self.frustration[restuck] = -self.frustration[restuck]
+            self._until[new] = self.best[new] - self.detectors.escape_margin
             self._escaping_since[fire] = t
+            self.track[fire, :t] = np.nan  # the escape's own track starts here
         self.best = np.minimum(self.best, d)
 
     def reward(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.float64]:
@@ -384,5 +394,5 @@ def design(*, cruise: float = 1.4, goal_gain: float = 4.0, relay_gain: float = 4
     s[0, 6], s[1, 6] = -side, side
     s[2, 8], s[3, 9] = relay_gain, relay_gain                     # the destination sensor
     s[2, 10], s[3, 10] = -frustration_block, -frustration_block   # frustration silences the goal
-    s[0, 10], s[1, 10] = frustration_turn, -frustration_turn      # ... and bends right
+    s[0, 10], s[1, 10] = frustration_turn, -frustration_turn      # ... and bends right (+1) or left (-1)
     return _core.Network(tau, theta, w, s)

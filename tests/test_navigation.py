@@ -239,3 +239,14 @@ def test_example_runs_with_tiny_settings_and_records(tmp_path: Path) -> None:
     assert [r[:3] for r in doc["rows"][:2]] == [["open-room", "off", "0.1 s"], ["open-room", "on", "0.1 s"]]
     assert all(r[3].endswith("%)") and "/3 (" in r[3] for r in doc["rows"])
     assert png.stat().st_size > 1000
+
+
+def test_example_evolved_comparison_runs_with_tiny_settings(tmp_path: Path) -> None:
+    record = tmp_path / "evolved.json"
+    assert reactive_navigation.main(["--evolve", "1", "--generations", "1", "--starts", "2",
+                                     "--record", str(record)]) == 0
+    doc = examples.read(record)
+    assert [r[0] for r in doc["rows"]] == ["hand-designed, detectors off", "hand-designed, detectors on",
+                                           "evolved, seed 0"]
+    assert all("/2 (" in cell for r in doc["rows"] for cell in r[1:4])
+    assert doc["summary"][-1].endswith("The paper evolved no network for this task.")

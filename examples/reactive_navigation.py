@@ -133,9 +133,15 @@ def judged(world: str, detectors: bool, starts: int, *, finer: int = 1, steps: i
             "wall": time.perf_counter() - started}
 
 
+def pct(x: float) -> str:
+    """A percentage, whole unless that would hide a fraction of a percent from 0 or 100."""
+    return f"{x:.1%}" if 0 < x < 0.01 or 0.99 < x < 1 else f"{x:.0%}"
+
+
 def rate(k: int, n: int) -> str:
+    """``k/n`` with its 95% Wilson interval."""
     lo, hi = wilson(k, n)
-    return f"{k}/{n} ({lo:.0%}-{hi:.0%})"
+    return f"{k}/{n} ({pct(lo)}-{pct(hi)})"
 
 
 def paths(world: str, detectors: bool, starts: int, steps: int = 1200) -> tuple[Navigate, list[np.ndarray], np.ndarray]:

@@ -248,6 +248,19 @@ PRESETS: dict[str, Preset] = {
                         task_params={"episodes": 6, "max_steps": 450, "validation_episodes": 20}),
         PYTHON_QUICK,
     ),
+    # Paper §3.2 used a hand-designed network here (dnnevo.robots.navigation.navigator) and
+    # evolved none: this is dnnevo's comparison only (docs/reactive-navigation.md), evolved in
+    # the U-trap without detectors with the landmark GA, rank selection and 3 elites.
+    "reactive-navigation": Preset(
+        "paper §3.2 (the paper did not evolve it; docs/reactive-navigation.md): reach a goal past "
+        "a U-shaped trap; 6 neurons, 60 x 40, 4 random starts, champions validated on 10 others",
+        EvolutionConfig(task=f"{PYTHON_TASK}dnnevo.robots.navigation.Navigate", population=60, generations=40,
+                        crossover_rate=0.5, mutation_rate=0.025, selection="rank", elitism=3,
+                        validation_candidates=3, size=6, n_inputs=11,
+                        task_params={"episodes": 4, "max_steps": 600, "validation_episodes": 10,
+                                     "world": "u-trap", "steps": 600}),
+        PYTHON_QUICK,
+    ),
     "categorical-perception": Preset(
         "Beer's categorical perception: catch circles, avoid diamonds (docs/classic.md); "
         "7 neurons, 100 x 300, 16 falls",

@@ -20,11 +20,10 @@ apart. ``--figure`` draws the paths of the first ``--paths`` starts in the U-tra
 with the detectors.
 
 **An evolved comparison**, which the paper does not make: with ``--evolve SEEDS`` the script
-instead evolves, for each seed, ``POPULATION`` networks of ``SIZE`` neurons for
-``--generations`` generations in the U-trap without detectors (``EPISODES`` random starts per
-network per generation, trials of 60 s, the champion chosen among each generation's 3 best on
-10 validation starts; the landmark GA's crossover 0.5 and mutation 0.025, rank selection, 3
-elites), and judges each champion on the fresh starts of every world, beside the hand-designed
+instead runs the ``reactive-navigation`` preset for each seed (60 networks of 6 neurons for
+``--generations`` generations in the U-trap without detectors, 4 random starts per network per
+generation, trials of 60 s, the champion chosen among each generation's 3 best on 10 validation
+starts; the landmark GA's crossover 0.5 and mutation 0.025, rank selection, 3 elites), and judges each champion on the fresh starts of every world, beside the hand-designed
 network without and with the detectors::
 
     python examples/reactive_navigation.py --evolve 5 --starts 200 \
@@ -42,8 +41,8 @@ from typing import Any
 import numpy as np
 
 import dnnevo
-from dnnevo import plot
-from dnnevo.closedloop import rollout
+from dnnevo import plot, presets
+from dnnevo.closedloop import named, rollout
 from dnnevo.evaluation.stats import wilson
 from dnnevo.experiments import examples
 from dnnevo.robots import Navigate
@@ -53,20 +52,15 @@ from dnnevo.runs import save_figure
 FRESH_SEED = 2_000_003
 """The seed of the start poses: used by no run, and not by the predator example's 1_000_003."""
 
-POPULATION, SIZE, EPISODES, TRAIN_STEPS = 60, 6, 4, 600
-"""The evolved comparison: networks per generation, neurons, starts per network per generation,
-and steps of 0.1 s per training trial."""
+PRESET = "reactive-navigation"
+"""The evolved comparison's preset."""
 
 
 def evolve(seed: int, generations: int) -> dnnevo.Network:
-    """One seed's champion, evolved in the U-trap without detectors (see the module docs)."""
-    from dnnevo.closedloop import ClosedLoop
-    cfg = dnnevo.EvolutionConfig(population=POPULATION, generations=generations, size=SIZE, n_inputs=11,
-                                 selection="rank", elitism=3, crossover_rate=0.5, mutation_rate=0.025,
-                                 validation_candidates=3)
-    fitness = ClosedLoop(Navigate("u-trap", steps=TRAIN_STEPS), episodes=EPISODES, max_steps=TRAIN_STEPS,
-                         validation_episodes=10)
-    result = dnnevo.evolve(fitness, cfg, seed=seed, progress=False)
+    """One seed's champion of the ``reactive-navigation`` preset (``dnnevo presets``), run for
+    ``generations``: evolved in the U-trap without detectors (see the module docs)."""
+    cfg = presets.get(PRESET, overrides=[f"generations={generations}"])
+    result = dnnevo.evolve(named.closed_loop(cfg), cfg, seed=seed, progress=False)
     if result.interrupted:
         raise KeyboardInterrupt
     return result.best

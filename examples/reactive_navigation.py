@@ -46,7 +46,7 @@ from dnnevo.closedloop import named, rollout
 from dnnevo.evaluation.stats import wilson
 from dnnevo.experiments import examples
 from dnnevo.robots import Navigate
-from dnnevo.robots.navigation import INTEGRATOR, WORLDS, navigator
+from dnnevo.robots.navigation import INTEGRATOR, WORLDS, Integration, navigator
 from dnnevo.runs import save_figure
 
 FRESH_SEED = 2_000_003
@@ -67,11 +67,11 @@ def evolve(seed: int, generations: int) -> dnnevo.Network:
 
 
 def network_judged(net: dnnevo.Network, world: str, starts: int, *, detectors: bool = False,
-                   integrator: dict[str, Any] | None = None) -> tuple[int, float]:
+                   integrator: Integration | None = None) -> tuple[int, float]:
     """``net``'s arrivals on the fresh starts of ``world`` and the fraction of its steps in
     contact; integrated as evolution ran (10 Euler steps of 0.1) unless ``integrator`` says."""
     env = Navigate(world, detectors=detectors)
-    i = integrator or {"dt": 0.1, "substeps": 10, "method": "euler"}
+    i: Integration = integrator or {"dt": 0.1, "substeps": 10, "method": "euler"}
     r = rollout([net], env, episodes=starts, max_steps=env.steps, seed=FRESH_SEED, purpose="evaluate", **i)
     return int(env.arrived.sum()), float(env.contact_steps.sum() / r.lengths.sum())
 

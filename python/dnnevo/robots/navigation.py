@@ -49,7 +49,7 @@ from dataclasses import dataclass
 from importlib import resources
 from os import PathLike
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -58,10 +58,18 @@ from dnnevo import _core
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.robots.world import D0, RobotWorld
 
-__all__ = ["INTEGRATOR", "WORLDS", "Detectors", "Navigate", "bearing", "design", "destination",
+__all__ = ["INTEGRATOR", "WORLDS", "Integration", "Detectors", "Navigate", "bearing", "design", "destination",
            "looping", "navigation_world", "navigator", "stuck"]
 
-INTEGRATOR = {"dt": 0.02, "substeps": 5, "method": "euler"}
+class Integration(TypedDict):
+    """How a network is integrated: the keyword arguments of :func:`dnnevo.closedloop.rollout`."""
+
+    dt: float
+    substeps: int
+    method: str
+
+
+INTEGRATOR: Integration = {"dt": 0.02, "substeps": 5, "method": "euler"}
 """How the hand-designed network is integrated: five Euler steps of 0.02 per world step of 0.1 s,
 so that the network's time is in seconds and its time constants (0.2 s) are ten Euler steps."""
 

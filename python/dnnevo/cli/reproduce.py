@@ -28,12 +28,12 @@ continues it."""
 
 DESCRIPTION = """\
 Run every experiment of the paper over seeds and write a report: landmark recognition (ideal
-training, then the robot-like test of the champions), predator avoidance (family robots),
-one-dimensional navigation (the three subnetworks, the goal seekers evolved on chains, both
-integrated systems, the single network) and sequence learning (1-bit, alternating, the
-incremental 2-bit route from those two runs, direct 2-bit, and beyond the paper direct 2-bit with
-16 neurons, 3-bit). --only classic runs the field's benchmarks written as Python tasks instead
-(walker, categorical perception, double pole). Each evolution has its own run folder
+training, then the robot-like test of the champions), predator avoidance and reactive navigation
+(family robots), one-dimensional navigation (the three subnetworks, the goal seekers evolved on
+chains, both integrated systems, the single network) and sequence learning (1-bit, alternating,
+the incremental 2-bit route from those two runs, direct 2-bit, and beyond the paper direct 2-bit
+with 16 neurons, 3-bit). --only classic runs the field's benchmarks written as Python tasks
+instead (walker, categorical perception, double pole). Each evolution has its own run folder
 OUT/EXPERIMENT/seed-N and its result in OUT/EXPERIMENT/seed-N.json (the robot-like test and the
 integrated systems are tests of other runs and have only the result). The report, OUT/report.md
 and OUT/report.html, covers the seeds and families of the command that wrote it."""

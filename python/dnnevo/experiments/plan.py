@@ -84,6 +84,13 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                "quantified)", preset="predator-avoidance",
                note="the task's arena, pursuers, sensors, fitness and success rule are dnnevo's "
                     "(docs/paper.md); a task written in Python (dnnevo.robots.pursuit)"),
+    Experiment("reactive-navigation", "robots", EVOLVE,
+               "§3.2: a hand-designed network with static and cyclic detectors reaches a goal "
+               "(not quantified; not evolved)", preset="reactive-navigation",
+               note="dnnevo's evolved comparison, which the paper does not make: networks evolved "
+                    "to reach a goal past a U-shaped trap, without detectors; the hand-designed "
+                    "network and its detectors are examples/reactive_navigation.py "
+                    "(docs/reactive-navigation.md)"),
     Experiment("nav1d-classifier", "nav1d", EVOLVE, "§4.2: solved at generation 5",
                preset="nav1d-classifier"),
     Experiment("nav1d-far", "nav1d", EVOLVE, "§4.2: solved at generation 0", preset="nav1d-far"),

@@ -310,3 +310,5 @@ def test_evaluate_scores_a_python_task_preset_as_its_run_does(tmp_path: Path) ->
     assert run.history["mean"][0] == from_genomes.mean()
     with pytest.raises(dnnevo.errors.InvalidArgumentError, match="genomes must be"):
         dnnevo.evaluate("legged-walker", genomes[0], generation=0, seed=11)
+    with pytest.raises(dnnevo.errors.InvalidArgumentError, match="genomes must be"):
+        dnnevo.evaluate("legged-walker", [networks[0], genomes[1]], generation=0, seed=11)

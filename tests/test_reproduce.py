@@ -236,10 +236,15 @@ def test_experiments_added_since_a_reproduction_began_join_it(tmp_path: Path) ->
     full = json.loads(manifest.read_text())
     # A folder begun before an experiment existed has no config for it: it is added.
     manifest.write_text(json.dumps({**full, "configs": {k: v for k, v in full["configs"].items()
-                                                          if k != "double-pole"}}))
+                                                          if k != "predator-avoidance"}}))
     again = run_cli(*args)
     assert again.returncode == 0 and "(3 already done)" in again.stdout, again.stderr
     assert json.loads(manifest.read_text()) == full
+    # An experiment with runs in the folder but no recorded config is no addition: refused.
+    manifest.write_text(json.dumps({**full, "configs": {}}))
+    before = manifest.read_bytes()
+    assert_one_line_error(run_cli(*args), "has no config for", "holds its runs")
+    assert manifest.read_bytes() == before
     # A recorded experiment whose config differs is refused, and the folder is left as it was.
     walker = {**full["configs"]["legged-walker"], "population": 7}
     manifest.write_text(json.dumps({**full, "configs": {**full["configs"], "legged-walker": walker}}))

@@ -193,6 +193,33 @@ def test_collect_takes_in_experiments_added_since_and_refuses_a_changed_one(tmp_
     assert (dest / "reproduce.json").read_bytes() == before
 
 
+def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, repo: Path) -> None:
+    """The classic benchmarks, collected beside the paper's families, get their rows."""
+    source = tmp_path / "classic"
+    r = run_cli("reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
+                "--no-dt-check", "--in-process", "--out", source)
+    assert r.returncode == 0, r.stderr
+    r = _results("collect", source, repo / "docs" / "results", "--seeds", "0", "--only", "classic",
+                 "--commit", "abc1234")
+    assert r.returncode == 0, r.stderr
+    assert repo / "README.md" in results.render(repo)
+    readme = (repo / "README.md").read_text()
+    for e in (e for e in plan.EXPERIMENTS if e.family == "classic"):
+        assert f"| {e.name} | {e.paper} | 1/1 |" in readme, e.name
+    assert "| landmark | " in readme
+
+
+def test_a_refused_collect_writes_nothing(tmp_path: Path, reproduction: Path) -> None:
+    """A damaged result refuses the whole collect before any result is copied."""
+    source = tmp_path / "source"
+    shutil.copytree(reproduction, source)
+    (source / "landmark-robot" / "seed-0.json").write_text("{")
+    dest = tmp_path / "results"
+    r = _results("collect", source, dest, "--seeds", "0", "--only", "landmark", "--commit", "abc1234")
+    assert r.returncode == 2 and "landmark-robot" in r.stderr, r.stderr
+    assert not dest.exists()
+
+
 def test_the_committed_tables_are_made_from_docs_results() -> None:
     """README.md and the docs say what docs/results holds: run
     ``python -m dnnevo.experiments.results render`` after collecting results."""

@@ -179,6 +179,10 @@ def _begin(root: Path, settings: jobs.Settings) -> None:
         check_settings(manifest, {**wanted, "configs": {k: v for k, v in wanted["configs"].items() if k in recorded}},
                        what="reproduction", force=False)
         added = {k: v for k, v in wanted["configs"].items() if k not in recorded}
+        for name in added:  # an experiment the folder has runs of was recorded, or it is not ours
+            if (root / name).exists():
+                raise RunFileError(f"{manifest}: has no config for {name}, yet {root / name} holds "
+                                   "its runs; choose another --out")
         if added:
             write_atomic(manifest, json.dumps({**found, "configs": {**recorded, **added}}, indent=1) + "\n")
         return

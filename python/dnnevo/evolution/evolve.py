@@ -93,7 +93,10 @@ def evaluate(
         if isinstance(genomes, Sequence) and all(isinstance(g, _core.Network) for g in genomes):
             networks = list(genomes)
         else:
-            rows = np.asarray(genomes, dtype=np.float64)
+            try:
+                rows = np.asarray(genomes, dtype=np.float64)
+            except (TypeError, ValueError) as e:
+                raise InvalidArgumentError(f"genomes must be an array (P, G) or a list of networks: {e}") from None
             if rows.ndim != 2:
                 raise InvalidArgumentError(f"genomes must be an array (P, G) or a list of networks; got shape {rows.shape}")
             networks = [_core.decode(config.size, config.n_inputs, row) for row in rows]

@@ -179,7 +179,7 @@ def load(folder: Path) -> Results:
                               f"{path.parent.relative_to(folder)} or collect again")
         if not re.fullmatch(r"[0-9]+", number):
             raise DnnevoError(f"{path}: not a result file (they are EXPERIMENT/seed-N.json)")
-        job = next(j for j in plan.jobs([int(number)]) if j.experiment == name)
+        job = next(j for j in plan.jobs([int(number)], plan.FAMILIES) if j.experiment == name)
         result = read_json(path)
         if not isinstance(result, dict) or result.get("job") != job.id:
             raise DnnevoError(f"{path}: not the result of job {job.id}")
@@ -256,7 +256,7 @@ def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
 
 def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             seeds: Sequence[int] = DEFAULT_SEEDS, commit: str | None = None) -> list[str]:
-    """Copies the finished results of ``families`` (default all) over ``seeds`` from the
+    """Copies the finished results of ``families`` (default the paper's) over ``seeds`` from the
     reproduction folder ``source`` into ``dest``, each checked against its run folder as
     ``dnnevo reproduce`` checks it, with ``reproduce.json`` and ``provenance.json``. Returns the
     ids of the jobs copied. ``dest`` must hold the same reproduction (same settings) or none."""
@@ -269,7 +269,6 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
         if manifest is None:
             raise DnnevoError(f"{dest / SETTINGS_FILE} holds another reproduction's settings than {settings_file}; "
                               f"empty {dest} first to replace them")
-    dest.mkdir(parents=True, exist_ok=True)
     old = _read_provenance(dest / PROVENANCE_FILE)
     if old and old.get("seeds") != sorted(seeds):
         raise DnnevoError(f"{dest / PROVENANCE_FILE} covers seeds {old.get('seeds')}, not {sorted(seeds)}; "
@@ -285,12 +284,15 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
         raise DnnevoError(f"{source}: {why}; pass --commit, the commit the reproduction ran")
     with checked(settings_file):
         settings = jobs.Settings(**manifest["settings"])
+    # Every result is checked before any is written, so a refusal leaves dest as it was.
+    chosen = {family: [job for job in plan.jobs(list(seeds), [family])
+                       if jobs.read_result(source, job, settings) is not None]  # checked against its run
+              for family in plan.families(families)}
+    dest.mkdir(parents=True, exist_ok=True)
     copied, times = [], {}
-    for family in plan.families(families):
+    for family, finished in chosen.items():
         done = []
-        for job in plan.jobs(list(seeds), [family]):
-            if jobs.read_result(source, job, settings) is None:  # checked against its run folder
-                continue
+        for job in finished:
             src, out = jobs.result_path(source, job), jobs.result_path(dest, job)
             out.parent.mkdir(parents=True, exist_ok=True)
             write_atomic(out, src.read_text(encoding="utf-8"))
@@ -499,7 +501,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                               "docs/results --only landmark --commit ca5f9b8")
     c.add_argument("source", type=Path, help="the reproduction's folder (dnnevo reproduce --out)")
     c.add_argument("dest", type=Path, nargs="?", default=RESULTS_DIR, help=f"default {RESULTS_DIR}")
-    c.add_argument("--only", help=f"comma-separated families, from {','.join(plan.FAMILIES)} (default all)")
+    c.add_argument("--only", help=f"comma-separated families, from {','.join(plan.FAMILIES)} (default the paper's: {','.join(plan.PAPER_FAMILIES)})")
     c.add_argument("--seeds", type=_seeds, default=list(DEFAULT_SEEDS), help="default 0-9")
     c.add_argument("--commit", help="the commit the reproduction ran (default: what its report names)")
     r = sub.add_parser("render", help="write the results tables into README.md and docs/**/*.md",

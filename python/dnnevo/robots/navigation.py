@@ -22,8 +22,8 @@ The paper gives no details; these are dnnevo's (docs/reactive-navigation.md says
 - **Detectors** (:class:`Detectors`, on with ``detectors=True``): **static** (:func:`stuck`) fires
   when every position of the last 3 s lies within 0.2 m of the current one; **cyclic**
   (:func:`looping`) when the robot comes back within 0.3 m of where it was 6 to 30 s before.
-  When one fires, the frustration input turns on, to the other side from the last escape (the
-  first bends right), until the robot is nearer the goal than it ever was before (by 0.1 m), or
+  When one fires, the frustration input turns on and bends the path right, until the robot is
+  nearer the goal than it ever was before (by 0.1 m), or
   for at most 40 s; the detectors then start again with an empty memory. An escape that is
   itself stuck (the static detector, watching the escape's own track) is replaced by one to the
   other side.

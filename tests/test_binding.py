@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import dnnevo
+import dnnevo.analysis
 from dnnevo import _core, presets
 from dnnevo.errors import ConfigError, InvalidArgumentError
 from dnnevo.tasks import landmark, nav1d, sequence
@@ -90,6 +91,27 @@ def test_records_are_typed_arrays() -> None:
     assert rec.classification == rec.outputs[-1, 0]
     silent = np.isnan(rec.echoes[:, 0])
     assert np.array_equal(silent, np.isnan(rec.echoes[:, 1]))
+
+
+def test_records_and_analysis_results_are_read_only() -> None:
+    """The records and analysis results are frozen objects, and so are their arrays: writing into
+    one raises instead of changing a result its to_dict() would not show."""
+    config = presets.get("sequence-1bit")
+    net = dnnevo.Network.random(config.size, config.n_inputs, seed=3)
+    seq = sequence.run_trial(config, net, "1", sequence.timings(config, 0, 0, 0))
+    config = presets.get("nav1d-classifier")
+    nav = nav1d.record(config, dnnevo.Network.random(config.size, config.n_inputs, seed=3),
+                       nav1d.fresh_chains(config, 1, 2, 0)[0])
+    config = presets.get("landmark")
+    land = landmark.record(config, dnnevo.Network.random(config.size, config.n_inputs, seed=3), 2,
+                           seed=1, trial=1)
+    [equilibrium, *_] = dnnevo.analysis.equilibria(dnnevo.Network.random(3, 1, seed=0), [0.0])
+    arrays = [seq.outputs, seq.targets, seq.trigger_correct, seq.r, nav.outputs, nav.trial, nav.moving,
+              nav.x, land.input, land.poses, land.echoes, equilibrium.state, equilibrium.eigenvalues]
+    for array in arrays:
+        assert not array.flags.writeable
+        with pytest.raises(ValueError, match="read-only"):
+            array[0] = array[0]
 
 
 def test_task_params_changed_in_place_are_refused_not_ignored() -> None:

@@ -10,7 +10,7 @@ use pyo3::types::{PyComplex, PyDict};
 use serde::Serialize;
 
 use crate::json::to_py;
-use crate::records::{matrix, vector};
+use crate::records::{frozen, matrix, vector};
 
 /// The snake_case name serde gives a unit enum variant, such as "stable_node".
 fn name<T: Serialize>(value: &T) -> String {
@@ -31,31 +31,6 @@ fn complex(py: Python<'_>, pairs: &[[f64; 2]]) -> PyResult<Py<PyArray1<Complex64
         .map(|&[re, im]| Complex64::new(re, im))
         .collect();
     frozen(py, PyArray1::from_vec(py, z).unbind())
-}
-
-/// `array`, made read-only: a result is frozen, and its `to_dict()` is built from the struct.
-fn frozen<T>(py: Python<'_>, array: Py<T>) -> PyResult<Py<T>> {
-    let kwargs = PyDict::new(py);
-    kwargs.set_item("write", false)?;
-    array
-        .bind(py)
-        .as_any()
-        .call_method("setflags", (), Some(&kwargs))?;
-    Ok(array)
-}
-
-/// A read-only 1-D array of `v`.
-fn fixed(py: Python<'_>, v: Vec<f64>) -> PyResult<Py<PyArrayDyn<f64>>> {
-    frozen(py, vector(py, v)?)
-}
-
-/// A read-only (rows, columns) array.
-fn fixed_rows<R: AsRef<[f64]>>(
-    py: Python<'_>,
-    rows: Vec<R>,
-    columns: usize,
-) -> PyResult<Py<PyArrayDyn<f64>>> {
-    frozen(py, matrix(py, rows, columns)?)
 }
 
 /// One equilibrium and its linear stability.
@@ -79,8 +54,8 @@ pub struct PyEquilibrium {
 impl PyEquilibrium {
     pub fn new(py: Python<'_>, e: Equilibrium) -> PyResult<Self> {
         Ok(PyEquilibrium {
-            state: fixed(py, e.state.clone())?,
-            outputs: fixed(py, e.outputs.clone())?,
+            state: vector(py, e.state.clone())?,
+            outputs: vector(py, e.outputs.clone())?,
             eigenvalues: complex(py, &e.eigenvalues)?,
             stability: name(&e.stability),
             inner: e,
@@ -156,11 +131,11 @@ impl PyCycle {
     pub fn new(py: Python<'_>, c: Cycle) -> PyResult<Self> {
         let n = c.amplitude.len();
         Ok(PyCycle {
-            amplitude: fixed(py, c.amplitude.clone())?,
-            mean_outputs: fixed(py, c.mean_outputs.clone())?,
-            output_range: fixed_rows(py, c.output_range.clone(), 2)?,
+            amplitude: vector(py, c.amplitude.clone())?,
+            mean_outputs: vector(py, c.mean_outputs.clone())?,
+            output_range: matrix(py, c.output_range.clone(), 2)?,
             multipliers: complex(py, &c.multipliers)?,
-            orbit: fixed_rows(py, c.orbit.clone(), n)?,
+            orbit: matrix(py, c.orbit.clone(), n)?,
             inner: c,
         })
     }
@@ -424,8 +399,8 @@ impl PyBifurcation {
         let events = objects(py, &b.events, |py, e: Event| {
             Ok(PyEvent {
                 kind: name(&e.kind),
-                state: fixed(py, e.state.clone())?,
-                outputs: fixed(py, e.outputs.clone())?,
+                state: vector(py, e.state.clone())?,
+                outputs: vector(py, e.outputs.clone())?,
                 inner: e,
             })
         })?;
@@ -437,8 +412,8 @@ impl PyBifurcation {
             })
         })?;
         Ok(PyBifurcation {
-            input: fixed(py, base.clone())?,
-            values: fixed(py, b.values.clone())?,
+            input: vector(py, base.clone())?,
+            values: vector(py, b.values.clone())?,
             base,
             equilibria,
             events,

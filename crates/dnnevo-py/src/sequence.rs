@@ -151,10 +151,10 @@ impl PySequenceRecord {
             reinforcement: vector(py, record.reinforcement)?,
             output: vector(py, record.output)?,
             outputs: matrix(py, record.outputs, size)?,
-            targets: integers(py, &record.targets),
+            targets: integers(py, &record.targets)?,
             r: vector(py, record.r)?,
             mean_output: vector(py, record.mean_output)?,
-            trigger_correct: flags(py, record.trigger_correct),
+            trigger_correct: flags(py, record.trigger_correct)?,
             final_state: vector(py, record.final_state)?,
         })
     }

@@ -336,6 +336,16 @@ def _positive(text: str) -> int:
     return value
 
 
+def _episode(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 0")
+    return value
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--seeds", type=_positive, default=10, help="seeds 0 .. N-1 (default 10)")
@@ -347,7 +357,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                    help="override a setting of the preset (repeatable), as for dnnevo run")
     p.add_argument("--figure", type=Path, help="draw the best seed's paths here (PNG)")
     p.add_argument("--animation", type=Path, help="animate the best seed's episode here (GIF)")
-    p.add_argument("--episode", type=int, metavar="E",
+    p.add_argument("--episode", type=_episode, metavar="E",
                    help="draw fresh episode E (default: the first the champion escapes)")
     p.add_argument("--draw", type=Path, metavar="NETWORK",
                    help="evolve nothing: draw this saved champion's episode (--figure, --animation)")

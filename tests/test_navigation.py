@@ -155,6 +155,18 @@ def test_static_detector_fires_on_a_stuck_robot_only() -> None:
     assert stuck(track[2:] * np.array([0.2, 1.0]), 30, 0.2).tolist() == [False]
 
 
+def test_detector_windows_and_tracks_of_the_wrong_shape_are_named() -> None:
+    straight = np.stack([np.linspace(0, 3, 40), np.zeros(40)], axis=1)[None]
+    for bad in (0, -1, 1.5, True):
+        with pytest.raises(InvalidArgumentError, match="span is .*; it must be an integer >= 1"):
+            stuck(straight, bad, 0.2)
+        with pytest.raises(InvalidArgumentError, match="after is .*; it must be an integer >= 1"):
+            looping(straight, bad, 0.3)
+    with pytest.raises(InvalidArgumentError, match=r"track has shape \(40, 2\)"):
+        stuck(straight[0], 3, 0.2)
+    assert stuck(straight, 3, 0.2).tolist() == [False] and looping(straight, 3, 0.05).tolist() == [False]
+
+
 def test_cyclic_detector_fires_on_a_circling_robot_not_a_straight_one() -> None:
     track = trajectories()
     assert looping(track[:, -300:], 60, 0.3).tolist() == [True, True, False]

@@ -234,6 +234,10 @@ def test_the_example_runs_and_records(tmp_path: Path, capsys: pytest.CaptureFixt
     assert_png(tmp_path / "again.png") and capsys.readouterr().out == ""
     with pytest.raises(SystemExit):
         predator_avoidance.main(["--draw", str(tmp_path / "nets" / "seed-1.json")])
+    with pytest.raises(SystemExit):  # a negative episode is refused, not drawn from the end
+        predator_avoidance.main(["--draw", str(tmp_path / "nets" / "seed-1.json"), "--episode", "-1",
+                                 "--figure", str(tmp_path / "never.png")])
+    assert not (tmp_path / "never.png").exists()
     doc = examples.read(record)
     given = argv[:argv.index("--record")]
     assert doc["command"] == " ".join(["python", "examples/predator_avoidance.py", *given])

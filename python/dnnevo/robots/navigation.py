@@ -151,12 +151,28 @@ def destination(poses: npt.ArrayLike, goal: npt.ArrayLike) -> npt.NDArray[np.flo
     return np.stack([np.maximum(0.0, b), np.maximum(0.0, -b)], axis=1) / np.pi
 
 
+def _track(track: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """``track`` as a (B, H, 2) float array, or an :class:`InvalidArgumentError`."""
+    t = np.asarray(track, dtype=float)
+    if t.ndim != 3 or t.shape[2] != 2:
+        raise InvalidArgumentError(f"track has shape {t.shape}; expected (rows, steps, 2)")
+    return t
+
+
+def _at_least_one(name: str, steps: int) -> None:
+    """A window of ``steps`` steps must hold at least one: 0 or fewer would call a robot that
+    drives straight stuck or looping."""
+    if not isinstance(steps, int | np.integer) or isinstance(steps, bool) or steps < 1:
+        raise InvalidArgumentError(f"{name} is {steps!r}; it must be an integer >= 1")
+
+
 def stuck(track: npt.ArrayLike, span: int, distance: float) -> npt.NDArray[np.bool_]:
     """The static detector: which rows of ``track`` (B, H, 2; positions, newest last, NaN where
     none was recorded) have every position of their last ``span`` steps (``span + 1`` entries)
     recorded and within ``distance`` of the newest: the robot has moved less than ``distance``
     in that time."""
-    t = np.asarray(track, dtype=float)
+    t = _track(track)
+    _at_least_one("span", span)
     if t.shape[1] < span + 1:
         return np.zeros(len(t), dtype=bool)
     window = t[:, t.shape[1] - span - 1:]
@@ -168,7 +184,8 @@ def looping(track: npt.ArrayLike, after: int, radius: float) -> npt.NDArray[np.b
     """The cyclic detector: which rows of ``track`` (B, H, 2; positions, newest last, NaN where
     none was recorded) have come back within ``radius`` of a position recorded at least
     ``after`` steps before the newest (pass the window to look back over as ``track``)."""
-    t = np.asarray(track, dtype=float)
+    t = _track(track)
+    _at_least_one("after", after)
     if t.shape[1] <= after:
         return np.zeros(len(t), dtype=bool)
     old = t[:, :t.shape[1] - after]

@@ -24,13 +24,11 @@ generalisation score.
 from __future__ import annotations
 
 import argparse
-import concurrent.futures
 import dataclasses
-import multiprocessing
 import shlex
 import sys
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -105,26 +103,6 @@ def one_seed(seed: int, budget: int, overrides: Sequence[str]) -> dict[str, Any]
             "seconds": time.perf_counter() - started}
 
 
-def seeds_run(seeds: int, workers: int, budget: int, overrides: Sequence[str]) -> Iterator[dict[str, Any]]:
-    """Each seed's result, in seed order, as it comes: one after another here, or ``workers`` at
-    a time in processes of their own (the same results either way)."""
-    if workers <= 1:
-        for seed in range(seeds):
-            yield one_seed(seed, budget, overrides)
-        return
-    # Spawned, not forked: a fork of a process that runs threads (rayon's, a test runner's) can
-    # inherit a lock held by one of them and hang.
-    spawn = multiprocessing.get_context("spawn")
-    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=spawn) as pool:
-        running = [pool.submit(one_seed, seed, budget, overrides) for seed in range(seeds)]
-        try:
-            for future in running:
-                yield future.result()
-        except BaseException:  # Ctrl-C: the seeds not yet started never start
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
-
-
 def _positive(text: str) -> int:
     try:
         value = int(text)
@@ -153,7 +131,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     overrides = [*args.set, *(["task_params.velocities=true", "n_inputs=6"] if args.velocities else [])]
     rows = []
     print("seed     episodes  generations  generalisation  long-test steps  tests  seconds")
-    for r in seeds_run(args.seeds, args.workers, args.budget, overrides):
+    for r in examples.seeds_run(one_seed, args.seeds, args.workers, args.budget, overrides):
         rows.append(r)
         shown = r["episodes"] if r["episodes"] is not None else f">{args.budget}"
         print(f"{r['seed']:4d}  {shown!s:>11}  {r['generations'] or '-'!s:>11}  {r['generalization']:14d}  "

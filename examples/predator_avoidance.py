@@ -36,12 +36,10 @@ champion; ``--draw NETWORK`` draws a saved champion without evolving anything.
 from __future__ import annotations
 
 import argparse
-import concurrent.futures
-import multiprocessing
 import shlex
 import sys
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -102,26 +100,6 @@ def one_seed(seed: int, overrides: Sequence[str], fresh: int) -> dict[str, Any]:
                      "return": float(judged.returns.mean())}
     out["seconds"] = time.perf_counter() - started
     return out
-
-
-def seeds_run(seeds: int, workers: int, overrides: Sequence[str], fresh: int) -> Iterator[dict[str, Any]]:
-    """Each seed's result, in seed order, as it comes: one after another here, or ``workers`` at
-    a time in processes of their own (the same results either way)."""
-    if workers <= 1:
-        for seed in range(seeds):
-            yield one_seed(seed, overrides, fresh)
-        return
-    # Spawned, not forked: a fork of a process that runs threads (rayon's, a test runner's) can
-    # inherit a lock held by one of them and hang.
-    spawn = multiprocessing.get_context("spawn")
-    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=spawn) as pool:
-        running = [pool.submit(one_seed, seed, overrides, fresh) for seed in range(seeds)]
-        try:
-            for future in running:
-                yield future.result()
-        except BaseException:  # Ctrl-C: the seeds not yet started never start
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
 
 
 def baselines(cfg: EvolutionConfig, fresh: int, randoms: int) -> dict[str, dict[str, dict[str, int]]]:
@@ -378,7 +356,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     rows = []
     print("seed  fresh episodes escaped    mean return  rule  transfer world            "
           "lost echoes               half step                 seconds")
-    for r in seeds_run(args.seeds, args.workers, args.set, args.fresh):
+    for r in examples.seeds_run(one_seed, args.seeds, args.workers, args.set, args.fresh):
         rows.append(r)
         if args.champions:
             args.champions.mkdir(parents=True, exist_ok=True)

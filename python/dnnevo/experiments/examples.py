@@ -26,11 +26,13 @@ dnnevo.experiments.results render`` then fills every ``<!-- results:example:NAME
 
 from __future__ import annotations
 
+import concurrent.futures
 import json
+import multiprocessing
 import platform
 import shlex
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -38,7 +40,7 @@ from dnnevo import _core
 from dnnevo.experiments import report
 from dnnevo.runs.files import RunFileError, read_json, write_atomic
 
-__all__ = ["EXAMPLES_DIR", "blocks", "command", "markdown", "read", "write"]
+__all__ = ["EXAMPLES_DIR", "blocks", "command", "markdown", "read", "seeds_run", "write"]
 
 EXAMPLES_DIR = Path("examples")
 """Where, under the results folder (``docs/results``), the examples' results live."""
@@ -68,6 +70,27 @@ def command(script: str, argv: Sequence[str] | None = None) -> str:
             continue
         kept.append(arg)
     return shlex.join(["python", script, *kept])
+
+
+def seeds_run(one_seed: Callable[..., Any], seeds: int, workers: int, *args: Any) -> Iterator[Any]:
+    """``one_seed(seed, *args)`` for seeds 0 .. ``seeds`` - 1, in seed order, as each comes: one
+    after another here, or ``workers`` at a time in processes of their own (the same results
+    either way; ``one_seed`` must be a module-level function). Spawned, not forked: a fork of a
+    process that runs threads (rayon's, a test runner's) can inherit a lock held by one of them
+    and hang. On Ctrl-C the seeds not yet started never start."""
+    if workers <= 1:
+        for seed in range(seeds):
+            yield one_seed(seed, *args)
+        return
+    spawn = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=spawn) as pool:
+        running = [pool.submit(one_seed, seed, *args) for seed in range(seeds)]
+        try:
+            for future in running:
+                yield future.result()
+        except BaseException:
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
 
 
 def write(path: Path, *, command: str, columns: Sequence[str], rows: Sequence[Sequence[Any]],

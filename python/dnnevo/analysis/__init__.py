@@ -9,6 +9,8 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
   and which attractor a state settles to; it knows no task;
 - :mod:`.trials`: a task's real trials recorded for the analysis, and replayed;
 - :mod:`.lesions`: a neuron clamped or a connection cut, and the champion judged again;
+- :mod:`.events`: windows of recorded trials aligned on the moments something happens, for a
+  task's own views (``dnnevo.robots.pursuit``: a pursuer appearing);
 - :mod:`.figures`: phase portraits, bifurcation diagrams, lesion tables and basins.
 
 The numerical work is in Rust (``ctrnn::analysis``); these modules turn its results into
@@ -50,7 +52,7 @@ from dnnevo.analysis.figures import (
     plot_phase_portrait,
 )
 from dnnevo.analysis.lesions import CLAMP_LIMIT, Lesion, LesionTable, clamp, cut, lesions
-from dnnevo.analysis.trials import recorded_trials, replay, trial_outputs
+from dnnevo.analysis.trials import analysed_task, recorded_trials, replay, trial_outputs
 
 __all__ = [
     "CLAMP_LIMIT",
@@ -66,6 +68,7 @@ __all__ = [
     "Event",
     "Lesion",
     "LesionTable",
+    "analysed_task",
     "attractors",
     "bifurcation",
     "clamp",

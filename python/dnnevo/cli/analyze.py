@@ -12,12 +12,13 @@ from typing import Any
 
 import numpy as np
 
-from dnnevo import _core, analysis, plot, tasks
+from dnnevo import _core, analysis, plot
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError, InvalidArgumentError
+from dnnevo.errors import InvalidArgumentError
 from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure, write_atomic
+from dnnevo.tasks.protocol import Task, views
 
 EXAMPLE = """examples:
   dnnevo run sequence-1bit --quick --out runs/demo && dnnevo analyze runs/demo
@@ -95,9 +96,7 @@ def analyze(args: argparse.Namespace) -> int:
     config, raw = run.read_run_config()
     net = run.read_best(config, raw)
     m = net.n_inputs
-    task = tasks.find(config.task)
-    if task is None:
-        raise ConfigError(f"task {config.task!r} has no analysis defaults; tasks with one: {', '.join(tasks.names())}")
+    task = analysis.analysed_task(config)
     if args.steps < 2:
         raise InvalidArgumentError(f"--steps is {args.steps}; a sweep needs at least 2 input values")
     if args.trials < 1:
@@ -116,6 +115,7 @@ def analyze(args: argparse.Namespace) -> int:
     trials = analysis.recorded_trials(config, net, seed=args.seed)
     outputs = np.vstack([o for o, _ in trials])
     basins = _basins(config, net, trials, found[0])
+    output = output_neuron(config, task)
     if args.neurons:
         neurons = _pair(args.neurons, net.size)
     else:
@@ -131,6 +131,7 @@ def analyze(args: argparse.Namespace) -> int:
     bif = analysis.bifurcation(net, index, start, stop, steps=args.steps, cycle_starts=4 if args.sweep_cycles else 0)
 
     table = analysis.lesions(config, net, args.trials, seed=args.seed, cuts=args.cuts) if args.lesions else None
+    seen = [view(config, net, args.seed, run.path.name) for view in views(task)]
     elapsed = time.perf_counter() - started
 
     stable = [e for e in found[0].equilibria if e.stable]
@@ -142,13 +143,20 @@ def analyze(args: argparse.Namespace) -> int:
         "lesions": table.to_dict() if table else None,
         "trial_basins": {"input": found[0].input.tolist(), "attractors": [e.outputs.tolist() for e in stable],
                          "every": basins[0], "basins": basins[1].tolist()},
+        **{v.key: v.doc for v in seen},
         "elapsed_s": elapsed,
     }
     text = json.dumps(doc, indent=1) + "\n"
     written = ["analysis.json"] if try_write(lambda: write_atomic(run.path / "analysis.json", text)) else []
     written += _figures(run, net, found, bif, table, outputs, neurons, name)
-    written += _basin_figure(run, config, trials, basins, found[0], bif, name)
-    print("\n".join(summary(found, bif, table, name, basins, output=output_neuron(config))))
+    written += _basin_figure(run, task, trials, basins, found[0], bif, name, output)
+    for v in seen:
+        for file, fig in v.figures.items():
+            if try_write(lambda: save_figure(fig, run.path / file)):
+                written.append(file)
+            plot.close(fig)
+    print("\n".join(summary(found, bif, table, name, basins, output=output)
+                    + [line for v in seen for line in v.lines]))
     wrote = ", ".join(str(run.path / w) for w in written) if written else "nothing"
     print(f"analysed in {elapsed:.1f} s; wrote {wrote}")
     return 0
@@ -177,9 +185,10 @@ def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifu
     return written
 
 
-def output_neuron(config: EvolutionConfig) -> int:
-    """The neuron whose firing rate is ``config``'s task's answer."""
-    return int(config.task_params.get("classifier", tasks.get(config.task).OUTPUT_NEURON))
+def output_neuron(config: EvolutionConfig, task: Task) -> int:
+    """The neuron whose firing rate is ``config``'s task's answer (``task``, as
+    :func:`dnnevo.analysis.analysed_task` reads it)."""
+    return int(config.task_params.get("classifier", task.OUTPUT_NEURON))
 
 
 BASIN_STATES = 1500
@@ -196,15 +205,15 @@ def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.n
     return every, analysis.settles_to(net, states[::every], stable, off.input)
 
 
-def _basin_figure(run: RunDir, config: EvolutionConfig, trials: list[tuple[np.ndarray, np.ndarray]],
-                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str) -> list[str]:
+def _basin_figure(run: RunDir, task: Task, trials: list[tuple[np.ndarray, np.ndarray]],
+                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str,
+                  neuron: int) -> list[str]:
     every, which = basins
     outputs = np.vstack([o for o, _ in trials])[::every]
     inputs = np.vstack([i for _, i in trials])[::every]
-    names = tasks.get(config.task).INPUT_NAMES
+    names = task.INPUT_NAMES
     starts = np.cumsum([0] + [len(o) for o, _ in trials])[1:-1] // every
     stable = [e for e in off.equilibria if e.stable]
-    neuron = output_neuron(config)
     labels = [f"{chr(65 + k)} (neuron {neuron} at {e.outputs[neuron]:.2f})" for k, e in enumerate(stable)]
     fig, ax = plot.subplots(figsize=(9.0, 3.6), layout="constrained")
     analysis.plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,

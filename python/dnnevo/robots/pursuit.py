@@ -37,6 +37,7 @@ episodes a network's rollout would meet.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 from os import PathLike
 from typing import Any, Literal
@@ -44,12 +45,18 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo import _core
+from dnnevo import _core, plot
+from dnnevo.analysis import events
 from dnnevo.closedloop.loop import Rollout
+from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
+from dnnevo.evaluation.stats import wilson
 from dnnevo.robots.world import D0, RobotWorld
+from dnnevo.tasks import user
+from dnnevo.tasks.protocol import Analysis, ViewResult
 
-__all__ = ["ARENA", "PURSUERS", "SECTORS", "TRANSFER", "Pursuit", "drive", "escape"]
+__all__ = ["APPEARS", "ARENA", "PURSUERS", "SECTORS", "TRANSFER", "Pursuit", "appears", "drive", "escape",
+           "pursuer_appears"]
 
 ARENA: dict[str, Any] = {
     "room": [8.0, 6.0],
@@ -228,3 +235,192 @@ def drive(policy: Policy, env: RobotWorld, *, episodes: int, max_steps: int, see
         if not active.any():
             break
     return Rollout(returns=returns[None, :], lengths=lengths[None, :])
+
+
+APPEARS: dict[str, float] = {"hidden_s": 3.0, "before_s": 2.0, "after_s": 5.0, "episodes": 100}
+"""The settings of :func:`pursuer_appears`: the pursuer sensor hidden for the first ``hidden_s``
+seconds of ``episodes`` fresh episodes, and windows from ``before_s`` before an appearance to
+``after_s`` after it."""
+
+
+def appears(sectors: npt.ArrayLike, *, quiet: int) -> list[int]:
+    """The steps at which a pursuer becomes visible to the pursuer sensor: ``sectors`` (T, Q)
+    are its inputs (0: no pursuer within its reach), and a pursuer appears at a step where some
+    sector reads one after none did for at least ``quiet`` steps (:func:`dnnevo.analysis.events.onsets`)."""
+    s = np.asarray(sectors, dtype=float)
+    return events.onsets((s > 0.0).any(axis=1), quiet=quiet)
+
+
+def _wrap(a: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    return np.asarray((a + np.pi) % (2.0 * np.pi) - np.pi)
+
+
+SERIES = {"away_speed": "velocity away from the pursuer (m/s)", "speed": "forward speed (m/s)",
+          "turn_away": "turning away from the pursuer's side (rad/s)",
+          "bearing_deg": "pursuer's bearing off the heading (deg)", "distance": "distance to the pursuer (m)"}
+"""The series :func:`pursuer_appears` follows through each window, as ``analysis.json`` names them."""
+
+
+def _event(e: user.Episode, at: int, before: int, after: int, settings: dict[str, Any],
+           left: int, right: int) -> dict[str, Any]:
+    """One appearance's window: the pursuer nearest at ``at`` followed from ``before`` steps
+    before to ``after`` after."""
+    pose, chasers = e.probes["pose"], e.probes["pursuers"]
+    k = int(np.argmin(np.hypot(*(chasers[at, :, :2] - pose[at, :2]).T)))
+    dx, dy = (chasers[:, k, :2] - pose[:, :2]).T
+    bearing = _wrap(np.arctan2(dy, dx) - pose[:, 2])
+    speed, base = settings["robot"]["max_speed"], settings["robot"]["wheel_base"]
+    wheels = speed * (2.0 * e.outputs[:, [left, right]] - 1.0)
+    forward, omega = wheels.mean(axis=1), (wheels[:, 1] - wheels[:, 0]) / base
+    series = {"away_speed": -forward * np.cos(bearing), "speed": forward,
+              "turn_away": -omega * np.sign(bearing), "bearing_deg": np.degrees(np.abs(bearing)),
+              "distance": np.hypot(dx, dy)}
+    out: dict[str, Any] = {name: events.aligned(v, at, before=before, after=after) for name, v in series.items()}
+    out["rates"] = events.aligned(e.outputs, at, before=before, after=after)
+    out["length"], out["at"] = len(e.outputs), at
+    return out
+
+
+def _rate(k: int, n: int) -> str:
+    if n == 0:
+        return "0/0"
+    lo, hi = wilson(k, n)
+    return f"{k}/{n} (95% {lo:.0%}-{hi:.0%})"
+
+
+def pursuer_appears(config: EvolutionConfig, net: _core.Network, seed: int, title: str) -> ViewResult:
+    """What the champion does when a pursuer appears: ``analysis.json``'s ``pursuer_appears``,
+    its summary lines and ``analysis-pursuer.png``.
+
+    The pursuer sensor reaches 6.5 m through walls, and the pursuers start at least 3 m away in
+    an 8 m x 6 m room: in the trained world a pursuer is in reach from the first step of almost
+    every episode, and is seldom lost again. So the view counts that on :data:`APPEARS`'s
+    ``episodes`` fresh episodes drawn from ``seed`` (the first of those ``dnnevo assess``
+    judges with it, ``purpose="evaluate"``, which no run draws from), and then makes the event
+    itself: the same episodes again with the pursuer sensor reading nothing for the first
+    ``hidden_s`` seconds, while the pursuers chase the robot. The step at which the sensor
+    reads a pursuer after ``before_s`` of nothing (:func:`appears`) is t = 0; the pursuer
+    nearest then is followed, and each :data:`SERIES` and every neuron's firing rate is drawn
+    as the mean over the appearances with ±1 standard deviation. Appearances in the unchanged
+    episodes, if there are at least 2, are drawn too."""
+    a = APPEARS
+    params = {k: v for k, v in config.task_params.items() if k not in ("episodes", "max_steps", "validation_episodes")}
+    loop_dt = float(Pursuit(**params).settings["dt"])
+    hidden, before, after = (round(a[k] / loop_dt) for k in ("hidden_s", "before_s", "after_s"))
+    episodes = int(a["episodes"])
+    left, right = 0, 1  # Pursuit's wheels (RobotWorld's defaults)
+    found: dict[str, Any] = {}
+
+    def probe(env: Any) -> dict[str, npt.ArrayLike]:
+        found.setdefault("settings", env.settings)
+        found.setdefault("sonars", len(env.settings["sonar"]["angles_deg"]))
+        return {"pose": env.fleet.poses, "pursuers": env.fleet.pursuers}
+
+    def hide(t: int, obs: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        if t >= hidden:
+            return obs
+        out = obs.copy()
+        out[:, found["sonars"]:] = 0.0
+        return out
+
+    natural = user.record(config, net, episodes, seed=seed, probe=probe)
+    m = found["sonars"]
+    at_start = sum(bool((e.inputs[0, m:] > 0).any()) for e in natural)
+    probed = user.record(config, net, episodes, seed=seed, probe=probe, shown=hide)
+    hidden_name = f"sensor hidden for the first {a['hidden_s']:g} s"
+    groups = {name: [_event(e, t, before, after, found["settings"], left, right)
+                     for e in recorded for t in appears(e.inputs[:, m:], quiet=before)]
+              for name, recorded in (("trained world", natural), (hidden_name, probed))}
+    t_axis = np.arange(-before, after + 1) * loop_dt
+    doc: dict[str, Any] = {**a, "seed": seed, "purpose": "evaluate", "visible_at_start": at_start,
+                           "t": t_axis.tolist(), "series": SERIES,
+                           "groups": {name: _group(evs, before) for name, evs in groups.items()}}
+    lines = [f"pursuer appears: in the trained world the pursuer sensor reads a pursuer from the first step in "
+             f"{at_start}/{episodes} fresh episodes (seed {seed}); one appears after {a['before_s']:g} s unseen "
+             f"{len(groups['trained world'])} times"]
+    for name, evs in groups.items():
+        g = doc["groups"][name]
+        if not evs or (name == "trained world" and len(evs) < 2):
+            continue
+        lines.append(f"    {name}: {len(evs)} appearances, the pursuer {g['distance_at_onset']:.2f} m away on "
+                     f"average; over the next {a['after_s']:g} s the robot's forward speed averages "
+                     f"{g['mean_speed']:+.2f} m/s and its velocity away from the pursuer {g['mean_away_speed']:+.2f} m/s")
+        lines.append(f"    moving away from it on average over those {a['after_s']:g} s in "
+                     f"{_rate(g['moves_away'], g['lasted'])}, farther from it at their end in "
+                     f"{_rate(g['farther'], g['lasted'])}; turns away from its side in the first second in "
+                     f"{_rate(g['turns_away_1s'], len(evs))}; caught within {a['after_s']:g} s in "
+                     f"{_rate(g['caught'], len(evs))}")
+    fig = _figure(groups, t_axis, title)
+    return ViewResult("pursuer_appears", doc, lines, {"analysis-pursuer.png": fig})
+
+
+def _group(evs: list[dict[str, Any]], zero: int) -> dict[str, Any]:
+    """One group's numbers: counts for the summary, and each series' mean and standard deviation
+    over the events at each step (None where no event has a value)."""
+    lasted = [e for e in evs if np.isfinite(e["distance"][-1])]
+    second = zero + 10
+    after = np.array([e["away_speed"][zero:] for e in evs]) if evs else np.zeros((0, 1))
+    with warnings.catch_warnings():  # a step that every appearance's episode has ended by is NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        out: dict[str, Any] = {
+            "events": len(evs), "lasted": len(lasted),
+            "distance_at_onset": float(np.mean([e["distance"][zero] for e in evs])) if evs else None,
+            "mean_speed": float(np.nanmean([e["speed"][zero:] for e in evs])) if evs else None,
+            "mean_away_speed": float(np.nanmean(after)) if evs else None,
+            "moves_away": sum(bool(np.mean(e["away_speed"][zero:]) > 0) for e in lasted),
+            "farther": sum(bool(e["distance"][-1] > e["distance"][zero]) for e in lasted),
+            "turns_away_1s": sum(bool(np.nanmean(e["turn_away"][zero:second + 1]) > 0) for e in evs),
+            "caught": sum(bool(np.isnan(e["distance"][-1])) for e in evs),
+        }
+        for name in (*SERIES, "rates"):
+            if evs:
+                w = np.array([e[name] for e in evs])
+                mean, sd = np.nanmean(w, axis=0), np.nanstd(w, axis=0)
+                out[name] = {"mean": np.where(np.isfinite(mean), mean, None).tolist(),
+                             "sd": np.where(np.isfinite(sd), sd, None).tolist()}
+    return out
+
+
+def _figure(groups: dict[str, list[dict[str, Any]]], t: npt.NDArray[np.float64], title: str) -> Any:
+    """One panel per series and one of the firing rates, over the time from the appearance."""
+    fig, axes = plot.subplots(5, 1, figsize=(7.0, 9.0), sharex=True, layout="constrained")
+    shown = {name: evs for name, evs in groups.items() if len(evs) >= 2}
+    for g, (name, evs) in enumerate(shown.items()):
+        color = "tab:gray" if name == "trained world" else "tab:blue"
+        label = f"{name} ({len(evs)} appearances)"
+        events.plot_aligned(t, [e["away_speed"] for e in evs], axes[0], label=f"away from it, {label}", color=color)
+        events.plot_aligned(t, [e["speed"] for e in evs], axes[0], label=f"forward, {label}",
+                            color="tab:orange" if color == "tab:blue" else "tab:brown")
+        events.plot_aligned(t, [e["turn_away"] for e in evs], axes[1], label=label, color=color)
+        events.plot_aligned(t, [e["bearing_deg"] for e in evs], axes[2], label=label, color=color)
+        events.plot_aligned(t, [e["distance"] for e in evs], axes[3], label=label, color=color)
+        if g == len(shown) - 1:
+            rates = np.array([e["rates"] for e in evs])
+            wheel = {0: " (left wheel)", 1: " (right wheel)"}
+            for i in range(rates.shape[2]):
+                events.plot_aligned(t, rates[:, :, i], axes[4], label=f"neuron {i}{wheel.get(i, '')}", color=f"C{i}")
+            axes[4].set_title(f"firing rates, {name}", fontsize=9)
+    for ax in axes[:2]:
+        ax.axhline(0.0, color="0.6", lw=0.8)
+    for ax, text in zip(axes, ("speed (m/s)", "turning away\n(rad/s)", "bearing off\nheading (deg)",
+                               "distance (m)", "firing rate")):
+        ax.set_ylabel(text)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, loc="best", ncol=3 if ax is axes[4] else 1)
+    axes[2].set_ylim(0, 180)
+    axes[4].set_ylim(0, 1)
+    axes[4].set_xlabel("time from the pursuer's appearance (s); mean ± 1 s.d. over appearances")
+    axes[0].set_title(f"{title}: when a pursuer appears")
+    return fig
+
+
+# Declared outside the class body so that the class's source, which a run folder's
+# fitness_sha256 records, stays that of the runs evolved before analyze knew this task.
+Pursuit.analysis = Analysis(  # type: ignore[attr-defined]
+    input_names=[f"sonar {a:g} deg" for a in (0, 45, 90, 135, 180, -135, -90, -45)]
+    + [f"pursuer {s}" for s in ("front", "left", "back", "right")],
+    conditions={"nothing sensed": [0.0] * 12,
+                **{f"pursuer {s} at 1.5 m": [0.0] * 8 + [1.0 - 1.5 / 6.5 if q == k else 0.0 for q in range(4)]
+                   for k, s in enumerate(("front", "left", "back", "right"))}},
+    main_input=8, output_neuron=0, episodes=4, views=[pursuer_appears],
+)

@@ -3,10 +3,16 @@ the layers above (``dnnevo assess``, ``plot``, ``sweep``, ``reproduce``) never b
 task's name. The built-in tasks' modules (:mod:`dnnevo.tasks.sequence`, :mod:`.nav1d`,
 :mod:`.landmark`) each implement it, and :mod:`dnnevo.tasks.registry` maps names to them, as
 ``crates/tasks`` does in Rust.
+
+A Python task (``"python:module.Class"``, :mod:`dnnevo.tasks.user`) is analysed by ``dnnevo
+analyze`` when its class declares what the analysis needs, an :class:`Analysis` as its
+``analysis`` attribute: the same names and trials the built-in tasks' modules define.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -18,7 +24,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.evaluation.assessment import Assessment
 from dnnevo.runs import RunDir
 
-__all__ = ["Task"]
+__all__ = ["Analysis", "Task", "View", "ViewResult", "views"]
 
 
 class Task(Protocol):
@@ -69,3 +75,49 @@ class Task(Protocol):
                         seed: int) -> list[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
         """Real trials drawn from ``seed`` as (firing rates (T, N), inputs (T, M)), for the
         dynamical analysis."""
+
+
+@dataclass(frozen=True)
+class ViewResult:
+    """What a task's own view of a champion (:attr:`Analysis.views`) found: its numbers for
+    ``analysis.json`` (under :attr:`key`), its summary lines, and its figures by file name
+    (``analyze`` writes them into the run folder, atomically, and closes them)."""
+
+    key: str
+    doc: dict[str, Any]
+    lines: list[str]
+    figures: dict[str, Any] = field(default_factory=dict)
+
+
+View = Callable[[EvolutionConfig, _core.Network, int, str], ViewResult]
+"""A task's own view of a champion: ``view(config, net, seed, title)`` (``title`` names the run
+in the figures) records what it needs on fresh episodes drawn from ``seed``."""
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """What ``dnnevo analyze`` needs of a Python task, which its class declares as
+    ``analysis = Analysis(...)``: the names the built-in tasks' modules define
+    (:attr:`Task.INPUT_NAMES`, :attr:`Task.ANALYSIS_CONDITIONS`, :attr:`Task.MAIN_INPUT`,
+    :attr:`Task.OUTPUT_NEURON`), how many fresh episodes to record for the phase and basins
+    figures and the lesions' clamps, and the task's own views. Lesioned networks are judged by
+    the class's own success rule, as ``dnnevo assess`` judges the champion."""
+
+    input_names: Sequence[str]
+    """The network's inputs, in order (one per sensor)."""
+    conditions: Mapping[str, Sequence[float]]
+    """The constant input vectors analysed by default, by name (the first one colours the
+    basins figure)."""
+    main_input: int
+    """The input a bifurcation sweep varies by default."""
+    output_neuron: int
+    """The neuron the basins figure draws and the summary quotes at each attractor."""
+    episodes: int = 4
+    """Fresh episodes recorded for the phase and basins figures and the clamps' mean rates."""
+    views: Sequence[View] = ()
+    """The task's own views of a champion, each run by ``analyze`` after the generic analysis."""
+
+
+def views(task: Any) -> Sequence[View]:
+    """The task's own views of a champion (:attr:`Analysis.views`); none for the built-in tasks."""
+    return tuple(getattr(task, "ANALYSIS_VIEWS", ()))

@@ -8,12 +8,21 @@ succeeded from their returns and lengths (one value per row of the last rollout:
 one network's episodes, when a champion is judged; every network's rows when a run validates
 its candidates). The
 fresh episodes are drawn with ``purpose="evaluate"``, which no run draws from.
+
+``dnnevo analyze`` analyses a Python task whose class declares what it needs, an
+:class:`~dnnevo.tasks.protocol.Analysis` as its ``analysis`` attribute (:func:`analysed`); its
+real trials are fresh episodes recorded step by step (:func:`record`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
+import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo.closedloop import named
@@ -22,8 +31,11 @@ from dnnevo.errors import ConfigError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, rate
 from dnnevo.runs import RunDir
 from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
+from dnnevo.tasks.protocol import Analysis, View
 
-__all__ = ["DEFAULT_TRIALS", "UserTask"]
+__all__ = ["DEFAULT_TRIALS", "Episode", "UserTask", "analysed", "record"]
+
+_Array = npt.NDArray[np.float64]
 
 #: ``dnnevo assess``'s default count of fresh episodes.
 DEFAULT_TRIALS = 200
@@ -40,6 +52,9 @@ class UserTask:
     ANALYSIS_CONDITIONS: dict[str, list[float]] = {}
     MAIN_INPUT = 0
     OUTPUT_NEURON = 0
+    ANALYSIS_VIEWS: Sequence[View] = ()
+    analysis: Analysis | None = None
+    """The class's analysis declaration, once :func:`analysed` has read it."""
 
     rate_column = staticmethod(rate_column)
     overall = staticmethod(overall)
@@ -74,6 +89,112 @@ class UserTask:
         return []
 
     def recorded_trials(self, config: EvolutionConfig, net: _core.Network, *,
-                        seed: int) -> list[Any]:
-        """No recorded trials for the dynamical analysis (yet)."""
-        raise ConfigError(f"dnnevo analyze does not know the inputs of {config.task} yet")
+                        seed: int) -> list[tuple[_Array, _Array]]:
+        """The first :attr:`Analysis.episodes` of the fresh episodes :meth:`judge` draws from
+        ``seed``, recorded (:func:`record`); a task read without :func:`analysed` has none."""
+        if self.analysis is None:
+            raise ConfigError(_refusal(config.task))
+        return [(e.outputs, e.inputs) for e in record(config, net, self.analysis.episodes, seed=seed)]
+
+
+def _refusal(task: str) -> str:
+    return (f"task {task!r} has no analysis defaults; its class must declare them as "
+            "analysis = dnnevo.tasks.protocol.Analysis(input_names=..., conditions=..., "
+            "main_input=..., output_neuron=...) (docs/analysis.md)")
+
+
+def analysed(config: EvolutionConfig) -> UserTask:
+    """The Python task of ``config`` with its class's :class:`~dnnevo.tasks.protocol.Analysis`
+    read into the names ``dnnevo analyze`` uses (:attr:`UserTask.INPUT_NAMES`, ...), checked
+    against the run's network; a class that declares none is a one-line
+    :class:`~dnnevo.ConfigError` that says what to declare. Imports the task's module."""
+    cls = named.environment_class(config.task)
+    a = getattr(cls, "analysis", None)
+    if not isinstance(a, Analysis):
+        raise ConfigError(_refusal(config.task))
+    m, where = config.n_inputs, f"{cls.__name__}.analysis"
+    if len(a.input_names) != m:
+        raise ConfigError(f"{where} names {len(a.input_names)} inputs; the run's network has {m}")
+    if not a.conditions:
+        raise ConfigError(f"{where} has no conditions; it needs at least one input vector")
+    for name, v in a.conditions.items():
+        if len(v) != m:
+            raise ConfigError(f"{where}: condition {name!r} has {len(v)} values; the network has {m} inputs")
+    if not 0 <= a.main_input < m:
+        raise ConfigError(f"{where}.main_input is {a.main_input}; the inputs are 0..{m - 1}")
+    if not 0 <= a.output_neuron < config.size:
+        raise ConfigError(f"{where}.output_neuron is {a.output_neuron}; the neurons are 0..{config.size - 1}")
+    if isinstance(a.episodes, bool) or not isinstance(a.episodes, int) or a.episodes < 1:
+        raise ConfigError(f"{where}.episodes is {a.episodes!r}; expected a whole number >= 1")
+    task = UserTask(config.task)
+    task.analysis = a
+    task.INPUT_NAMES = list(a.input_names)
+    task.ANALYSIS_CONDITIONS = {name: [float(x) for x in v] for name, v in a.conditions.items()}
+    task.MAIN_INPUT, task.OUTPUT_NEURON = a.main_input, a.output_neuron
+    task.ANALYSIS_VIEWS = tuple(a.views)
+    return task
+
+
+@dataclass(frozen=True)
+class Episode:
+    """One recorded episode, one row per time step ``t``: the inputs the network was given, the
+    firing rates it answered with, and what ``probe`` read of the environment when the inputs
+    were observed (before the step that the rates drive)."""
+
+    inputs: _Array
+    """(T, M)."""
+    outputs: _Array
+    """(T, N)."""
+    probes: dict[str, npt.NDArray[Any]]
+    """Each probed name's values, (T, ...)."""
+
+
+Probe = Callable[[Any], dict[str, npt.ArrayLike]]
+"""Reads the environment's state: each name's values, one row per episode (B, ...)."""
+
+Shown = Callable[[int, _Array], _Array]
+"""What the networks are shown at step ``t`` of the observations (B, M) the environment gave."""
+
+
+def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: int,
+           probe: Probe | None = None, shown: Shown | None = None) -> list[Episode]:
+    """``net`` on ``episodes`` fresh episodes of ``config``'s Python task, step by step: the same
+    episodes, with the same integration, that :meth:`UserTask.judge` (``dnnevo assess``) draws
+    from ``seed`` (``purpose="evaluate"``, which no run draws from), each to its end or to the
+    task's ``max_steps``. ``probe`` reads the environment at each step (:class:`Episode`);
+    ``shown``, when given, changes what the network is shown (a probe of its own: the
+    episodes then differ from the judged ones from the first changed step on)."""
+    loop = named.closed_loop(config)
+    env, s = loop.env, loop.settings
+    batch = _core.Batch([net], replicas=episodes, dt=s["dt"], substeps=s["substeps"], method=s["method"])
+    batch.reset()
+    rng = np.random.default_rng(_core.condition_seed(seed, 0, "evaluate"))
+    obs = np.asarray(env.reset(np.arange(episodes, dtype=np.int64), rng), dtype=float)
+    active = np.ones(episodes, dtype=bool)
+    lengths = np.full(episodes, s["max_steps"], dtype=np.int64)
+    if s["max_steps"] < 1:
+        raise ConfigError(f"task_params.max_steps is {s['max_steps']}: no step to record")
+    rates = np.empty((episodes, batch.size))
+    ins: list[_Array] = []
+    outs: list[_Array] = []
+    probed: list[dict[str, npt.NDArray[Any]]] = []
+    for t in range(s["max_steps"]):
+        if shown is not None:
+            obs = np.asarray(shown(t, obs), dtype=float)
+        batch.step(obs, active=active, out=rates)
+        ins.append(obs.copy())
+        outs.append(rates.copy())
+        if probe is not None:
+            probed.append({k: np.array(v) for k, v in probe(env).items()})
+        obs, _, done = env.step(rates, active)
+        obs = np.asarray(obs, dtype=float)
+        ended = active & np.asarray(done, dtype=bool)
+        lengths[ended] = t + 1
+        active &= ~ended
+        if not active.any():
+            break
+    stacked_in, stacked_out = np.stack(ins, axis=1), np.stack(outs, axis=1)
+    names = probed[0].keys() if probed else ()
+    stacked = {k: np.stack([p[k] for p in probed], axis=1) for k in names}
+    return [Episode(stacked_in[e, :n], stacked_out[e, :n], {k: v[e, :n] for k, v in stacked.items()})
+            for e, n in enumerate(lengths.tolist())]

@@ -17,6 +17,7 @@ from cli_helpers import run_cli
 from dnnevo.cli.command import main
 from dnnevo.errors import WriteError
 from dnnevo.runs import files as files_module
+from dnnevo.runs import rundir as rundir_module
 from dnnevo.runs.files import write_atomic, write_error
 
 QUICK = ("sequence-1bit", "--quick", "--seed", "2")
@@ -88,6 +89,21 @@ def read_only(monkeypatch: pytest.MonkeyPatch) -> None:
         raise OSError(errno.EROFS, os.strerror(errno.EROFS))
 
     monkeypatch.setattr(files_module.tempfile, "mkstemp", refuse)
+    monkeypatch.setattr(rundir_module, "os", _ReadOnlyOs())
+
+
+class _ReadOnlyOs:
+    """The os module as a read-only file system shows it to the writer's lock: opening a file
+    to write fails with EROFS."""
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(os, name)
+
+    @staticmethod
+    def open(path: object, flags: int, *args: object, **kwargs: object) -> int:
+        if flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT):
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+        return os.open(path, flags, *args, **kwargs)  # type: ignore[arg-type]
 
 
 @pytest.fixture(scope="module")
@@ -123,3 +139,21 @@ def test_plot_on_a_read_only_folder_is_one_line(finished_run: Path, read_only: N
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].endswith("could not be written: the file system is read-only; "
                                              "what it held before is kept")
+
+
+
+def test_assess_answers_on_a_read_only_folder(finished_run: Path, read_only: None,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    before = snapshot(finished_run)
+    assert main(["assess", str(finished_run), "--trials", "5"]) in (0, 1)  # pass or fail
+    assert "overall:" in capsys.readouterr().out
+    assert snapshot(finished_run) == before
+
+
+def test_resume_on_a_read_only_folder_is_one_line(finished_run: Path, read_only: None,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    before = snapshot(finished_run)
+    assert main(["resume", str(finished_run), "--generations", "5"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"dnnevo: error: {finished_run} cannot be written: the file system is read-only"]
+    assert snapshot(finished_run) == before

@@ -53,10 +53,14 @@ _WRITE_FAILURES = {
 }
 
 
+def write_failure(error: OSError) -> str:
+    """Why a write failed, in words: "the file system is read-only", "the disk is full", ..."""
+    return _WRITE_FAILURES.get(error.errno or 0, error.strerror or str(error))
+
+
 def write_error(path: Path, error: OSError) -> WriteError:
     """One line naming the file that could not be written, and why."""
-    why = _WRITE_FAILURES.get(error.errno or 0, error.strerror or str(error))
-    return WriteError(f"{path} could not be written: {why}; what it held before is kept")
+    return WriteError(f"{path} could not be written: {write_failure(error)}; what it held before is kept")
 
 
 def write_atomic_with(path: Path, write: Callable[[str], None], *, suffix: str = "") -> None:

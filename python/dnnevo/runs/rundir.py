@@ -40,9 +40,10 @@ from typing import Any
 
 from dnnevo._core import Network
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import ConfigError, DnnevoError, FormatError
+from dnnevo.errors import ConfigError, DnnevoError, FormatError, WriteError
 from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
-from dnnevo.runs.files import FILE_MODE, RunFileError, checked, fail, read_json, read_text, short, write_atomic
+from dnnevo.runs.files import (FILE_MODE, RunFileError, checked, fail, read_json, read_text, short, write_atomic,
+                               write_failure)
 from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, history_rows, log_cell, read_cell
 from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth, first_difference
 
@@ -95,14 +96,18 @@ class RunDir:
         if self.path.exists() and not self.path.is_dir():
             raise DnnevoError(f"{self.path} exists and is not a folder")
         if create:
-            self.path.mkdir(parents=True, exist_ok=True)
+            try:
+                self.path.mkdir(parents=True, exist_ok=True)
+            except OSError as e:
+                raise WriteError(f"{self.path} cannot be made: {write_failure(e)}") from None
         elif not self.path.exists():
             raise RunFileError(f"{self.path} does not exist")
         flags = os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC
         try:
             fd = os.open(self.lock_file, flags, FILE_MODE)
         except OSError as e:
-            raise DnnevoError(f"cannot open the lock file {self.lock_file}: {e.strerror}") from None
+            # The folder itself is what cannot be written (read-only, no permission, full).
+            raise WriteError(f"{self.path} cannot be written: {write_failure(e)}") from None
         try:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)

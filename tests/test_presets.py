@@ -26,6 +26,52 @@ def test_every_preset_runs(name: str, tmp_path: Path) -> None:
     assert dnnevo.Network.load(tmp_path / "best.json") == result.best
 
 
+
+# The paper's own settings, each with the sentence it comes from (Yamauchi & Beer 1994); the
+# readings of its gaps are docs/paper.md's. The paper's GA (§2.2): "Individuals were selected for
+# reproduction with a probability proportional to their fitness", and no elitism. A preset of the
+# paper's experiment must keep them.
+PAPER_GA = {"selection": "proportional", "elitism": 0}
+PAPER = {
+    # §3.2: "A population of 100 networks ... a crossover rate of 0.5 and a mutation rate of 0.025.
+    # Six test trials ... three trials on landmark 1 and three trials on landmark 2."
+    "landmark": {"size": 8, "population": 100, "crossover_rate": 0.5, "mutation_rate": 0.025,
+                 "task_params": {"trials_per_landmark": 3}},
+    # §4.2: "A population of 1000 networks was evolved with a crossover rate of 0.5 and a mutation
+    # rate of 0.025." (five-neuron subnetworks, §4.2)
+    "nav1d-far": {"size": 5, "population": 1000, "crossover_rate": 0.5, "mutation_rate": 0.025,
+                  "task_params": {"environments": ["far"]}},
+    "nav1d-near": {"size": 5, "population": 1000, "crossover_rate": 0.5, "mutation_rate": 0.025,
+                   "task_params": {"environments": ["near"]}},
+    "nav1d-classifier": {"size": 5, "population": 1000, "crossover_rate": 0.5, "mutation_rate": 0.025,
+                         "task_params": {"environments": ["far", "near"]}},
+    # §5.2: "five-neuron networks ... a population of 1000 networks for 500 generations, with a
+    # crossover rate of 0.3, a mutation rate of 0.01, and perf_base set to 0.5 ... four trials."
+    "sequence-1bit": {"size": 5, "population": 1000, "generations": 500, "crossover_rate": 0.3,
+                      "mutation_rate": 0.01,
+                      "task_params": {"targets": ["0", "1"], "trials_per_target": 2, "perf_base": 0.5}},
+    # §5.3: "ten-neuron networks ... a population of 1000 networks for 500 generations, with a
+    # crossover rate of 0.3, a mutation rate of 0.002 and perf_base set to the average performance
+    # of each generation."
+    "sequence-2bit-paper": {"size": 10, "population": 1000, "generations": 500, "crossover_rate": 0.3,
+                            "mutation_rate": 0.002,
+                            "task_params": {"targets": ["0", "1", "01", "10"], "perf_base": "generation-mean"}},
+    # §5.4: "A population of 1000 ten-neuron networks ... 700 generations, with a crossover rate of
+    # 0.3, a mutation rate of 0.002, and perf_base set to 0.666" (read as 2/3, docs/paper.md).
+    "sequence-3bit": {"size": 10, "population": 1000, "generations": 700, "crossover_rate": 0.3,
+                      "mutation_rate": 0.002,
+                      "task_params": {"targets": ["011", "101", "110"], "perf_base": 2 / 3}},
+}
+
+
+@pytest.mark.parametrize("name", sorted(PAPER))
+def test_the_paper_s_presets_keep_the_paper_s_settings(name: str) -> None:
+    preset = presets.get(name)
+    want = {**PAPER_GA, **PAPER[name]}
+    task_params = want.pop("task_params")
+    assert {key: getattr(preset, key) for key in want} == want
+    assert {key: preset.task_params.get(key) for key in task_params} == task_params
+
 @pytest.mark.parametrize(("preset", "made_as"), [
     # The README's results of these presets were made with these commands, before the presets.
     ("sequence-2bit-direct16-clamp-eval", ("sequence-2bit-direct16", ["task_params.clamp=evaluation"])),

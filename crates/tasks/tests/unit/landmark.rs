@@ -92,6 +92,20 @@ fn batched_outputs_equal_the_record_and_ignore_threads() {
         }
     }
     let fitness = t.evaluate(&nets, 1, 9, None).unwrap();
+    // Networks that listen to the sonar: the fitness is the mean score of their own trials'
+    // answers, landmark by landmark, and not the constant classifier's one half.
+    for (p, f) in fitness.iter().enumerate() {
+        let scores: Vec<f64> = trials
+            .iter()
+            .zip(&out[p])
+            .map(|(s, &o)| score(s.landmark, o))
+            .collect();
+        assert_eq!(f.to_bits(), (scores.iter().sum::<f64>() / 4.0).to_bits());
+    }
+    assert!(
+        fitness.iter().any(|&f| (f - 0.5).abs() > 1e-3),
+        "{fitness:?}"
+    );
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()

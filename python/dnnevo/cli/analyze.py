@@ -24,9 +24,17 @@ EXAMPLE = """examples:
   dnnevo run sequence-1bit --quick --out runs/demo && dnnevo analyze runs/demo
   dnnevo analyze runs/demo --input 0,0 --input 0,1 --neurons 0,2
   dnnevo analyze runs/demo --sweep 0:1 --sweep-input 1 --sweep-cycles --no-lesions
+  dnnevo run predator-avoidance --quick --out runs/pa && dnnevo analyze runs/pa
 
-With the sensors held at each --input vector (default: all off, then each of the task's inputs
-on alone), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
+A Python task ("python:module.Class") is analysed when its class declares an
+analysis = dnnevo.tasks.protocol.Analysis(...): its input names, default --input vectors, main
+input, output neuron, how many fresh episodes to record, and views of its own (predator
+avoidance: what the champion does when a pursuer appears, analysis-pursuer.png); its recorded
+trials are fresh episodes of those 'dnnevo assess' judges with --seed, and its lesions are
+judged by the class's success rule.
+
+With the sensors held at each --input vector (default: the task's own conditions; for the
+built-in tasks all off, then each input on alone), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
 saddle, unstable) and attracting limit cycles are found and printed. --sweep varies one input
 (default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
 points (H: a cycle is born); --sweep-cycles also follows the attracting cycles along it,

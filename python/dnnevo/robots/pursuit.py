@@ -256,8 +256,9 @@ def _wrap(a: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
 
 
 SERIES = {"away_speed": "velocity away from the pursuer (m/s)", "speed": "forward speed (m/s)",
-          "turn_away": "turning away from the pursuer's side (rad/s)",
-          "bearing_deg": "pursuer's bearing off the heading (deg)", "distance": "distance to the pursuer (m)"}
+          "turn_away": "turning of the direction of travel away from the pursuer (rad/s)",
+          "bearing_deg": "pursuer's bearing off the direction of travel (deg)",
+          "distance": "distance to the pursuer (m)"}
 """The series :func:`pursuer_appears` follows through each window, as ``analysis.json`` names them."""
 
 
@@ -268,11 +269,14 @@ def _event(e: user.Episode, at: int, before: int, after: int, settings: dict[str
     pose, chasers = e.probes["pose"], e.probes["pursuers"]
     k = int(np.argmin(np.hypot(*(chasers[at, :, :2] - pose[at, :2]).T)))
     dx, dy = (chasers[:, k, :2] - pose[:, :2]).T
-    bearing = _wrap(np.arctan2(dy, dx) - pose[:, 2])
     speed, base = settings["robot"]["max_speed"], settings["robot"]["wheel_base"]
     wheels = speed * (2.0 * e.outputs[:, [left, right]] - 1.0)
     forward, omega = wheels.mean(axis=1), (wheels[:, 1] - wheels[:, 0]) / base
-    series = {"away_speed": -forward * np.cos(bearing), "speed": forward,
+    # The direction of travel is the heading, or its opposite while the robot backs; it turns
+    # with the heading, so turning it away from the pursuer is -omega * sign(its bearing).
+    travel = pose[:, 2] + np.where(forward < 0.0, np.pi, 0.0)
+    bearing = _wrap(np.arctan2(dy, dx) - travel)
+    series = {"away_speed": -np.abs(forward) * np.cos(bearing), "speed": forward,
               "turn_away": -omega * np.sign(bearing), "bearing_deg": np.degrees(np.abs(bearing)),
               "distance": np.hypot(dx, dy)}
     out: dict[str, Any] = {name: events.aligned(v, at, before=before, after=after) for name, v in series.items()}
@@ -344,10 +348,13 @@ def pursuer_appears(config: EvolutionConfig, net: _core.Network, seed: int, titl
             continue
         lines.append(f"    {name}: {len(evs)} appearances, the pursuer {g['distance_at_onset']:.2f} m away on "
                      f"average; over the next {a['after_s']:g} s the robot's forward speed averages "
-                     f"{g['mean_speed']:+.2f} m/s and its velocity away from the pursuer {g['mean_away_speed']:+.2f} m/s")
+                     f"{g['mean_speed']:+.2f} m/s ({g['mean_speed_before']:+.2f} in the {a['before_s']:g} s before) "
+                     f"and its velocity away from the pursuer {g['mean_away_speed']:+.2f} m/s "
+                     f"({g['mean_away_speed_before']:+.2f} before)")
         lines.append(f"    moving away from it on average over those {a['after_s']:g} s in "
                      f"{_rate(g['moves_away'], g['lasted'])}, farther from it at their end in "
-                     f"{_rate(g['farther'], g['lasted'])}; turns away from its side in the first second in "
+                     f"{_rate(g['farther'], g['lasted'])}; turns its direction of travel away from it over the "
+                     f"first second in "
                      f"{_rate(g['turns_away_1s'], len(evs))}; caught within {a['after_s']:g} s in "
                      f"{_rate(g['caught'], len(evs))}")
     fig = _figure(groups, t_axis, title)
@@ -367,6 +374,8 @@ def _group(evs: list[dict[str, Any]], zero: int) -> dict[str, Any]:
             "distance_at_onset": float(np.mean([e["distance"][zero] for e in evs])) if evs else None,
             "mean_speed": float(np.nanmean([e["speed"][zero:] for e in evs])) if evs else None,
             "mean_away_speed": float(np.nanmean(after)) if evs else None,
+            "mean_away_speed_before": float(np.nanmean([e["away_speed"][:zero] for e in evs])) if evs else None,
+            "mean_speed_before": float(np.nanmean([e["speed"][:zero] for e in evs])) if evs else None,
             "moves_away": sum(bool(np.mean(e["away_speed"][zero:]) > 0) for e in lasted),
             "farther": sum(bool(e["distance"][-1] > e["distance"][zero]) for e in lasted),
             "turns_away_1s": sum(bool(np.nanmean(e["turn_away"][zero:second + 1]) > 0) for e in evs),
@@ -402,7 +411,7 @@ def _figure(groups: dict[str, list[dict[str, Any]]], t: npt.NDArray[np.float64],
             axes[4].set_title(f"firing rates, {name}", fontsize=9)
     for ax in axes[:2]:
         ax.axhline(0.0, color="0.6", lw=0.8)
-    for ax, text in zip(axes, ("speed (m/s)", "turning away\n(rad/s)", "bearing off\nheading (deg)",
+    for ax, text in zip(axes, ("speed (m/s)", "turning away\n(rad/s)", "bearing off\ntravel (deg)",
                                "distance (m)", "firing rate")):
         ax.set_ylabel(text)
         if ax.get_legend_handles_labels()[0]:

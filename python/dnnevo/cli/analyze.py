@@ -158,8 +158,8 @@ def analyze(args: argparse.Namespace) -> int:
     written = ["analysis.json"] if try_write(lambda: write_atomic(run.path / "analysis.json", text)) else []
     written += _figures(run, net, found, bif, table, outputs, neurons, name)
     written += _basin_figure(run, task, trials, basins, found[0], bif, name, output)
-    for v in seen:
-        for file, fig in v.figures.items():
+    for view_result in seen:
+        for file, fig in view_result.figures.items():
             if try_write(lambda: save_figure(fig, run.path / file)):
                 written.append(file)
             plot.close(fig)

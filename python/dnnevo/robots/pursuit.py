@@ -335,7 +335,7 @@ def pursuer_appears(config: EvolutionConfig, net: _core.Network, seed: int, titl
     groups = {name: [_event(e, t, before, after, found["settings"], left, right)
                      for e in recorded for t in appears(e.inputs[:, m:], quiet=before)]
               for name, recorded in (("trained world", natural), (hidden_name, probed))}
-    t_axis = np.arange(-before, after + 1) * loop_dt
+    t_axis = np.asarray(np.arange(-before, after + 1) * loop_dt, dtype=np.float64)
     doc: dict[str, Any] = {**a, "seed": seed, "purpose": "evaluate", "visible_at_start": at_start,
                            "t": t_axis.tolist(), "series": SERIES,
                            "groups": {name: _group(evs, before) for name, evs in groups.items()}}
@@ -385,9 +385,15 @@ def _group(evs: list[dict[str, Any]], zero: int) -> dict[str, Any]:
             if evs:
                 w = np.array([e[name] for e in evs])
                 mean, sd = np.nanmean(w, axis=0), np.nanstd(w, axis=0)
-                out[name] = {"mean": np.where(np.isfinite(mean), mean, None).tolist(),
-                             "sd": np.where(np.isfinite(sd), sd, None).tolist()}
+                out[name] = {"mean": _json(mean), "sd": _json(sd)}
     return out
+
+
+def _json(a: npt.NDArray[np.float64]) -> Any:
+    """``a`` as nested lists, None where it is not finite (a step every event had ended by)."""
+    out = a.astype(object)
+    out[~np.isfinite(a)] = None
+    return out.tolist()
 
 
 def _figure(groups: dict[str, list[dict[str, Any]]], t: npt.NDArray[np.float64], title: str) -> Any:

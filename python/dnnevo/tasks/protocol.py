@@ -111,7 +111,9 @@ class Analysis:
     main_input: int
     """The input a bifurcation sweep varies by default."""
     output_neuron: int
-    """The neuron the basins figure draws and the summary quotes at each attractor."""
+    """The neuron whose firing rate is the task's answer (:attr:`Task.OUTPUT_NEURON`), which the
+    basins figure draws and the summary quotes at each attractor; for a robot, one of its
+    wheels."""
     episodes: int = 4
     """Fresh episodes recorded for the phase and basins figures and the clamps' mean rates."""
     views: Sequence[View] = ()

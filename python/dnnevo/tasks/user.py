@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -165,20 +165,22 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
     ``shown``, when given, changes what the network is shown (a probe of its own: the
     episodes then differ from the judged ones from the first changed step on)."""
     loop = named.closed_loop(config)
-    env, s = loop.env, loop.settings
-    batch = _core.Batch([net], replicas=episodes, dt=s["dt"], substeps=s["substeps"], method=s["method"])
+    env, s = loop.env, config.integrator
+    max_steps = int(loop.settings["max_steps"])  # type: ignore[call-overload]
+    method = cast(Literal["euler", "rk4"], s.method)
+    batch = _core.Batch([net], replicas=episodes, dt=s.dt, substeps=s.substeps, method=method)
     batch.reset()
     rng = np.random.default_rng(_core.condition_seed(seed, 0, "evaluate"))
     obs = np.asarray(env.reset(np.arange(episodes, dtype=np.int64), rng), dtype=float)
     active = np.ones(episodes, dtype=bool)
-    lengths = np.full(episodes, s["max_steps"], dtype=np.int64)
-    if s["max_steps"] < 1:
-        raise ConfigError(f"task_params.max_steps is {s['max_steps']}: no step to record")
+    lengths = np.full(episodes, max_steps, dtype=np.int64)
+    if max_steps < 1:
+        raise ConfigError(f"task_params.max_steps is {max_steps}: no step to record")
     rates = np.empty((episodes, batch.size))
     ins: list[_Array] = []
     outs: list[_Array] = []
     probed: list[dict[str, npt.NDArray[Any]]] = []
-    for t in range(s["max_steps"]):
+    for t in range(max_steps):
         if shown is not None:
             obs = np.asarray(shown(t, obs), dtype=float)
         batch.step(obs, active=active, out=rates)
@@ -186,8 +188,8 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
         outs.append(rates.copy())
         if probe is not None:
             probed.append({k: np.array(v) for k, v in probe(env).items()})
-        obs, _, done = env.step(rates, active)
-        obs = np.asarray(obs, dtype=float)
+        seen, _, done = env.step(rates, active)
+        obs = np.asarray(seen, dtype=float)
         ended = active & np.asarray(done, dtype=bool)
         lengths[ended] = t + 1
         active &= ~ended

@@ -107,3 +107,15 @@ def test_a_python_task_without_analysis_defaults_is_refused(tmp_path: Path) -> N
     assert r.returncode == 0, r.stderr
     assert_one_line_error(run_cli("analyze", out, "--no-lesions"), "has no analysis defaults",
                           "analysis = dnnevo.tasks.protocol.Analysis(")
+
+
+def test_the_analysis_declaration_leaves_the_runs_digest_alone() -> None:
+    """Pursuit's Analysis is declared outside its class body, since a run folder records a digest
+    of the class's source (fitness_sha256) and resume and assess refuse a class that changed:
+    this is the digest of the reference reproduction's predator-avoidance runs (at 43deba7)."""
+    from dnnevo import presets
+    from dnnevo.closedloop import named
+
+    config = presets.get("predator-avoidance")
+    digest = named.closed_loop(config).digest()
+    assert digest == "9cd751a8cf583ae73f4345f0bbc6415a4e8386ae9044bfb5529ef83ddd52f7f4"

@@ -255,11 +255,13 @@ def _wrap(a: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     return np.asarray((a + np.pi) % (2.0 * np.pi) - np.pi)
 
 
-SERIES = {"away_speed": "velocity away from the pursuer (m/s)", "speed": "forward speed (m/s)",
-          "turn_away": "turning of the direction of travel away from the pursuer (rad/s)",
+SERIES = {"away_speed": "velocity away from the pursuer the wheels command (m/s)",
+          "speed": "forward speed the wheels command (m/s)",
+          "turn_away": "turning of the direction of travel away from the pursuer the wheels command (rad/s)",
           "bearing_deg": "pursuer's bearing off the direction of travel (deg)",
           "distance": "distance to the pursuer (m)"}
-"""The series :func:`pursuer_appears` follows through each window, as ``analysis.json`` names them."""
+"""The series :func:`pursuer_appears` follows through each window, as ``analysis.json`` names them.
+The first three are the wheel commands of the step (a robot pressed against a wall moves less)."""
 
 
 def _event(e: user.Episode, at: int, before: int, after: int, settings: dict[str, Any],

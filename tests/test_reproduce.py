@@ -372,3 +372,50 @@ def _at_generation(checkpoint: Path, generation: int) -> bool:
         return len(json.loads(checkpoint.read_text())["history"]) >= generation
     except (OSError, ValueError, KeyError):
         return False
+
+
+# A reproduction that kills itself (SIGKILL) while it writes NAME's temporary file, half of it
+# written: what a kill at the worst moment of the report's write leaves behind.
+KILLED_IN_WRITE = """
+import os, signal, sys
+from dnnevo.cli.command import main
+from dnnevo.runs import files
+real = files.write_atomic_with
+def write_atomic_with(path, write, **kwargs):
+    def half_then_die(tmp):
+        with open(tmp, "w") as f:
+            f.write("# half a rep")
+        os.kill(os.getpid(), signal.SIGKILL)
+    return real(path, half_then_die if path.name == sys.argv[1] else write, **kwargs)
+files.write_atomic_with = write_atomic_with
+main(sys.argv[2:])
+"""
+
+
+def _whole_report(name: str, text: bytes) -> bool:
+    """A report file written to its end (its wall times change from run to run)."""
+    return text.startswith(b"# dnnevo") and b"| experiment |" in text if name.endswith(".md") else \
+        text.startswith(b"<!DOCTYPE html>") and text.endswith(b"</html>\n")
+
+
+@pytest.mark.parametrize("name", report.REPORT_FILES)
+def test_a_kill_inside_the_report_s_write_leaves_the_old_report_and_the_next_run_tidies(
+        tmp_path: Path, name: str) -> None:
+    args = ["reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
+            "--no-dt-check", "--in-process", "--out", str(tmp_path)]
+    assert run_cli(*args).returncode == 0
+    old = {n: f"an older {n}\n".encode() for n in report.REPORT_FILES}
+    for n, text in old.items():
+        (tmp_path / n).write_bytes(text)
+    killed = subprocess.run([sys.executable, "-c", KILLED_IN_WRITE, name, *args], capture_output=True)
+    assert killed.returncode == -signal.SIGKILL
+    # The file being written is still the old one, whole; a file written before it is new, whole.
+    written_before = report.REPORT_FILES[:report.REPORT_FILES.index(name)]
+    for n in report.REPORT_FILES:
+        text = (tmp_path / n).read_bytes()
+        assert _whole_report(n, text) if n in written_before else text == old[n], n
+    assert [p.name for p in tmp_path.glob(f".{name}.*")] != []  # the half-written temporary file
+    # The same command finishes the report, and leaves no temporary file behind.
+    assert run_cli(*args).returncode == 0
+    assert all(_whole_report(n, (tmp_path / n).read_bytes()) for n in report.REPORT_FILES)
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == [".dnnevo.lock"]

@@ -19,7 +19,7 @@ from dnnevo.experiments import report
 from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.runs import LOCK_NAME, RunDir, RunFileError, check_settings, write_atomic
-from dnnevo.runs.files import read_json
+from dnnevo.runs.files import read_json, remove_temporaries
 from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "reproduce.json"
@@ -103,6 +103,7 @@ def reproduce(args: argparse.Namespace) -> int:
     root = args.out.resolve()
     t0 = time.perf_counter()
     with RunDir(root).writing(create=True):
+        _tidy(root, order)
         _begin(root, settings)
         # Finished runs are not run again; the others need only the unfinished among their needs.
         stored = {j.id: jobs.read_result(root, j, settings) for j in order}
@@ -160,6 +161,16 @@ def _command(args: argparse.Namespace) -> str:
     words += [] if args.dt_check else ["--no-dt-check"]
     words += [w for kv in args.set for w in ("--set", kv)]
     return " ".join(shlex.quote(w) for w in words)
+
+
+def _tidy(root: Path, order: list[plan.Job]) -> None:
+    """Removes the temporary files that a reproduction killed inside a write left behind (of the
+    report, its figures, the settings and the runs' results). The lock's holder alone writes
+    them; each run folder's own are its run's to remove."""
+    remove_temporaries(root, (*report.REPORT_FILES, SETTINGS_FILE))
+    remove_temporaries(root / report.FIGURES)
+    for experiment in sorted({j.experiment for j in order}):
+        remove_temporaries(root / experiment, {jobs.result_path(root, j).name for j in order})
 
 
 def _begin(root: Path, settings: jobs.Settings) -> None:

@@ -23,7 +23,7 @@ from dnnevo.tasks import DEFAULT_TRIALS, registry
 from dnnevo.config import EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError, DnnevoError
 from dnnevo.runs import LOCK_NAME, RunDir, RunFileError, check_settings, first_difference, write_atomic
-from dnnevo.runs.files import checked, read_json
+from dnnevo.runs.files import checked, read_json, remove_temporaries
 from dnnevo.experiments.runsview import RunsView
 
 SETTINGS_FILE = "sweep.json"
@@ -83,6 +83,8 @@ def sweep_command(args: argparse.Namespace) -> int:
     with RunDir(args.out).writing(create=True) as folder:
         resuming = not args.force and (manifest.exists() or manifest.is_symlink())
         if resuming:
+            # A sweep killed inside a write of its own files left their temporary files.
+            remove_temporaries(args.out, (*sweep.SUMMARY_FILES, SETTINGS_FILE))
             _extend(manifest, settings)
             check_settings(manifest, settings, what="sweep")
         else:

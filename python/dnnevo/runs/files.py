@@ -15,13 +15,13 @@ import json
 import re
 import os
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Container, Iterator
 from pathlib import Path
 from typing import Any
 
 from dnnevo.errors import DnnevoError, WriteError
 
-__all__ = ['FILE_MODE', 'RunFileError', 'checked', 'fail', 'load_json', 'number', 'read_json', 'read_text', 'save_figure', 'short', 'write_atomic', 'write_atomic_with', 'write_error']
+__all__ = ['FILE_MODE', 'RunFileError', 'checked', 'fail', 'load_json', 'number', 'read_json', 'read_text', 'remove_temporaries', 'save_figure', 'short', 'temporary_of', 'write_atomic', 'write_atomic_with', 'write_error']
 
 def _umask() -> int:
     mask = os.umask(0o022)
@@ -61,6 +61,29 @@ def write_failure(error: OSError) -> str:
 def write_error(path: Path, error: OSError) -> WriteError:
     """One line naming the file that could not be written, and why."""
     return WriteError(f"{path} could not be written: {write_failure(error)}; what it held before is kept")
+
+
+#: Temporary files of atomic writes: ``.NAME.RANDOM.tmp`` (Python, Rust), optionally with the
+#: final name's extension after it, and ``.NAME.tmpPID`` (Rust before version 0.1.1).
+_TEMPORARY = re.compile(r"^\.(?P<name>.+)\.(?:[A-Za-z0-9_]{8,16}\.tmp(?:\.[a-z]+)?|tmp\d+)$")
+
+
+def temporary_of(path: Path) -> str | None:
+    """The name of the file that ``path`` is the temporary file of (an atomic write killed
+    before its rename leaves one behind), or None when ``path`` is no such file."""
+    m = _TEMPORARY.match(path.name)
+    return m["name"] if m and path.is_file() else None
+
+
+def remove_temporaries(folder: Path, names: Container[str] | None = None) -> None:
+    """Removes the temporary files that killed atomic writes left in ``folder``: those of the
+    files ``names``, or every one when None. Only the holder of the folder's lock may call it,
+    since it alone writes there."""
+    if folder.is_dir():
+        for p in folder.iterdir():
+            name = temporary_of(p)
+            if name is not None and (names is None or name in names):
+                p.unlink(missing_ok=True)
 
 
 def write_atomic_with(path: Path, write: Callable[[str], None], *, suffix: str = "") -> None:

@@ -32,7 +32,6 @@ import io
 import json
 import math
 import os
-import re
 import tomllib
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -42,8 +41,8 @@ from dnnevo._core import Network
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FormatError, WriteError
 from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
-from dnnevo.runs.files import (FILE_MODE, RunFileError, checked, fail, read_json, read_text, short, write_atomic,
-                               write_failure)
+from dnnevo.runs.files import (FILE_MODE, RunFileError, checked, fail, read_json, read_text,
+                               remove_temporaries, short, temporary_of, write_atomic, write_failure)
 from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, history_rows, log_cell, read_cell
 from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth, first_difference
 
@@ -68,9 +67,6 @@ FIGURES = (
     "analysis-lesions.png",
     "analysis.json",
 )
-#: Temporary files of atomic writes: ``.NAME.RANDOM.tmp`` (Python, Rust), optionally with the
-#: final name's extension after it, and ``.NAME.tmpPID`` (Rust before version 0.1.1).
-_TEMP = re.compile(r"^\.(?P<name>.+)\.(?:[A-Za-z0-9_]{8,16}\.tmp(?:\.[a-z]+)?|tmp\d+)$")
 
 
 class RunDir:
@@ -127,21 +123,15 @@ class RunDir:
     def stale_files(self) -> list[Path]:
         """Temporary files of this folder's own atomic writes (the run's four files); stale when
         the lock is held, as only the lock's holder writes them."""
-        out = []
-        for p in self.path.iterdir():
-            m = _TEMP.match(p.name)
-            if m and m["name"] in RUN_FILES:
-                out.append(p)
-        return out
+        return [p for p in self.path.iterdir() if temporary_of(p) in RUN_FILES]
 
     def remove_stale(self) -> None:
         """Removes temporary files left by a writer that was killed inside a write."""
-        for p in self.stale_files():
-            p.unlink(missing_ok=True)
+        remove_temporaries(self.path, RUN_FILES)
 
     def _leftover(self, p: Path) -> bool:
         """A file that holds no run: the lock file, or a temporary file of a killed write."""
-        return p.name == LOCK_NAME or (_TEMP.match(p.name) is not None and p.is_file())
+        return p.name == LOCK_NAME or temporary_of(p) is not None
 
     def refuse_unless_new(self, *, force: bool) -> None:
         """Refuses, before anything is written (the lock file included), a folder that holds
@@ -181,9 +171,7 @@ class RunDir:
         killed write."""
         for name in (*RUN_FILES, *FIGURES, *extra):
             (self.path / name).unlink(missing_ok=True)
-        for p in self.path.iterdir():
-            if _TEMP.match(p.name) and p.is_file():
-                p.unlink(missing_ok=True)
+        remove_temporaries(self.path)
 
     # -- writing ------------------------------------------------------------------------------
 

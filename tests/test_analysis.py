@@ -13,7 +13,6 @@ import pytest
 from dnnevo import tasks
 import dnnevo
 from dnnevo import _core, analysis
-from dnnevo.evaluation import assessment as assess
 from dnnevo import presets
 from dnnevo.errors import InvalidArgumentError
 

@@ -18,7 +18,6 @@ from cli_helpers import assert_one_line_error, assert_png, run_cli
 from dnnevo import tasks
 from dnnevo.cli import assess as _cli_assess
 import dnnevo
-from dnnevo.evaluation import assessment as assess
 from dnnevo.tasks import landmark
 from dnnevo import presets
 from dnnevo.config import EvolutionConfig

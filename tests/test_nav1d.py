@@ -22,10 +22,8 @@ from dnnevo import tasks
 from dnnevo.cli import assess as _cli_assess
 import dnnevo
 from dnnevo.evaluation.stats import wilson
-from dnnevo.evaluation import assessment as assess
 from dnnevo.tasks import nav1d
 from dnnevo import presets
-from dnnevo.config import apply_overrides
 from dnnevo.errors import ConfigError, DnnevoError, InvalidArgumentError
 
 

@@ -398,9 +398,8 @@ def _whole_report(name: str, text: bytes) -> bool:
         text.startswith(b"<!DOCTYPE html>") and text.endswith(b"</html>\n")
 
 
-@pytest.mark.parametrize("name", report.REPORT_FILES)
-def test_a_kill_inside_the_report_s_write_leaves_the_old_report_and_the_next_run_tidies(
-        tmp_path: Path, name: str) -> None:
+def test_a_kill_inside_the_report_s_write_leaves_the_old_report_and_the_next_run_tidies(tmp_path: Path) -> None:
+    name = report.REPORT_FILES[-1]  # killed in the last write: the files before it are new
     args = ["reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
             "--no-dt-check", "--in-process", "--out", str(tmp_path)]
     assert run_cli(*args).returncode == 0

@@ -31,6 +31,18 @@ of the champions and of the baselines, and seeds whose champion beats each basel
 intervals apart. ``--figure`` and ``--animation`` draw the best seed's champion in the first
 fresh episode it escapes (``--episode E`` for another), and ``--champions DIR`` saves every
 champion; ``--draw NETWORK`` draws a saved champion without evolving anything.
+
+Which of the transfer world's changes costs the champions their escapes? ``--ablation DIR``
+evolves nothing: it judges the champions saved in ``DIR`` (``seed-0.json`` ..., one per
+``--seeds``) and the two baselines on the same fresh episodes in worlds that each make part of
+the transfer world's changes (:data:`dnnevo.robots.pursuit.TRANSFER_FACTORS`: the room, the
+pursuers, the sensors' noise), one alone or all but one, beside the training and the transfer
+world::
+
+    python examples/predator_avoidance.py --ablation runs/predator-avoidance-champions
+
+prints each seed's escapes world by world, then one row per world: the champions' escapes
+pooled and seed by seed, the baselines', and how many champions beat each baseline.
 """
 
 from __future__ import annotations
@@ -53,7 +65,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.evaluation.stats import wilson
 from dnnevo.experiments import examples
 from dnnevo.robots import Pursuit
-from dnnevo.robots.pursuit import TRANSFER, drive, escape
+from dnnevo.robots.pursuit import TRANSFER, TRANSFER_FACTORS, drive, escape, transfer_part
 from dnnevo.runs import save_figure
 
 PRESET = "predator-avoidance"
@@ -85,6 +97,39 @@ def worlds(cfg: EvolutionConfig) -> dict[str, ClosedLoop]:
             "half step": _loop(Pursuit(steps=2 * steps, dt=dt / 2), cfg, finer=2)}
 
 
+def _factors(factors: Sequence[str]) -> str:
+    """What ``factors`` of the transfer world change, in words, from :data:`TRANSFER`."""
+    t = TRANSFER
+    said = {"room": f"room ({t['world']['room'][0]:g} m x {t['world']['room'][1]:g} m, "
+                    f"{len(t['world']['boxes'])} boxes)",
+            "pursuers": f"pursuers ({t['pursuers']['speed']:g} m/s, {t['pursuers']['max_turn_rate']:g} rad/s)",
+            "noise": f"noise (sonar {100 * t['sonar']['noise_sd']:g} cm, pursuer sensor "
+                     f"{100 * t['sector_noise_sd']:g} cm)"}
+    return " + ".join(said[f] for f in factors) if factors else "nothing"
+
+
+def ablation_worlds(cfg: EvolutionConfig) -> dict[str, tuple[str, ClosedLoop]]:
+    """The worlds of ``--ablation``, each with what it changes of the training world: the
+    training world, each of :data:`TRANSFER_FACTORS` alone, the transfer world without each
+    one, and the transfer world; each a closed loop integrated as the run was."""
+    steps = int(cfg.task_params["max_steps"])
+    names = list(TRANSFER_FACTORS)
+    parts = {"training world": [], **{f"{f} only": [f] for f in names},
+             **{f"all but the {f}": [g for g in names if g != f] for f in names}, "transfer world": names}
+    return {world: (_factors(factors), _loop(Pursuit(**transfer_part(*factors), steps=steps), cfg))
+            for world, factors in parts.items()}
+
+
+def judge(network: dnnevo.Network, loops: dict[str, ClosedLoop], fresh: int) -> dict[str, dict[str, Any]]:
+    """``network``'s escapes of ``fresh`` fresh episodes in each world of ``loops``."""
+    out: dict[str, dict[str, Any]] = {}
+    for name, loop in loops.items():
+        ok, threshold, judged = loop.judged(network, fresh, FRESH_SEED, "evaluate")
+        out[name] = {"successes": int(ok.sum()), "episodes": len(ok), "meets": bool(ok.mean() >= threshold),
+                     "return": float(judged.returns.mean())}
+    return out
+
+
 def one_seed(seed: int, overrides: Sequence[str], fresh: int) -> dict[str, Any]:
     """Evolves one seed and judges its champion on fresh episodes in every world."""
     started = time.perf_counter()
@@ -93,21 +138,25 @@ def one_seed(seed: int, overrides: Sequence[str], fresh: int) -> dict[str, Any]:
     result = dnnevo.evolve(fitness, cfg, seed=seed, progress=False)
     if result.interrupted:  # Ctrl-C or SIGTERM stops evolve after a generation; stop here too
         raise KeyboardInterrupt
-    out: dict[str, Any] = {"seed": seed, "network": result.best}
-    for name, loop in worlds(cfg).items():
-        ok, threshold, judged = loop.judged(result.best, fresh, FRESH_SEED, "evaluate")
-        out[name] = {"successes": int(ok.sum()), "episodes": len(ok), "meets": bool(ok.mean() >= threshold),
-                     "return": float(judged.returns.mean())}
+    out: dict[str, Any] = {"seed": seed, "network": result.best, **judge(result.best, worlds(cfg), fresh)}
     out["seconds"] = time.perf_counter() - started
     return out
 
 
-def baselines(cfg: EvolutionConfig, fresh: int, randoms: int) -> dict[str, dict[str, dict[str, int]]]:
+def saved_seed(seed: int, directory: Path, overrides: Sequence[str], fresh: int) -> dict[str, Any]:
+    """Judges the champion saved as ``directory/seed-N.json`` in every world of the ablation."""
+    cfg = presets.get(PRESET, overrides=list(overrides))
+    loops = {name: loop for name, (_, loop) in ablation_worlds(cfg).items()}
+    return {"seed": seed, **judge(dnnevo.Network.load(directory / f"seed-{seed}.json"), loops, fresh)}
+
+
+def baselines(cfg: EvolutionConfig, fresh: int, randoms: int, loops: dict[str, ClosedLoop] | None = None
+              ) -> dict[str, dict[str, dict[str, int]]]:
     """The escape rule's and ``randoms`` random networks' (pooled) escapes on the fresh
-    episodes of each world."""
+    episodes of each world (of ``loops``, by default :func:`worlds`)."""
     nets = [dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=FRESH_SEED + k) for k in range(randoms)]
     out: dict[str, dict[str, dict[str, int]]] = {"escape rule": {}, "random networks": {}}
-    for name, loop in worlds(cfg).items():
+    for name, loop in (worlds(cfg) if loops is None else loops).items():
         env = loop.env
         assert isinstance(env, Pursuit)
         r = drive(escape(env), env, episodes=fresh, max_steps=env.steps, seed=FRESH_SEED, purpose="evaluate")
@@ -170,6 +219,48 @@ def summarize(rows: list[dict[str, Any]], base: dict[str, dict[str, dict[str, in
     lines.append(f"seeds whose champion keeps its escape rate at half the step (within its 95% "
                  f"interval at the run's step): {k} of {n} ({lo:.0%}-{hi:.0%})")
     return lines
+
+
+def _seeds(seeds: list[int]) -> str:
+    """``seed 0``, ``seeds 0-9`` or ``seeds 0, 2, 5``."""
+    if len(seeds) == 1:
+        return f"seed {seeds[0]}"
+    run = seeds == list(range(seeds[0], seeds[0] + len(seeds)))
+    return f"seeds {seeds[0]}-{seeds[-1]}" if run else "seeds " + ", ".join(map(str, seeds))
+
+
+def ablation_table(rows: list[dict[str, Any]], base: dict[str, dict[str, dict[str, int]]],
+                   changes: dict[str, str]) -> tuple[list[str], list[list[str]], list[str]]:
+    """``--ablation``'s columns, one row per world of ``changes`` (what each changes) and the
+    summary lines."""
+    n = len(rows)
+
+    def count(k: int) -> str:
+        lo, hi = wilson(k, n)
+        return f"{k} of {n} ({lo:.0%}-{hi:.0%})"
+
+    table, pooled = [], {}
+    for world, change in changes.items():
+        pooled[world] = {k: sum(r[world][k] for r in rows) for k in ("successes", "episodes")}
+        table.append([world, change, rate(pooled[world]["successes"], pooled[world]["episodes"]),
+                      " ".join(str(r[world]["successes"]) for r in rows),
+                      *(rate(b[world]["successes"], b[world]["episodes"]) for b in base.values()),
+                      *(count(sum(beats(r[world], b[world]) for r in rows)) for b in base.values())])
+    fresh = rows[0]["training world"]["episodes"]
+    columns = ["world", "changed from the training world", "champions, pooled (95% interval)",
+               f"champions, seed by seed ({_seeds([r['seed'] for r in rows])}, of {fresh} each)",
+               *(f"{name}{', pooled' if name == 'random networks' else ''}" for name in base),
+               *(f"champions that beat the {name}" for name in base)]
+    home = pooled["training world"]
+    lo_home = wilson(home["successes"], home["episodes"])[0]
+    others = [w for w in changes if w != "training world"]
+    lines = [f"pooled escapes the champions gain (+) or lose (-) against the training world's "
+             f"{home['successes']}/{home['episodes']}: "
+             + "; ".join(f"{w} {pooled[w]['successes'] - home['successes']:+d}" for w in others),
+             "worlds where the champions' pooled rate is below the training world's (95% intervals apart): "
+             + (", ".join(w for w in others if wilson(pooled[w]["successes"], pooled[w]["episodes"])[1] < lo_home)
+                or "none")]
+    return columns, table, lines
 
 
 class Traced(Pursuit):
@@ -341,6 +432,10 @@ def main(argv: Sequence[str] | None = None) -> None:
                    help="evolve nothing: draw this saved champion's episode (--figure, --animation)")
     p.add_argument("--champions", type=Path, metavar="DIR",
                    help="save each seed's champion here, as seed-N.json")
+    p.add_argument("--ablation", type=Path, metavar="DIR",
+                   help="evolve nothing: judge the champions saved in DIR (seed-N.json for each of --seeds) "
+                        "in worlds with part of the transfer world's changes "
+                        "(docs/results/examples/predator-avoidance-ablation.json)")
     p.add_argument("--record", type=Path, metavar="JSON",
                    help="also write the table here, for the docs "
                         "(docs/results/examples/predator-avoidance.json)")
@@ -352,6 +447,14 @@ def main(argv: Sequence[str] | None = None) -> None:
         network = dnnevo.Network.load(args.draw)
         draw(trace(network, cfg, f"champion {args.draw.stem}", episodes=args.fresh, episode=args.episode),
              args.figure, args.animation)
+        return
+    if args.ablation:
+        if args.figure or args.animation or args.champions:
+            p.error("--ablation judges saved champions; it draws and saves nothing")
+        missing = [f"seed-{s}.json" for s in range(args.seeds) if not (args.ablation / f"seed-{s}.json").is_file()]
+        if missing:
+            p.error(f"--ablation: {args.ablation} has no {missing[0]} (save champions with --champions DIR)")
+        ablation(cfg, args, argv)
         return
     rows = []
     print("seed  fresh episodes escaped    mean return  rule  transfer world            "
@@ -385,6 +488,27 @@ def main(argv: Sequence[str] | None = None) -> None:
         best = max(rows, key=lambda r: (r["trained"]["successes"], r["trained"]["return"]))
         draw(trace(best["network"], cfg, f"seed {best['seed']}'s champion", episodes=args.fresh,
                    episode=args.episode), args.figure, args.animation)
+
+
+def ablation(cfg: EvolutionConfig, args: argparse.Namespace, argv: Sequence[str] | None) -> None:
+    """``--ablation``: each saved champion's escapes world by world as it comes, then the table
+    with the baselines and, with ``--record``, the record."""
+    changes = {world: change for world, (change, _) in ablation_worlds(cfg).items()}
+    rows = []
+    print("seed  " + "  ".join(changes))
+    for r in examples.seeds_run(saved_seed, args.seeds, args.workers, args.ablation, args.set, args.fresh):
+        rows.append(r)
+        print(f"{r['seed']:4d}  " + "  ".join(f"{r[w]['successes']}/{r[w]['episodes']}".ljust(len(w))
+                                              for w in changes), flush=True)
+    loops = {world: loop for world, (_, loop) in ablation_worlds(cfg).items()}
+    columns, table, summary = ablation_table(rows, baselines(cfg, args.fresh, args.random, loops), changes)
+    print()
+    for row in table:
+        print(" | ".join(f"{c}: {v}" for c, v in zip(columns, row) if c != columns[1]))
+    print("\n".join(summary))
+    if args.record:
+        examples.write(args.record, command=examples.command("examples/predator_avoidance.py", argv),
+                       columns=columns, rows=table, summary=summary)
 
 
 def draw(shown: Shown, figure: Path | None, animation: Path | None) -> None:

@@ -22,6 +22,7 @@ import double_pole  # noqa: E402
 import categorical_perception  # noqa: E402
 import legged_walker  # noqa: E402
 import pendulum  # noqa: E402
+import predator_avoidance  # noqa: E402
 
 
 def assert_rendered(tmp_path: Path, name: str, script: str, argv: list[str], summary: list[str]) -> None:
@@ -238,3 +239,36 @@ def test_legged_walker_without_its_sensor(tmp_path: Path, capsys: pytest.Capture
     assert_png(tmp_path / "w.png")
     recorded = examples.read(tmp_path / "w.json")
     assert "sensor cut" not in recorded["columns"] and len(recorded["rows"][0]) == 7
+
+
+def test_predator_avoidance_ablation_judges_saved_champions(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--ablation evolves nothing: it loads a saved champion, judges it and the baselines in each
+    world of the ablation, and records one row per world."""
+    from dnnevo import presets
+
+    nets = tmp_path / "nets"
+    nets.mkdir()
+    cfg = presets.get("predator-avoidance")
+    dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=3).save(nets / "seed-0.json")
+    record = tmp_path / "results" / "examples" / "predator-avoidance-ablation.json"
+    argv = ["--ablation", str(nets), "--seeds", "1", "--fresh", "4", "--random", "1",
+            "--set", "task_params.max_steps=40", "--record", str(record)]
+    predator_avoidance.main(argv)
+    lines = capsys.readouterr().out.splitlines()
+    worlds = list(predator_avoidance.ablation_worlds(cfg))
+    assert lines[0].split("  ") == ["seed", *worlds] and lines[1].split()[0] == "0"
+    assert all(re.fullmatch(r"[0-4]/4", cell) for cell in lines[1].split()[1:])
+    summary = lines[-2:]
+    assert summary[0].startswith("pooled escapes the champions gain (+) or lose (-) against the training world's")
+    assert_rendered(tmp_path, "predator-avoidance-ablation", "examples/predator_avoidance.py", argv, summary)
+    from dnnevo.experiments import examples
+
+    rows = examples.read(record)["rows"]
+    assert [row[0] for row in rows] == worlds and all(re.fullmatch(r"[0-4]", row[3]) for row in rows)
+    assert all(row[5].startswith(("0/4 ", "1/4 ", "2/4 ", "3/4 ", "4/4 ")) for row in rows)  # 1 random network
+    with pytest.raises(SystemExit):  # a champion missing is named before anything runs
+        predator_avoidance.main(["--ablation", str(nets), "--seeds", "2"])
+    assert "has no seed-1.json" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        predator_avoidance.main(["--ablation", str(nets), "--seeds", "1", "--figure", str(tmp_path / "x.png")])
+    assert not (tmp_path / "x.png").exists()

@@ -14,7 +14,7 @@ import dnnevo
 from dnnevo.closedloop import ClosedLoop, rollout
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.robots import Pursuit
-from dnnevo.robots.pursuit import ARENA, PURSUERS, TRANSFER, drive, escape
+from dnnevo.robots.pursuit import ARENA, PURSUERS, TRANSFER, TRANSFER_FACTORS, drive, escape, transfer_part
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "examples"))
@@ -95,6 +95,80 @@ def test_the_world_and_settings_are_the_documented_ones() -> None:
     assert env.settings["pursuers"]["count"] == 2
     moved = Pursuit(**TRANSFER)
     assert moved.world["room"] == TRANSFER["world"]["room"] and moved.sector_noise_sd == 0.2
+
+
+def params(env: Pursuit, prefix: str = "") -> dict[str, object]:
+    """Every parameter of ``env``'s world, one per leaf: ``world.room``, ``settings.pursuers.speed``..."""
+    def flat(d: dict, p: str) -> dict[str, object]:
+        out: dict[str, object] = {}
+        for k, v in d.items():
+            out.update(flat(v, f"{p}{k}.") if isinstance(v, dict) else {f"{p}{k}": v})
+        return out
+    return flat({"world": env.world, "settings": env.settings, "sector_noise_sd": env.sector_noise_sd,
+                 "steps": env.steps, "contact_penalty": env.contact_penalty, "max_contact": env.max_contact}, prefix)
+
+
+def changed(a: dict[str, object], b: dict[str, object]) -> set[str]:
+    assert a.keys() == b.keys()
+    return {k for k in a if a[k] != b[k]}
+
+
+# TRANSFER as it was when the reference runs and docs/results/examples/predator-avoidance.json
+# judged champions in it.
+TRANSFER_AS_RECORDED = {
+    "world": {"room": [7.0, 7.0], "start": {"min": [0.4, 0.4], "max": [6.6, 6.6]},
+              "boxes": [{"center": [2.0, 5.0], "size": [1.4, 0.5], "angle_deg": 0.0},
+                        {"center": [5.0, 5.2], "size": [0.7, 0.7], "angle_deg": 45.0},
+                        {"center": [3.5, 3.0], "size": [0.5, 1.5], "angle_deg": 0.0},
+                        {"center": [5.5, 1.8], "size": [0.8, 0.8], "angle_deg": 15.0}]},
+    "pursuers": {"speed": 0.45, "max_turn_rate": 2.5}, "sonar": {"noise_sd": 0.05}, "sector_noise_sd": 0.2}
+FACTOR_PARAMS = {"room": {"world.room", "world.start.max", "world.boxes"},
+                 "pursuers": {"settings.pursuers.speed", "settings.pursuers.max_turn_rate"},
+                 "noise": {"settings.sonar.noise_sd", "sector_noise_sd"}}
+
+
+def test_each_one_factor_world_differs_from_the_training_world_only_in_its_factor() -> None:
+    trained, transfer = params(Pursuit()), params(Pursuit(**TRANSFER))
+    assert TRANSFER == TRANSFER_AS_RECORDED and transfer == params(Pursuit(**TRANSFER_AS_RECORDED))
+    assert list(TRANSFER_FACTORS) == list(FACTOR_PARAMS)
+    assert changed(trained, transfer) == set().union(*FACTOR_PARAMS.values())  # the factors are all it changes
+    assert transfer_part() == {} and params(Pursuit(**transfer_part())) == trained
+    assert transfer_part(*TRANSFER_FACTORS) == TRANSFER
+    for factor, keys in FACTOR_PARAMS.items():
+        alone = params(Pursuit(**transfer_part(factor)))
+        assert changed(trained, alone) == keys, factor
+        assert {k: alone[k] for k in keys} == {k: transfer[k] for k in keys}, factor
+        others = [f for f in TRANSFER_FACTORS if f != factor]
+        assert changed(transfer, params(Pursuit(**transfer_part(*others)))) == keys, factor
+    part = transfer_part("pursuers")
+    part["pursuers"]["speed"] = 9.0  # a copy: TRANSFER stays as it was
+    assert TRANSFER == TRANSFER_AS_RECORDED
+    with pytest.raises(InvalidArgumentError, match="no transfer factor 'rooms'"):
+        transfer_part("rooms")
+
+
+def test_the_ablations_training_and_transfer_worlds_are_the_examples() -> None:
+    """--ablation judges in the same training and transfer worlds, integrated alike, as the
+    evolving run of the example; its one-factor worlds start where the training world does
+    (the room aside)."""
+    from dnnevo import presets
+
+    cfg = presets.get("predator-avoidance")
+    judged, ablated = predator_avoidance.worlds(cfg), predator_avoidance.ablation_worlds(cfg)
+    assert list(ablated) == ["training world", "room only", "pursuers only", "noise only", "all but the room",
+                             "all but the pursuers", "all but the noise", "transfer world"]
+    for mine, theirs in (("training world", "trained"), ("transfer world", "transfer")):
+        loop, other = ablated[mine][1], judged[theirs]
+        assert params(loop.env) == params(other.env) and loop.settings == other.settings
+    assert ablated["training world"][0] == "nothing"
+    assert ablated["room only"][0] == "room (7 m x 7 m, 4 boxes)"
+    starts = {}
+    for world in ("training world", "pursuers only", "noise only"):
+        env = ablated[world][1].env
+        drive(escape(env), env, episodes=20, max_steps=0, seed=predator_avoidance.FRESH_SEED, purpose="evaluate")
+        starts[world] = env.fleet.poses.copy(), env.fleet.pursuers.copy()
+    for world in ("pursuers only", "noise only"):
+        assert all(np.array_equal(a, b) for a, b in zip(starts[world], starts["training world"]))
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [

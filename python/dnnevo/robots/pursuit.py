@@ -37,6 +37,7 @@ episodes a network's rollout would meet.
 
 from __future__ import annotations
 
+import copy
 import warnings
 from collections.abc import Callable, Mapping
 from os import PathLike
@@ -55,8 +56,8 @@ from dnnevo.robots.world import D0, RobotWorld
 from dnnevo.tasks import user
 from dnnevo.tasks.protocol import Analysis, ViewResult
 
-__all__ = ["APPEARS", "ARENA", "PURSUERS", "SECTORS", "TRANSFER", "Pursuit", "appears", "drive", "escape",
-           "pursuer_appears"]
+__all__ = ["APPEARS", "ARENA", "PURSUERS", "SECTORS", "TRANSFER", "TRANSFER_FACTORS", "Pursuit", "appears", "drive",
+           "escape", "pursuer_appears", "transfer_part"]
 
 ARENA: dict[str, Any] = {
     "room": [8.0, 6.0],
@@ -95,6 +96,32 @@ TRANSFER: dict[str, Any] = {
 """A world training never saw, for the transfer test: ``Pursuit(**TRANSFER)`` is a square 7 m
 room with four other boxes, pursuers 12% faster that turn two thirds faster, 5 cm of Gaussian
 noise on every sonar range and 20 cm on the pursuer sensor's gaps."""
+
+TRANSFER_FACTORS: dict[str, tuple[str, ...]] = {"room": ("world",), "pursuers": ("pursuers",),
+                                                "noise": ("sonar", "sector_noise_sd")}
+"""The three changes :data:`TRANSFER` makes at once, each named by the keys of :data:`TRANSFER`
+it sets: the room (its size, boxes and starting area), the pursuers (faster, sharper-turning)
+and the sensors' noise (on the sonar ranges and on the pursuer sensor's gaps). Each key belongs
+to one factor; :func:`transfer_part` makes a world of some of them."""
+
+
+def transfer_part(*factors: str) -> dict[str, Any]:
+    """The arguments of :class:`Pursuit` for the training world changed by ``factors`` (names of
+    :data:`TRANSFER_FACTORS`) alone, as :data:`TRANSFER` changes them: no factor is the training
+    world, all of them :data:`TRANSFER` itself. A copy: changing it leaves :data:`TRANSFER` alone.
+
+    >>> sorted(transfer_part("noise"))
+    ['sector_noise_sd', 'sonar']
+    >>> transfer_part("pursuers")
+    {'pursuers': {'speed': 0.45, 'max_turn_rate': 2.5}}
+    >>> transfer_part() == {} and transfer_part(*TRANSFER_FACTORS) == TRANSFER
+    True
+    """
+    unknown = [f for f in factors if f not in TRANSFER_FACTORS]
+    if unknown:
+        raise InvalidArgumentError(f"no transfer factor {unknown[0]!r}; expected one of {', '.join(TRANSFER_FACTORS)}")
+    keys = {key for f in factors for key in TRANSFER_FACTORS[f]}
+    return copy.deepcopy({key: value for key, value in TRANSFER.items() if key in keys})
 
 
 def _number(name: str, value: Any, low: float, high: float = float("inf")) -> float:

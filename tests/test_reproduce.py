@@ -122,6 +122,18 @@ def test_a_tampered_result_is_refused(tmp_path: Path) -> None:
     ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"),
      lambda d: d.update(goal_rate_by_trial={})),
     ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"), lambda d: d.update(goal_interval=[0.1])),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"]["u-trap"]["with"].update(arrived=11)),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"]["u-trap"]["with"].update(arrived=-1)),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"]["u-trap"]["with"].update(arrived=3.0)),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"]["u-trap"]["with"].update(arrived=True)),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"]["u-trap"]["without"].update(starts=9)),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"]["open-room"].pop("without")),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"]["open-room"].update(sometimes={})),
+    ("reactive-navigation-hand", (), lambda d: d["worlds"].pop("cul-de-sac")),
+    ("reactive-navigation-hand", (), lambda d: d.update(worlds=[])),
+    ("reactive-navigation-hand", (), lambda d: d.update(starts=20)),
+    ("reactive-navigation-hand", (), lambda d: d.update(seed=d["seed"] + 1)),
+    ("reactive-navigation-hand", (), lambda d: d.update(steps="1200")),
 ])
 def test_a_result_of_the_wrong_shape_is_named(tmp_path: Path, experiment: str, needs: tuple[str, ...],
                                               edit: Any) -> None:
@@ -234,11 +246,20 @@ def test_experiments_added_since_a_reproduction_began_join_it(tmp_path: Path) ->
     assert run_cli(*args).returncode == 0
     manifest = out / "reproduce.json"
     full = json.loads(manifest.read_text())
-    # A folder begun before an experiment existed has no config for it: it is added.
-    manifest.write_text(json.dumps({**full, "configs": {k: v for k, v in full["configs"].items()
-                                                          if k != "predator-avoidance"}}))
+    # Only the configs of the experiments the command ran are recorded ...
+    assert sorted(full["configs"]) == sorted(e.name for e in plan.EXPERIMENTS if e.family == "classic")
+    # ... and checked: another family's recorded config, even one that differs, refuses nothing.
+    other = {**full, "configs": {**full["configs"], "sequence-1bit": {"population": 7}}}
+    manifest.write_text(json.dumps(other))
     again = run_cli(*args)
     assert again.returncode == 0 and "(3 already done)" in again.stdout, again.stderr
+    assert json.loads(manifest.read_text()) == other
+    # A folder begun before an experiment existed has no config for it: it is added.
+    shutil.rmtree(out / "double-pole")
+    manifest.write_text(json.dumps({**full, "configs": {k: v for k, v in full["configs"].items()
+                                                          if k != "double-pole"}}))
+    again = run_cli(*args)
+    assert again.returncode == 0 and "(2 already done)" in again.stdout, again.stderr
     assert json.loads(manifest.read_text()) == full
     # An experiment with runs in the folder but no recorded config is no addition: refused.
     manifest.write_text(json.dumps({**full, "configs": {}}))
@@ -418,3 +439,44 @@ def test_a_kill_inside_the_report_s_write_leaves_the_old_report_and_the_next_run
     assert run_cli(*args).returncode == 0
     assert all(_whole_report(n, (tmp_path / n).read_bytes()) for n in report.REPORT_FILES)
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == [".dnnevo.lock"]
+
+
+def test_the_hand_designed_job_counts_what_the_navigation_function_does(tmp_path: Path) -> None:
+    """The paper's own reactive navigation is a job: the shipped network on the fresh starts of
+    the job's seed, in every world, with and without the detectors, counted as
+    :func:`dnnevo.robots.navigation.hand_designed` counts them."""
+    from dnnevo.experiments import sweep
+    from dnnevo.robots import navigation
+
+    assert (jobs.Settings().starts(), jobs.Settings(quick=True).starts()) == (jobs.HAND_STARTS, jobs.HAND_QUICK_STARTS)
+    assert jobs.Settings(quick=True, eval_trials=7).starts() == 7 == jobs.Settings(eval_trials=7).starts()
+    names = [e.name for e in plan.EXPERIMENTS if e.family == "robots"]
+    assert names.index("reactive-navigation-hand") < names.index("reactive-navigation")
+    job = next(j for j in plan.jobs([2], only=["robots"]) if j.spec.kind == plan.HAND_DESIGNED)
+    assert job.id == "reactive-navigation-hand/seed-2" and job.needs == ()
+    result = jobs.run_job(job, tmp_path, QUICK, 1)
+    seed = sweep.eval_seed(2, QUICK.eval_seed)
+    assert (result["seed"], result["starts"], result["steps"]) == (seed, 10, 1200)
+    for world in navigation.WORLDS:
+        for condition, detectors in (("with", True), ("without", False)):
+            direct = navigation.hand_designed(world, 10, seed=seed, detectors=detectors)
+            assert result["worlds"][world][condition] == {"arrived": direct["arrived"], "starts": 10}, world
+    assert jobs.read_result(tmp_path, job, QUICK) == result
+    # Its inputs are the shipped network and worlds: a result made with others is done again.
+    stale = {**result, "inputs": {**result["inputs"], "dnnevo/robots/data/navigator.json": "0" * 64}}
+    jobs.result_path(tmp_path, job).write_text(json.dumps(stale))
+    assert jobs.read_result(tmp_path, job, QUICK) is None
+
+
+def test_the_quick_robots_reproduction_has_the_papers_reactive_navigation_row(tmp_path: Path) -> None:
+    r = run_cli("reproduce", "--only", "robots", "--seeds", "0", "--quick", "--no-dt-check", "--in-process",
+                "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    md = (tmp_path / "report.md").read_text()
+    e = plan.experiment("reactive-navigation-hand")
+    row = next(line for line in md.splitlines() if line.startswith(f"| {e.name} | {e.paper} | 1/1 | - | "))
+    assert "goal reached with / without detectors: open-room " in row and "/20 (" in row  # quick: 20 starts
+    assert "| seed | open-room: goal reached with / without detectors" in md
+    assert md.index("| reactive-navigation-hand |") < md.index("| reactive-navigation |")
+    result = json.loads(jobs.result_path(tmp_path, plan.Job(e.name, 0, ())).read_text())
+    assert result["starts"] == jobs.HAND_QUICK_STARTS and result["kind"] == plan.HAND_DESIGNED

@@ -104,7 +104,7 @@ def reproduce(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with RunDir(root).writing(create=True):
         _tidy(root, order)
-        _begin(root, settings)
+        _begin(root, settings, {j.experiment for j in order})
         # Finished runs are not run again; the others need only the unfinished among their needs.
         stored = {j.id: jobs.read_result(root, j, settings) for j in order}
         done = {j.id: scheduler.Outcome(scheduler.Task(j.id, j.needs, jobs.run_job), "done", stored[j.id])
@@ -173,10 +173,13 @@ def _tidy(root: Path, order: list[plan.Job]) -> None:
         remove_temporaries(root / experiment, {jobs.result_path(root, j).name for j in order})
 
 
-def _begin(root: Path, settings: jobs.Settings) -> None:
-    """Records the settings in a new reproduction's folder, or checks them in an old one."""
+def _begin(root: Path, settings: jobs.Settings, experiments: set[str]) -> None:
+    """Records the settings and the configs of ``experiments`` (those the command runs) in a new
+    reproduction's folder, or checks them in an old one. Other experiments' configs are neither
+    recorded nor checked: a change to a family this command does not run cannot refuse it."""
     manifest = root / SETTINGS_FILE
     wanted = settings.to_dict()
+    wanted["configs"] = {k: v for k, v in wanted["configs"].items() if k in experiments}
     if manifest.exists() or manifest.is_symlink():
         # Experiments added to dnnevo since the folder was begun join it; the others must match.
         try:
@@ -187,8 +190,9 @@ def _begin(root: Path, settings: jobs.Settings) -> None:
         if not isinstance(recorded, dict):
             check_settings(manifest, wanted, what="reproduction", force=False)
             return
-        check_settings(manifest, {**wanted, "configs": {k: v for k, v in wanted["configs"].items() if k in recorded}},
-                       what="reproduction", force=False)
+        # The recorded configs of experiments this command runs must be the wanted ones.
+        ours = {k: v for k, v in wanted["configs"].items() if k in recorded}
+        check_settings(manifest, {**wanted, "configs": {**recorded, **ours}}, what="reproduction", force=False)
         added = {k: v for k, v in wanted["configs"].items() if k not in recorded}
         for name in added:  # an experiment the folder has runs of was recorded, or it is not ours
             if (root / name).exists():

@@ -31,16 +31,17 @@ import json
 import multiprocessing
 import platform
 import shlex
+import subprocess
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeGuard
 
 from dnnevo import _core
 from dnnevo.experiments import report
 from dnnevo.runs.files import RunFileError, read_json, write_atomic
 
-__all__ = ["EXAMPLES_DIR", "blocks", "command", "markdown", "read", "seeds_run", "write"]
+__all__ = ["EXAMPLES_DIR", "blocks", "command", "markdown", "read", "seeds_run", "source_commit", "write"]
 
 EXAMPLES_DIR = Path("examples")
 """Where, under the results folder (``docs/results``), the examples' results live."""
@@ -93,15 +94,41 @@ def seeds_run(one_seed: Callable[..., Any], seeds: int, workers: int, *args: Any
             raise
 
 
+def source_commit(module: Path) -> str | None:
+    """The commit of the git checkout that the Python file ``module`` is tracked in (an editable
+    install runs the checkout's Python code), with ``-dirty`` when the checkout has uncommitted
+    changes; None when the file is tracked by none (an installed wheel) or git is missing."""
+
+    def git(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(["git", "-C", str(module.parent), *args], capture_output=True, text=True, timeout=30)
+
+    try:
+        if git("ls-files", "--error-unmatch", module.name).returncode != 0:
+            return None
+        head = git("rev-parse", "--short=12", "HEAD")
+        status = git("status", "--porcelain", "--untracked-files=no")
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if head.returncode != 0 or status.returncode != 0:
+        return None
+    return head.stdout.strip() + ("-dirty" if status.stdout.strip() else "")
+
+
 def write(path: Path, *, command: str, columns: Sequence[str], rows: Sequence[Sequence[Any]],
           summary: Sequence[str]) -> None:
     """Writes an example's table (``rows`` of cells, shown as ``str`` of each), the lines that
-    sum it up, the ``command`` that made it and the dnnevo that ran it, atomically."""
+    sum it up, the ``command`` that made it and the dnnevo that ran it, atomically. The commit
+    is the extension's (:func:`dnnevo.build_info`); when the Python code comes from a checkout at
+    another commit (an editable install), that one is recorded too, as ``python_commit``."""
     info = _core.build_info()
+    made = {"commit": info["commit"], "version": info["version"], "kernel": info["kernel"],
+            "arch": platform.machine()}
+    python = source_commit(Path(__file__))
+    if python is not None and python != info["commit"]:
+        made["python_commit"] = python
     doc = {"format": FORMAT, "command": command, "columns": [str(c) for c in columns],
            "rows": [[str(c) for c in row] for row in rows], "summary": [str(s) for s in summary],
-           "made": {"commit": info["commit"], "version": info["version"], "kernel": info["kernel"],
-                    "arch": platform.machine()}}
+           "made": made}
     path.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(path, json.dumps(doc, indent=1) + "\n")
 
@@ -124,7 +151,7 @@ def read(path: Path) -> dict[str, Any]:
     return doc
 
 
-def _strings(value: Any) -> bool:
+def _strings(value: Any) -> TypeGuard[list[str]]:
     return isinstance(value, list) and all(isinstance(v, str) for v in value)
 
 
@@ -132,7 +159,8 @@ def blocks(doc: dict[str, Any]) -> list[report.Block]:
     """The command, the table, the summary lines and the dnnevo that made them."""
     table = report.Block("table", rows=(tuple(doc["columns"]), *(tuple(r) for r in doc["rows"])))
     made = doc.get("made") or {}
-    source = (f"(made by dnnevo {made.get('version')} at commit {made.get('commit')}, "
+    python = f", its Python code at commit {made['python_commit']}" if "python_commit" in made else ""
+    source = (f"(made by dnnevo {made.get('version')} at commit {made.get('commit')}{python}, "
               f"{made.get('kernel')} kernel)") if made else ""
     return [report.Block("p", f"`{doc['command']}`:"), table,
             *(report.Block("p", line) for line in doc["summary"]), *([report.Block("p", source)] if source else [])]

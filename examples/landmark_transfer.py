@@ -1,0 +1,246 @@
+"""Landmark recognition in held-out worlds (issue 47): how well do saved champions tell the two
+landmarks apart in worlds that no run trained or selected on, and where do they sit between a
+trivial classifier and an observer fitted on each world?
+
+Every champion (the ``best.json`` of each run folder given) is judged on ``--trials`` fresh
+trials per landmark, drawn from ``TEST_SEED``, in five worlds: the training world (the paper's
+ideal world, unvaried), the robot-like test (``dnnevo assess --robot-like``), and the three
+held-out worlds of :mod:`dnnevo.tasks.landmark_worlds` (another wall follower, another sonar, a
+bigger room with the landmark off-centre). In each world, on the same test trials:
+
+- **constant**: always one answer: 50% by construction (as many trials of each landmark);
+- **threshold**: the best single-threshold rule on the sonar input's mean or the fraction of
+  steps it reads near (input above ``NEAR``, a range under 2 m), fitted on ``--fit-trials``
+  trials per landmark of that world drawn from ``FIT_SEED``;
+- **observer**: logistic regression (:mod:`dnnevo.evaluation.observer`) on seven features of the
+  input stream (mean, sd, max, fraction near, near episodes, longest and mean near run), fitted
+  on the same ``FIT_SEED`` trials; for a held-out world also fitted on the other two held-out
+  worlds' trials only (leave one world out), which says whether the features themselves
+  transfer.
+
+A champion meets the issue's goal in a world when it is right in more than 85% of the trials and
+the 95% Wilson interval's lower end is above 80%::
+
+    python examples/landmark_transfer.py /root/dnnevo-reference/landmark \\
+        /root/dnnevo-reference/landmark-robust --record docs/results/examples/landmark-transfer.json
+
+Each FOLDER is a run folder (``config.toml`` and ``best.json``) or a folder of them
+(``seed-0``, ``seed-1``, ...); its name labels its champions. Without any, the reference
+reproduction's two landmark folders are used if they exist. Nothing is written into them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dnnevo import _core
+from dnnevo.config import EvolutionConfig
+from dnnevo.evaluation import observer
+from dnnevo.evaluation.stats import wilson
+from dnnevo.experiments import examples
+from dnnevo.runs import RunDir
+from dnnevo.tasks import landmark, landmark_worlds
+
+REFERENCE = [Path("/root/dnnevo-reference/landmark"), Path("/root/dnnevo-reference/landmark-robust")]
+"""The champions judged by default: the reference reproduction's ``landmark`` and
+``landmark-robust`` runs, seeds 0-9."""
+
+FIT_SEED = 47_001
+"""The seed of the trials the threshold rule and the observer are fitted on."""
+TEST_SEED = 47_002
+"""The seed of the trials everything is judged on. Runs draw their training and validation
+trials from their own run seeds (0-9) under other stream purposes; ``dnnevo sweep`` and the docs
+judge on 1000003 + seed, 3000003, 5000011 and 7: no run or earlier figure used 47001 or 47002."""
+
+NEAR = 0.25
+"""The input above which the sonar "reads near": a range under 0.5 / 0.25 = 2 m."""
+
+THRESHOLD_COLUMNS = [observer.FEATURES.index("mean"), observer.FEATURES.index("fraction near")]
+"""The features the single-threshold rule may use: the input's mean and the fraction near."""
+
+GOAL_RATE, GOAL_LOWER = 0.85, 0.80
+"""The issue's goal for a champion in a world: rate above 85%, interval's lower end above 80%."""
+
+
+@dataclass(frozen=True)
+class Place:
+    """A world champions are judged in: its config overlay and whether trials are robot-like."""
+
+    name: str
+    world: landmark_worlds.World
+    robot_like: bool = False
+
+
+PLACES = [Place("training", landmark_worlds.TRAINING),
+          Place("robot-like", landmark_worlds.TRAINING, robot_like=True),
+          *(Place(name, w) for name, w in landmark_worlds.WORLDS.items())]
+HELD_OUT = list(landmark_worlds.WORLDS)
+
+
+def champions(folder: Path) -> list[tuple[str, Path]]:
+    """The run folders in ``folder`` (itself, or its ``seed-N`` subfolders in seed order)."""
+    if (folder / "config.toml").is_file():
+        return [(folder.name, folder)]
+    runs = [p for p in folder.glob("seed-*") if p.is_dir() and re.fullmatch(r"seed-\d+", p.name)]
+    if not runs:
+        raise SystemExit(f"{folder}: neither a run folder (config.toml) nor a folder of seed-N run folders")
+    return [(p.name, p) for p in sorted(runs, key=lambda p: int(p.name[5:]))]
+
+
+def load(run: Path) -> tuple[EvolutionConfig, _core.Network]:
+    """A run's config and champion, read without writing anything."""
+    rd = RunDir(run)
+    config, table = rd.read_run_config()
+    return config, rd.read_best(config, table)
+
+
+def sonar_features(config: EvolutionConfig, net: _core.Network, per_landmark: int, seed: int,
+                   robot_like: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Features and labels (0: landmark 1, 1: landmark 2) of the trials ``assess`` draws from
+    ``seed``: trial t of ``2 per_landmark``, landmark 1 first (the sonar does not depend on the
+    network, which the recorder only needs to run)."""
+    rows, labels = [], []
+    for t in range(2 * per_landmark):
+        which = 1 if t < per_landmark else 2
+        rec = landmark.record(config, net, which, seed=seed, trial=t, robot_like=robot_like)
+        rows.append(observer.features(rec.input, NEAR))
+        labels.append(which - 1)
+    return np.array(rows), np.array(labels)
+
+
+def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int) -> dict[str, dict[str, Any]]:
+    """Each place's threshold rule and observer, fitted on ``fit`` trials per landmark from
+    FIT_SEED and judged on ``test`` from TEST_SEED; held-out worlds also get the observer fitted
+    on the other held-out worlds."""
+    data = {}
+    for place in PLACES:
+        cfg = landmark_worlds.config(base, place.world)
+        data[place.name] = (sonar_features(cfg, net, fit, FIT_SEED, place.robot_like),
+                            sonar_features(cfg, net, test, TEST_SEED, place.robot_like))
+    out = {}
+    for name, ((xf, yf), (xt, yt)) in data.items():
+        rule = observer.fit_threshold(xf, yf, THRESHOLD_COLUMNS)
+        model = observer.fit_logistic(xf, yf)
+        result = {"threshold": int(np.sum(rule.predict(xt) == yt)), "observer": int(np.sum(model.predict(xt) == yt)),
+                  "n": len(yt), "rule": f"{observer.FEATURES[rule.feature]} {'>' if rule.sign > 0 else '<'} "
+                                        f"{rule.threshold:.3g} says landmark 2"}
+        if name in HELD_OUT:
+            others = [data[o][0] for o in HELD_OUT if o != name]
+            lowo = observer.fit_logistic(np.vstack([x for x, _ in others]), np.concatenate([y for _, y in others]))
+            result["observer, other worlds"] = int(np.sum(lowo.predict(xt) == yt))
+        out[name] = result
+    return out
+
+
+def judge(run: Path, trials: int) -> dict[str, int]:
+    """Trials right of ``run``'s champion in each place (of ``2 trials``), and under
+    ``"<place> one answer"`` the trials given its commoner answer."""
+    config, net = load(run)
+    out = {}
+    for place in PLACES:
+        report = landmark.assess(landmark_worlds.config(config, place.world), net, trials, TEST_SEED,
+                                 robot_like=place.robot_like)
+        (a, b), (c, d) = report["confusion"]
+        out[place.name] = a + d
+        out[f"{place.name} one answer"] = max(a + c, b + d)
+    return out
+
+
+def pct(k: int, n: int) -> str:
+    return f"{100 * k / n:.1f}"
+
+
+def meets(k: int, n: int) -> bool:
+    return k / n > GOAL_RATE and wilson(k, n)[0] > GOAL_LOWER
+
+
+def table(families: dict[str, dict[str, dict[str, int]]], base: dict[str, dict[str, Any]],
+          trials: int) -> tuple[list[str], list[list[str]], list[str]]:
+    """The record's columns, one row per place and family, and the summary lines."""
+    n = 2 * trials
+    columns = ["world", "champions", "meet the goal", "% right, seed by seed", "pooled % (95% interval)",
+               "threshold rule %", "observer %", "observer fitted on the other two worlds %"]
+    rows = []
+    for place in PLACES:
+        b = base[place.name]
+        for family, seeds in families.items():
+            ks = [r[place.name] for r in seeds.values()]
+            lo, hi = wilson(sum(ks), n * len(ks))
+            lowo = b.get("observer, other worlds")
+            rows.append([place.name + (" (held out)" if place.name in HELD_OUT else ""), family,
+                         f"{sum(meets(k, n) for k in ks)}/{len(ks)}", " ".join(pct(k, n) for k in ks),
+                         f"{pct(sum(ks), n * len(ks))} ({100 * lo:.1f}-{100 * hi:.1f})",
+                         pct(b["threshold"], b["n"]), pct(b["observer"], b["n"]),
+                         "-" if lowo is None else pct(lowo, b["n"])])
+    summary = [f"{trials} fresh trials per landmark per champion and world (seed {TEST_SEED}); the bounds are "
+               f"judged on the same trials and fitted on others (seed {FIT_SEED}). The constant classifier is "
+               "right in 50% of them by construction. The goal (issue 47): more than 85% right with the 95% "
+               "Wilson interval's lower end above 80%."]
+    for family, seeds in families.items():
+        every = [s for s, r in seeds.items() if all(meets(r[w], n) for w in HELD_OUT)]
+        worst = [min(r[w] for w in HELD_OUT) for r in seeds.values()]
+        summary.append(f"{family}: {len(every)}/{len(seeds)} champions meet the goal in all three held-out worlds"
+                       f"{' (' + ', '.join(every) + ')' if every else ''}; worst held-out world per champion, "
+                       f"% right: {' '.join(pct(k, n) for k in worst)}.")
+    stuck = {f: {w: sum(r[f"{w} one answer"] >= 0.95 * n for r in seeds.values()) for w in HELD_OUT}
+             for f, seeds in families.items()}
+    summary.append("Champions that give one answer in at least 95% of a held-out world's trials, as the constant "
+                   "classifier does: " + "; ".join(f"{f}: " + ", ".join(f"{w} {k}/{len(families[f])}"
+                                                                      for w, k in by.items())
+                                                   for f, by in stuck.items()) + ".")
+    summary.append("Threshold rules: " + "; ".join(f"{p.name}: {base[p.name]['rule']}" for p in PLACES) + ".")
+    return columns, rows, summary
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("folders", nargs="*", type=Path, metavar="FOLDER",
+                   help="run folders, or folders of seed-N run folders (default: "
+                        + " and ".join(map(str, REFERENCE)) + ", if they exist)")
+    p.add_argument("--trials", type=int, default=100, help="fresh test trials per landmark (default 100)")
+    p.add_argument("--fit-trials", type=int, default=100,
+                   help="trials per landmark the bounds are fitted on, per world (default 100)")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs (docs/results/examples/landmark-transfer.json)")
+    args = p.parse_args(argv)
+    if args.trials < 1 or args.fit_trials < 1:
+        p.error("--trials and --fit-trials must be at least 1")
+    folders = args.folders or REFERENCE
+    missing = [f for f in folders if not f.is_dir()]
+    if missing:
+        p.error(f"{missing[0]} is not a folder; pass the champions' folders (run folders, or folders "
+                "of seed-N run folders), for example: examples/landmark_transfer.py runs/sweep-landmark")
+    families: dict[str, dict[str, dict[str, int]]] = {}
+    start = time.perf_counter()
+    for folder in folders:
+        family = families.setdefault(folder.name, {})
+        for label, run in champions(folder):
+            family[label] = judge(run, args.trials)
+            print(f"{folder.name} {label}: " + "  ".join(f"{p.name} {pct(family[label][p.name], 2 * args.trials)}%"
+                                                         for p in PLACES), flush=True)
+    first = champions(folders[0])[0][1]
+    base_cfg, base_net = load(first)
+    base = bounds(base_cfg, base_net, args.fit_trials, args.trials)
+    columns, rows, summary = table(families, base, args.trials)
+    print()
+    print(" | ".join(columns))
+    for row in rows:
+        print(" | ".join(row))
+    print("\n".join(summary))
+    print(f"{time.perf_counter() - start:.0f} s", file=sys.stderr)
+    if args.record:
+        examples.write(args.record, command=examples.command("examples/landmark_transfer.py", argv),
+                       columns=columns, rows=rows, summary=summary)
+
+
+if __name__ == "__main__":
+    main()

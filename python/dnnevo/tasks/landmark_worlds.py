@@ -1,0 +1,134 @@
+"""Held-out test worlds for landmark recognition (issue 47): three worlds that no run trains or
+selects on, each differing in kind from what ``landmark-robust``'s varied training changes and
+from the others, so that a champion's rate in them measures transfer.
+
+Each world is a ``task_params`` overlay on the paper's ideal world (the defaults of
+``crates/tasks/src/landmark/config.rs``); :func:`config` puts one on a run's config in place of
+its own task settings (trial counts and training variation do not change a fresh trial). Every
+number and why it was chosen: ``docs/landmark.md``, "Transfer to held-out worlds".
+
+What ``landmark-robust`` varies in training, per trial (``training.rs``): the whole landmark's
+position (+-0.15 m), turn (+-5 deg) and size (+-8%), the follower's speed (+-8%) and wall
+distance (+-0.05 m), the sonar's cone (+-8 deg), the trial's length (+-3 s), and the input's
+gain (+-15%), offset (+-0.025) and noise (sd 0.015, on the input, not the range). The robot-like
+test adds range noise (sd 0.03 m), specular misses beyond 60 deg, each box moved on its own and a
+room scaled by up to 5%.
+
+>>> sorted(WORLDS)
+['follower', 'room', 'sonar']
+>>> WORLDS["follower"].params["sim"]["follower"]["speed"]
+0.45
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+from dnnevo.config import EvolutionConfig
+from dnnevo.errors import InvalidArgumentError
+from dnnevo.tasks import landmark
+
+__all__ = ["TRAINING", "WORLDS", "World", "config", "factors"]
+
+
+@dataclass(frozen=True)
+class World:
+    """A held-out world: its name, what it changes and the overlay that makes it."""
+
+    name: str
+    changes: str
+    """What differs from the training world, in words."""
+    params: dict[str, Any]
+    """The ``task_params`` of the world (the paper's defaults for everything it leaves out)."""
+
+
+def _sim(*, follower: dict[str, float] | None = None, sonar: dict[str, Any] | None = None) -> dict[str, Any]:
+    sim: dict[str, Any] = {}
+    if follower:
+        sim["follower"] = {"speed": 0.6, "wall_distance": 0.55, "max_turn_rate": 2.0, "sensor_range": 2.0,
+                           **follower}
+    if sonar:
+        sim["sonars"] = [{"mount_angle_deg": 90.0, "mount_offset": 0.265, "cone_deg": 25.0, "rays": 7,
+                          "min_range": 0.15, "max_range": 6.5, "noise_sd": 0.0,
+                          "specular_max_incidence_deg": None, **sonar}]
+    return sim
+
+
+def _room(width: float, height: float, centre: tuple[float, float]) -> dict[str, Any]:
+    """Both landmarks in a ``width`` x ``height`` room with their centre at ``centre``: the
+    shipped boxes (landmark 1 one 1.2 m x 0.6 m box, landmark 2 two 0.6 m crates 0.6 m apart)
+    moved as they are, and the start region 0.4 m from the walls as in the shipped worlds."""
+    out = {}
+    for n in (1, 2):
+        world = landmark.default_world(n)
+        dx, dy = centre[0] - 3.0, centre[1] - 2.5  # the shipped landmarks' centre
+        boxes = [{**b, "center": [round(b["center"][0] + dx, 9), round(b["center"][1] + dy, 9)]}
+                 for b in world["boxes"]]
+        out[f"landmark{n}"] = {"room": [width, height], "boxes": boxes,
+                               "start": {"min": [0.4, 0.4], "max": [width - 0.4, height - 0.4]}}
+    return out
+
+
+TRAINING = World("training", "the paper's ideal world, unvaried (what every trial starts from)", {})
+"""The training world itself, for reference: the defaults, no variation."""
+
+WORLDS: dict[str, World] = {w.name: w for w in [
+    World("follower",
+          "another wall follower: 0.45 m/s (-25%), 0.80 m from the wall (+0.25 m), corners turned at "
+          "1.2 rad/s at most (2.0)",
+          {"sim": _sim(follower={"speed": 0.45, "wall_distance": 0.80, "max_turn_rate": 1.2})}),
+    World("sonar",
+          "another sonar: a 40 deg cone (25) of 11 rays, its axis 15 deg forward of the side (75 deg), "
+          "range noise sd 0.05 m, specular misses beyond 45 deg incidence, 4 m range",
+          {"sim": _sim(sonar={"cone_deg": 40.0, "rays": 11, "mount_angle_deg": 75.0, "noise_sd": 0.05,
+                              "specular_max_incidence_deg": 45.0, "max_range": 4.0})}),
+    World("room",
+          "a bigger room, 8 m x 6.5 m (6 x 5), the landmark off-centre at (3.2, 2.6): 2.0-2.3 m from the "
+          "left and bottom walls, 3.6-4.2 m from the others (2.1-2.4 m in training)",
+          _room(8.0, 6.5, (3.2, 2.6))),
+]}
+"""The held-out worlds by name."""
+
+
+def config(base: EvolutionConfig, world: World) -> EvolutionConfig:
+    """``base`` (a run's config: its network layout and integrator) with ``world``'s task settings
+    in place of its own. The task is built here, so a world that does not validate fails now.
+
+    >>> from dnnevo import presets
+    >>> cfg = config(presets.get("landmark-robust"), WORLDS["room"])
+    >>> landmark.params(cfg)["landmark1"]["room"], landmark.params(cfg)["training"]["cone_deg"]
+    ([8.0, 6.5], 0.0)
+    """
+    if base.task != landmark.NAME:
+        raise InvalidArgumentError(f"the run's task is {base.task!r}; the held-out worlds are {landmark.NAME!r}'s")
+    out = dataclasses.replace(base, task_params=copy.deepcopy(world.params))
+    landmark.params(out)  # builds the task: an invalid world fails here
+    return out
+
+
+def factors(world: World) -> dict[str, tuple[Any, Any]]:
+    """The task settings ``world`` changes, by dotted name, as (training value, world value).
+
+    >>> factors(WORLDS["follower"])["sim.follower.speed"]
+    (0.6, 0.45)
+    """
+    base = landmark.params(EvolutionConfig(task=landmark.NAME))
+    mine = landmark.params(EvolutionConfig(task=landmark.NAME, task_params=copy.deepcopy(world.params)))
+    out: dict[str, tuple[Any, Any]] = {}
+
+    def walk(a: Any, b: Any, path: str) -> None:
+        if isinstance(a, dict) and isinstance(b, dict):
+            for k in sorted(set(a) | set(b)):
+                walk(a.get(k), b.get(k), f"{path}.{k}" if path else k)
+        elif isinstance(a, list) and isinstance(b, list) and len(a) == len(b) and not all(
+                isinstance(x, int | float) for x in a + b):
+            for i, (x, y) in enumerate(zip(a, b, strict=True)):
+                walk(x, y, f"{path}.{i}")
+        elif a != b:
+            out[path] = (a, b)
+
+    walk(base, mine, "")
+    return out

@@ -1,0 +1,143 @@
+"""Landmark recognition's held-out worlds and bounds (issue 47): the worlds change what they say
+and build, the bounds are fitted on trials other than the ones they are judged on, and the
+example's code path writes a record that renders."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dnnevo
+from dnnevo import presets
+from dnnevo.evaluation import observer
+from dnnevo.experiments import examples, results
+from dnnevo.tasks import landmark, landmark_worlds
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "examples"))
+
+import landmark_transfer  # noqa: E402
+
+# What each world says it changes, by the config's dotted names; nothing else may differ.
+STATED = {
+    "follower": {"sim.follower.speed", "sim.follower.wall_distance", "sim.follower.max_turn_rate"},
+    "sonar": {f"sim.sonars.0.{k}" for k in ("cone_deg", "rays", "mount_angle_deg", "noise_sd",
+                                            "specular_max_incidence_deg", "max_range")},
+    "room": {f"landmark{n}.{k}" for n in (1, 2) for k in ("room", "start.max", "boxes.0.center")}
+    | {"landmark2.boxes.1.center"},
+}
+
+
+@pytest.mark.parametrize("name", sorted(landmark_worlds.WORLDS))
+def test_each_world_changes_its_stated_factors_and_builds(name: str) -> None:
+    world = landmark_worlds.WORLDS[name]
+    assert set(landmark_worlds.factors(world)) == STATED[name]
+    cfg = landmark_worlds.config(presets.get("landmark-robust"), world)
+    params = landmark.params(cfg)  # the task builds (validates)
+    # The run's training variation is gone: a held-out world is judged as it is.
+    assert params["training"]["cone_deg"] == 0.0 and params["trials_per_landmark"] == 3
+
+
+def test_the_worlds_go_beyond_what_training_varies() -> None:
+    """Each factor the robust preset's training varies goes further in the world that changes it."""
+    t = presets.get("landmark-robust").task_params["training"]
+    f = {k: v for w in landmark_worlds.WORLDS.values() for k, v in landmark_worlds.factors(w).items()}
+    speed = f["sim.follower.speed"]
+    assert abs(speed[1] / speed[0] - 1) > 2 * t["follower_speed"]
+    distance = f["sim.follower.wall_distance"]
+    assert abs(distance[1] - distance[0]) > 2 * t["follower_distance"]
+    cone = f["sim.sonars.0.cone_deg"]
+    assert abs(cone[1] - cone[0]) > t["cone_deg"]
+    # Training moves the landmark by at most 0.15 m in a 6 m x 5 m room; the room world's is bigger.
+    assert f["landmark1.room"][1][0] - f["landmark1.room"][0][0] >= 2.0
+
+
+def test_a_world_for_another_task_is_refused() -> None:
+    with pytest.raises(Exception, match="held-out worlds"):
+        landmark_worlds.config(presets.get("sequence-1bit"), landmark_worlds.WORLDS["room"])
+
+
+def test_logistic_regression_recovers_a_known_rule() -> None:
+    rng = np.random.default_rng(4)
+    x = rng.normal(size=(400, 3)) * [1.0, 5.0, 0.1] + [0.0, 2.0, 0.0]
+    y = (x[:, 0] - 0.2 * x[:, 1] > -0.4).astype(int)  # a rule on two of the three columns
+    model = observer.fit_logistic(x, y, ridge=1e-4)
+    w = model.w / model.sd  # weights on the raw columns
+    assert w[1] / w[0] == pytest.approx(-0.2, abs=0.03)
+    assert abs(w[2] / w[0]) < 0.5
+    fresh = rng.normal(size=(400, 3)) * [1.0, 5.0, 0.1] + [0.0, 2.0, 0.0]
+    assert np.mean(model.predict(fresh) == (fresh[:, 0] - 0.2 * fresh[:, 1] > -0.4)) > 0.97
+
+
+def test_the_threshold_rule_sees_only_its_fitting_trials(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The bounds fit on FIT_SEED's trials and judge on TEST_SEED's, the champions' test seed."""
+    assert landmark_transfer.FIT_SEED != landmark_transfer.TEST_SEED
+    seen: list[tuple[int, int]] = []
+    sense = landmark_transfer.sonar_features
+
+    def spy(config, net, per_landmark, seed, robot_like):  # type: ignore[no-untyped-def]
+        seen.append((seed, per_landmark))
+        return sense(config, net, per_landmark, seed, robot_like)
+
+    fits: list[np.ndarray] = []
+    fit = observer.fit_threshold
+
+    def fit_spy(x, y, columns=None):  # type: ignore[no-untyped-def]
+        fits.append(np.asarray(x))
+        return fit(x, y, columns)
+
+    monkeypatch.setattr(landmark_transfer, "sonar_features", spy)
+    monkeypatch.setattr(observer, "fit_threshold", fit_spy)
+    monkeypatch.setattr(landmark_transfer, "PLACES", landmark_transfer.PLACES[:1])
+    cfg = presets.get("landmark")
+    net = dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=1)
+    out = landmark_transfer.bounds(cfg, net, 3, 2)
+    assert seen == [(landmark_transfer.FIT_SEED, 3), (landmark_transfer.TEST_SEED, 2)]
+    assert len(fits) == 1 and len(fits[0]) == 6  # fitted on the 2 x 3 fitting trials alone
+    assert out["training"]["n"] == 4
+
+
+def test_the_sonar_features_are_of_the_champions_test_trials() -> None:
+    """The bounds judge the very trials ``assess`` draws: trial t of a seed is the same sonar."""
+    cfg = presets.get("landmark")
+    net = dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=2)
+    x, y = landmark_transfer.sonar_features(cfg, net, 2, 9, False)
+    assert y.tolist() == [0, 0, 1, 1]
+    again = [observer.features(landmark.record(cfg, net, 2, seed=9, trial=3).input, landmark_transfer.NEAR)]
+    assert np.array_equal(x[3], again[0])
+
+
+def test_a_tiny_run_makes_a_record_that_renders(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    runs = tmp_path / "tiny"
+    r = subprocess.run([sys.executable, "-m", "dnnevo", "run", "landmark", "--quick", "--out", str(runs / "seed-0"),
+                        "--seed", "0", "--set", "generations=1", "--set", "population=10", "--threads", "1"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    record = tmp_path / "results" / "examples" / "landmark-transfer.json"
+    argv = [str(runs), "--trials", "3", "--fit-trials", "4", "--record", str(record)]
+    landmark_transfer.main(argv)
+    doc = examples.read(record)
+    assert doc["command"] == examples.command("examples/landmark_transfer.py", argv[:-2])
+    assert [row[0] for row in doc["rows"]] == ["training", "robot-like", "follower (held out)",
+                                               "sonar (held out)", "room (held out)"]
+    assert all(row[1] == "tiny" and row[2] in ("0/1", "1/1") for row in doc["rows"])
+    page = tmp_path / "page.md"
+    page.write_text("<!-- results:example:landmark-transfer:begin -->\nSTALE TABLE\n"
+                    "<!-- results:example:landmark-transfer:end -->\n")
+    assert results.render(tmp_path, results_dir=tmp_path / "results", files=[page]) == [page]
+    assert "| room (held out) | tiny |" in page.read_text() and "STALE TABLE" not in page.read_text()
+    assert "tiny seed-0: training" in capsys.readouterr().out
+
+
+def test_help_names_an_example_and_a_missing_folder_is_named(capsys: pytest.CaptureFixture[str],
+                                                              tmp_path: Path) -> None:
+    with pytest.raises(SystemExit):
+        landmark_transfer.main(["--help"])
+    assert "examples/landmark_transfer.py /root/dnnevo-reference/landmark" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        landmark_transfer.main([str(tmp_path / "nowhere")])
+    assert "nowhere is not a folder; pass the champions' folders" in capsys.readouterr().err

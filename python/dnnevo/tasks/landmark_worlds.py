@@ -86,8 +86,8 @@ WORLDS: dict[str, World] = {w.name: w for w in [
           {"sim": _sim(sonar={"cone_deg": 40.0, "rays": 11, "mount_angle_deg": 75.0, "noise_sd": 0.05,
                               "specular_max_incidence_deg": 45.0, "max_range": 4.0})}),
     World("room",
-          "a bigger room, 8 m x 6.5 m (6 x 5), the landmark off-centre at (3.2, 2.6): 2.0-2.3 m from the "
-          "left and bottom walls, 3.6-4.2 m from the others (2.1-2.4 m in training)",
+          "a bigger room, 8 m x 6.5 m (6 x 5), the landmark off-centre at (3.2, 2.6): 2.3-2.6 m from the "
+          "left and bottom walls, 3.6-4.2 m from the others (2.1-2.4 m from every wall in training)",
           _room(8.0, 6.5, (3.2, 2.6))),
 ]}
 """The held-out worlds by name."""

@@ -46,7 +46,7 @@ from dnnevo.closedloop import named, rollout
 from dnnevo.evaluation.stats import wilson
 from dnnevo.experiments import examples
 from dnnevo.robots import Navigate
-from dnnevo.robots.navigation import INTEGRATOR, WORLDS, Integration, navigator
+from dnnevo.robots.navigation import INTEGRATOR, WORLDS, Integration, hand_designed, navigator
 from dnnevo.runs import save_figure
 
 FRESH_SEED = 2_000_003
@@ -112,19 +112,13 @@ def comparison(seeds: int, generations: int, starts: int) -> tuple[list[str], li
 
 
 def judged(world: str, detectors: bool, starts: int, *, finer: int = 1, steps: int = 1200) -> dict[str, Any]:
-    """The hand-designed network on ``starts`` fresh starts of ``world``; with ``finer`` > 1 the
-    world's and the network's steps ``finer`` times shorter (as many more steps)."""
-    env = Navigate(world, detectors=detectors, dt=0.1 / finer, steps=steps * finer)
+    """The hand-designed network on ``starts`` fresh starts of ``world``
+    (:func:`~dnnevo.robots.navigation.hand_designed` from ``FRESH_SEED``), with its ``wall``
+    time; with ``finer`` > 1 the world's and the network's steps ``finer`` times shorter (as
+    many more steps)."""
     started = time.perf_counter()
-    r = rollout([navigator()], env, episodes=starts, max_steps=env.steps, seed=FRESH_SEED, purpose="evaluate",
-                dt=INTEGRATOR["dt"] / finer, substeps=INTEGRATOR["substeps"], method=INTEGRATOR["method"])
-    ok = env.success(r.returns[0], r.lengths[0])
-    seconds = r.lengths[0] * env.settings["dt"]
-    return {"world": world, "detectors": detectors, "dt": env.settings["dt"], "arrived": int(ok.sum()),
-            "starts": starts, "time": float(seconds[ok].mean()) if ok.any() else float("nan"),
-            "contact": float(env.contact_steps.sum() / r.lengths.sum()),
-            "static": float(env.fired[:, 0].mean()), "cyclic": float(env.fired[:, 1].mean()),
-            "wall": time.perf_counter() - started}
+    r = hand_designed(world, starts, seed=FRESH_SEED, detectors=detectors, finer=finer, steps=steps)
+    return {**r, "wall": time.perf_counter() - started}
 
 
 def pct(x: float) -> str:

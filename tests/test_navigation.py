@@ -17,8 +17,8 @@ from dnnevo.closedloop import rollout
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.experiments import examples
 from dnnevo.robots import Navigate
-from dnnevo.robots.navigation import (INTEGRATOR, WORLDS, Detectors, bearing, design,
-                                      destination, looping, navigation_world, navigator, stuck)
+from dnnevo.robots.navigation import (INTEGRATOR, WORLDS, Detectors, bearing, design, destination,
+                                      hand_designed, looping, navigation_world, navigator, stuck)
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "examples"))
@@ -231,6 +231,26 @@ def test_detectors_turn_u_trap_failures_into_arrivals() -> None:
             assert env.escapes[~ok[False]].min() >= 1  # every rescued start needed an escape
     assert (~ok[False]).sum() >= 3  # the network alone is caught in the trap
     assert (ok[True] & ~ok[False]).sum() >= 3  # ... and the detectors get it out
+
+
+def test_hand_designed_counts_what_a_rollout_of_the_network_does() -> None:
+    """The one function the example and ``dnnevo reproduce`` call counts the arrivals, contacts
+    and firings of a rollout from the same starts, with and without detectors."""
+    for detectors in (False, True):
+        env = Navigate("u-trap", detectors=detectors, steps=600)
+        r = rollout([navigator()], env, episodes=6, max_steps=env.steps, seed=11, purpose="evaluate", **INTEGRATOR)
+        got = hand_designed("u-trap", 6, seed=11, detectors=detectors, steps=600)
+        ok = env.arrived
+        assert (got["world"], got["detectors"], got["dt"], got["starts"]) == ("u-trap", detectors, 0.1, 6)
+        assert got["arrived"] == int(ok.sum())
+        assert got["contact"] == env.contact_steps.sum() / r.lengths.sum()
+        assert [got["static"], got["cyclic"]] == env.fired.mean(axis=0).tolist()
+        assert np.isnan(got["time"]) if not ok.any() else got["time"] == (r.lengths[0][ok] * 0.1).mean()
+    finer = hand_designed("open-room", 2, seed=11, finer=2, steps=300)
+    assert finer["dt"] == 0.05 and finer["arrived"] == 2
+    for name, kwargs in (("starts", {"starts": 0}), ("finer", {"finer": 0}), ("steps", {"steps": -1})):
+        with pytest.raises(InvalidArgumentError, match=f"{name} is"):
+            hand_designed("open-room", **{"starts": 1, "seed": 0, **kwargs})  # type: ignore[arg-type]
 
 
 def test_bad_detector_settings_are_named() -> None:

@@ -29,7 +29,10 @@ The paper gives no details; these are dnnevo's (docs/reactive-navigation.md says
   other side.
 
 :func:`navigator` is the hand-designed network, loaded from ``dnnevo/robots/data/navigator.json``;
-:func:`design` builds the same network from the documented weights.
+:func:`design` builds the same network from the documented weights. :func:`hand_designed` runs it
+on fresh starts of a world, with or without the detectors, and counts its arrivals: the paper's
+own experiment, which ``examples/reactive_navigation.py`` and the ``reactive-navigation-hand``
+job of ``dnnevo reproduce`` both run.
 
 >>> from dnnevo.closedloop import rollout
 >>> from dnnevo.robots import Navigate
@@ -55,11 +58,12 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
+from dnnevo.closedloop import rollout
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.robots.world import D0, RobotWorld
 
 __all__ = ["INTEGRATOR", "WORLDS", "Integration", "Detectors", "Navigate", "bearing", "design", "destination",
-           "looping", "navigation_world", "navigator", "stuck"]
+           "hand_designed", "looping", "navigation_world", "navigator", "stuck"]
 
 class Integration(TypedDict):
     """How a network is integrated: the keyword arguments of :func:`dnnevo.closedloop.rollout`."""
@@ -421,3 +425,32 @@ def design(*, cruise: float = 1.4, goal_gain: float = 4.0, relay_gain: float = 4
     s[2, 10], s[3, 10] = -frustration_block, -frustration_block   # frustration silences the goal
     s[0, 10], s[1, 10] = frustration_turn, -frustration_turn      # ... and bends right (+1) or left (-1)
     return _core.Network(tau, theta, w, s)
+
+
+def hand_designed(world: str | PathLike[str] | Mapping[str, Any], starts: int, *, seed: int,
+                  detectors: bool = False, finer: int = 1, steps: int = 1200) -> dict[str, Any]:
+    """The hand-designed network (:func:`navigator`) in ``world`` from ``starts`` fresh start
+    poses drawn from ``seed`` (``purpose="evaluate"``: the same starts with and without
+    ``detectors``), for trials of ``steps`` steps of 0.1 s; with ``finer`` > 1 the world's and
+    the network's steps are ``finer`` times shorter (as many more steps). Returns the world's
+    name, ``detectors``, the world's step ``dt`` (s), ``arrived`` (the starts that reached the
+    goal), ``starts``, the mean ``time`` to arrive (s; NaN when none did), the fraction of steps
+    in ``contact`` with a wall or box, and the ``static`` and ``cyclic`` firings per start.
+
+    >>> r = hand_designed("open-room", 4, seed=7, steps=300)
+    >>> (r["arrived"], r["starts"])
+    (4, 4)
+    """
+    _at_least_one("starts", starts)
+    _at_least_one("finer", finer)
+    _at_least_one("steps", steps)
+    env = Navigate(world, detectors=detectors, dt=0.1 / finer, steps=steps * finer)
+    r = rollout([navigator()], env, episodes=starts, max_steps=env.steps, seed=seed, purpose="evaluate",
+                dt=INTEGRATOR["dt"] / finer, substeps=INTEGRATOR["substeps"], method=INTEGRATOR["method"])
+    ok = env.success(r.returns[0], r.lengths[0])
+    seconds = r.lengths[0] * env.settings["dt"]
+    return {"world": world if isinstance(world, str) else str(world), "detectors": detectors,
+            "dt": env.settings["dt"], "arrived": int(ok.sum()), "starts": starts,
+            "time": float(seconds[ok].mean()) if ok.any() else float("nan"),
+            "contact": float(env.contact_steps.sum() / r.lengths.sum()),
+            "static": float(env.fired[:, 0].mean()), "cyclic": float(env.fired[:, 1].mean())}

@@ -76,6 +76,8 @@ def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) 
         assert row in readme.splitlines()
     assert "| nav1d-far | §4.2: solved at generation 0 | not yet run | - |" in readme
     assert "| sequence-3bit | §5.4: 1 success, at generation 700 | not yet run |" in readme
+    hand = plan.experiment("reactive-navigation-hand")
+    assert f"| {hand.name} | {hand.paper} | not yet run | - | - |" in readme
     planned = len(plan.jobs([0]))  # the paper's families, seed 0
     assert "commit abc1234" in readme and f"4 of {planned} runs done" in readme and "Quick mode" in readme
     # Families beyond the paper's appear only once their runs are collected.
@@ -207,6 +209,44 @@ def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, re
     for e in (e for e in plan.EXPERIMENTS if e.family == "classic"):
         assert f"| {e.name} | {e.paper} | 1/1 |" in readme, e.name
     assert "| landmark | " in readme
+
+
+def test_the_papers_reactive_navigation_is_rendered_from_its_results_or_said_not_yet_run(tmp_path: Path,
+                                                                                        repo: Path) -> None:
+    """The hand-designed reactive navigator's results, collected with the robots family, make
+    its row and its per-seed table; a results folder without them says it is not yet run, and a
+    damaged one is named."""
+    source = tmp_path / "robots"
+    r = run_cli("reproduce", "--only", "robots", "--seeds", "0", "--quick", "--eval-trials", "10",
+                "--no-dt-check", "--in-process", "--out", source)
+    assert r.returncode == 0, r.stderr
+    stored = repo / "docs" / "results"
+    r = _results("collect", source, stored, "--seeds", "0", "--only", "robots", "--commit", "abc1234")
+    assert r.returncode == 0, r.stderr
+    hand = plan.experiment("reactive-navigation-hand")
+    results.render(repo)
+    readme, page = (repo / "README.md").read_text(), (stored / "index.md").read_text()
+    row = next(line for line in readme.splitlines() if line.startswith(f"| {hand.name} | {hand.paper} | 1/1 |"))
+    assert "goal reached with / without detectors: open-room 10/10 (" in row and "cul-de-sac " in row
+    assert "| seed | open-room: goal reached with / without detectors (95% intervals) |" in page
+    assert "| 0 | " in page.split(f"### {hand.name}")[1].split("###")[0]
+    assert results.render(repo, check=True) == []
+    # Damaged counts are named when read, not rendered.
+    path = stored / hand.name / "seed-0.json"
+    good = path.read_text()
+    broken = json.loads(good)
+    broken["worlds"]["u-trap"]["with"]["arrived"] = 11
+    path.write_text(json.dumps(broken))
+    with pytest.raises(DnnevoError, match=r"reactive-navigation-hand/seed-0.json: not a valid job result \(ValueError"):
+        results.load(stored)
+    # Results of the family without the new experiment's: its row is not yet run, the others stand.
+    shutil.rmtree(stored / hand.name)
+    results.render(repo)
+    readme, page = (repo / "README.md").read_text(), (stored / "index.md").read_text()
+    assert f"| {hand.name} | {hand.paper} | not yet run | - | - |" in readme
+    assert "| predator-avoidance | " in readme and "| reactive-navigation | not in the paper" in readme
+    assert f"### {hand.name}\n\n" in page and "Not yet run over seeds 0." in page.split(f"### {hand.name}")[1]
+    assert results.render(repo, check=True) == []
 
 
 def test_a_refused_collect_writes_nothing(tmp_path: Path, reproduction: Path) -> None:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import json
 import time
+from importlib import resources
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -35,8 +36,10 @@ from dnnevo.errors import ConfigError
 from dnnevo.runs import RunDir, RunFileError, first_difference, short, write_atomic
 from dnnevo.runs.files import read_json
 from dnnevo.evolution.seeding import Seeding
+from dnnevo.robots import navigation
 
-__all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "Settings", "Stopped", "result_path", "read_result", "run_job"]
+__all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "HAND_STARTS", "HAND_QUICK_STARTS", "HAND_CONDITIONS", "Settings",
+           "Stopped", "result_path", "read_result", "run_job", "hand_counts"]
 
 ROBOT_SEED_BASE = 3_000_003
 """The robot-like test of seed s's landmark champion draws its trials from seed
@@ -44,6 +47,19 @@ ROBOT_SEED_BASE = 3_000_003
 
 SYSTEM_TRIALS = 5
 """Trials per environment of the integrated navigation system, as in the paper's Fig. 2."""
+
+HAND_STARTS = 200
+"""Fresh start poses per world and condition for the hand-designed reactive navigator, unless
+``eval_trials`` says otherwise: as many as ``examples/reactive_navigation.py`` draws."""
+
+HAND_QUICK_STARTS = 20
+"""The same in a quick reproduction: it shows that the test runs, in about a second."""
+
+HAND_STEPS = 1200
+"""The hand-designed navigator's trials: 1200 steps of 0.1 s (120 s), ``Navigate``'s default."""
+
+HAND_CONDITIONS = ("with", "without")
+"""The hand-designed navigator's conditions: with the static and cyclic detectors, without."""
 
 
 class Stopped(Exception):
@@ -91,6 +107,14 @@ class Settings:
         """The fresh trials judging a champion of ``task``."""
         return self.eval_trials if self.eval_trials is not None else registry.get(task).DEFAULT_TRIALS
 
+    def starts(self) -> int:
+        """The hand-designed reactive navigator's fresh starts per world and condition:
+        ``eval_trials`` when given, as the robot-like test's trials per landmark are, else
+        :data:`HAND_QUICK_STARTS` in a quick reproduction and :data:`HAND_STARTS` in a full one."""
+        if self.eval_trials is not None:
+            return self.eval_trials
+        return HAND_QUICK_STARTS if self.quick else HAND_STARTS
+
     def to_dict(self) -> dict[str, Any]:
         """The settings and every evolution's config, as plain JSON types."""
         configs = {e.name: self.config(e).to_dict() for e in plan.EXPERIMENTS if e.kind == plan.EVOLVE}
@@ -118,7 +142,7 @@ def read_result(root: Path, job: plan.Job, settings: Settings) -> dict[str, Any]
         diff = first_difference(stored, expected)
         if diff is not None:
             raise RunFileError(f"{path}: its {diff[0]} is {short(diff[1])}, this reproduction's is {short(diff[2])}")
-        _check_body(job, found)
+        _check_body(job, found, settings)
         if found["inputs"] != _inputs(root, job):
             return None
     except RunFileError:
@@ -135,7 +159,14 @@ def _inputs(root: Path, job: plan.Job) -> dict[str, Any]:
     champion (``best.json``) of its own run (an evolution) or of each run it tests, and an
     evolution's generation count (the rows of ``log.csv``; the file itself holds wall times).
     None stands for a missing file. A result whose inputs changed (a run folder deleted, a run
-    extended with ``dnnevo resume``) is done again."""
+    extended with ``dnnevo resume``) is done again. The hand-designed navigator's inputs are the
+    SHA-256 of the shipped network and worlds, so that a result made with other ones is done
+    again."""
+    if job.spec.kind == plan.HAND_DESIGNED:
+        files = ["navigator.json", *(f"{w}.toml" for w in navigation.WORLDS)]
+        data = resources.files("dnnevo.robots").joinpath("data")
+        return {f"dnnevo/robots/data/{f}": hashlib.sha256(data.joinpath(f).read_bytes()).hexdigest()
+                for f in files}
     own = job.spec.kind == plan.EVOLVE
     out: dict[str, Any] = {}
     for run in [job.id] if own else list(job.needs):
@@ -165,7 +196,41 @@ def _fraction(value: Any, what: str) -> float:
     return x
 
 
-def _check_body(job: plan.Job, found: dict[str, Any]) -> None:
+def _count(value: Any, what: str, low: int = 0, high: int | None = None) -> int:
+    if not isinstance(value, int) or isinstance(value, bool) or value < low or (high is not None and value > high):
+        raise ValueError(f"{what} is {short(value)}; expected an integer from {low}"
+                         + (f" to {high}" if high is not None else ""))
+    return value
+
+
+def hand_counts(found: dict[str, Any]) -> dict[str, dict[str, tuple[int, int]]]:
+    """The hand-designed navigator's counts in a result, ``(arrived, starts)`` by world
+    (:data:`~dnnevo.robots.navigation.WORLDS`) and condition (:data:`HAND_CONDITIONS`), checked:
+    every world and condition there and nothing else, each count an integer, ``arrived`` from 0
+    to ``starts``, ``starts`` the result's, and its ``seed`` and ``steps`` integers too. Raises
+    ValueError, KeyError or TypeError otherwise."""
+    _count(found["seed"], "seed")
+    _count(found["steps"], "steps", 1)
+    starts = _count(found["starts"], "starts", 1)
+    worlds = found["worlds"]
+    if not isinstance(worlds, dict) or sorted(worlds) != sorted(navigation.WORLDS):
+        raise ValueError(f"worlds is {short(worlds)}; expected the worlds {', '.join(navigation.WORLDS)}")
+    out: dict[str, dict[str, tuple[int, int]]] = {}
+    for world in navigation.WORLDS:
+        conditions = worlds[world]
+        if not isinstance(conditions, dict) or sorted(conditions) != sorted(HAND_CONDITIONS):
+            raise ValueError(f"worlds.{world} is {short(conditions)}; expected {' and '.join(HAND_CONDITIONS)}")
+        out[world] = {}
+        for c in HAND_CONDITIONS:
+            counts = conditions[c]
+            if not isinstance(counts, dict) or sorted(counts) != ["arrived", "starts"]:
+                raise ValueError(f"worlds.{world}.{c} is {short(counts)}; expected arrived and starts")
+            n = _count(counts["starts"], f"worlds.{world}.{c}.starts", starts, starts)
+            out[world][c] = (_count(counts["arrived"], f"worlds.{world}.{c}.arrived", 0, n), n)
+    return out
+
+
+def _check_body(job: plan.Job, found: dict[str, Any], settings: Settings) -> None:
     """Every field a report reads is there and of its type."""
     if not float(found["wall_s"]) >= 0.0:
         raise ValueError("wall_s is negative")
@@ -180,6 +245,13 @@ def _check_body(job: plan.Job, found: dict[str, Any]) -> None:
         if len(matrix) != 2 or any(len(row) != 2 for row in matrix) or not all(
                 isinstance(x, int) and not isinstance(x, bool) and x >= 0 for row in matrix for x in row):
             raise ValueError("confusion is not a 2 x 2 matrix of counts")
+    elif kind == plan.HAND_DESIGNED:
+        hand_counts(found)
+        if found["starts"] != settings.starts():
+            raise ValueError(f"starts is {found['starts']}; these settings draw {settings.starts()}")
+        if found["seed"] != sweep.eval_seed(job.seed, settings.eval_seed):
+            raise ValueError(f"seed is {short(found['seed'])}; job {job.id} draws its starts from "
+                             f"{sweep.eval_seed(job.seed, settings.eval_seed)}")
     else:
         for key in ("goal_rate", "classification_rate"):
             _fraction(found[key], key)
@@ -205,7 +277,8 @@ def run_job(job: plan.Job, root: str | Path, settings: Settings, threads: int | 
     if done is not None:
         return done
     t0 = time.perf_counter()
-    body = {plan.EVOLVE: _evolve, plan.ROBOT_LIKE: _robot_like, plan.SYSTEM: _system}[job.spec.kind](
+    body = {plan.EVOLVE: _evolve, plan.ROBOT_LIKE: _robot_like, plan.SYSTEM: _system,
+            plan.HAND_DESIGNED: _hand_designed}[job.spec.kind](
         job, root, settings, threads, progress)
     result = {**_header(job, settings), **body, "wall_s": round(time.perf_counter() - t0, 2),
               "inputs": _inputs(root, job)}
@@ -258,3 +331,18 @@ def _system(job: plan.Job, root: Path, settings: Settings, threads: int | None, 
         "classification_interval": list(stats.wilson(report["classification_rate"] * envs, envs)),
         "goal_rate_by_trial": {env: [float(r) for r in v] for env, v in rates.items()},
     }
+
+
+def _hand_designed(job: plan.Job, root: Path, settings: Settings, threads: int | None,
+                   progress: bool) -> dict[str, Any]:
+    """The paper's reactive navigation: the shipped hand-designed network in every world, from
+    the same fresh starts with and without the detectors (:func:`dnnevo.robots.navigation.hand_designed`)."""
+    seed, starts = sweep.eval_seed(job.seed, settings.eval_seed), settings.starts()
+    worlds: dict[str, dict[str, dict[str, int]]] = {}
+    for world in navigation.WORLDS:
+        worlds[world] = {}
+        for condition in HAND_CONDITIONS:
+            r = navigation.hand_designed(world, starts, seed=seed, detectors=condition == "with",
+                                         steps=HAND_STEPS)
+            worlds[world][condition] = {"arrived": r["arrived"], "starts": r["starts"]}
+    return {"seed": seed, "starts": starts, "steps": HAND_STEPS, "worlds": worlds}

@@ -2,8 +2,9 @@
 
 An :class:`Experiment` is one row of the paper-vs-dnnevo table: an evolution of a preset (with
 its overrides, and seeded from other experiments' runs of the same seed where the paper does
-that), or a test of other experiments' champions (the landmark robot-like test, the integrated
-navigation system). A :class:`Job` is one experiment at one seed; it needs the jobs of the same
+that), a test of other experiments' champions (the landmark robot-like test, the integrated
+navigation system), or a test of a network designed by hand (reactive navigation's, with and
+without its detectors). A :class:`Job` is one experiment at one seed; it needs the jobs of the same
 seed that its experiment needs, and nothing else, so seeds never wait for each other.
 
 >>> [job.id for job in jobs([0], only=["sequence"])][:3]
@@ -20,7 +21,8 @@ from dataclasses import dataclass
 
 from dnnevo.errors import ConfigError, did_you_mean
 
-__all__ = ["FAMILIES", "PAPER_FAMILIES", "EXPERIMENTS", "Experiment", "Job", "jobs", "experiment"]
+__all__ = ["FAMILIES", "PAPER_FAMILIES", "EXPERIMENTS", "EVOLVE", "ROBOT_LIKE", "SYSTEM", "HAND_DESIGNED",
+           "Experiment", "Job", "jobs", "experiment"]
 
 PAPER_FAMILIES = ("landmark", "robots", "nav1d", "sequence")
 """The paper's experiment families, in the paper's order (``robots`` is §3.2's other robot
@@ -30,8 +32,9 @@ FAMILIES = (*PAPER_FAMILIES, "classic")
 """Every family; ``--only`` picks among them. ``classic`` is the field's benchmarks written as
 Python tasks (:mod:`dnnevo.classic`), which the paper does not have."""
 
-EVOLVE, ROBOT_LIKE, SYSTEM = "evolve", "robot-like", "nav1d-system"
-"""The kinds of job: an evolution run, the landmark robot-like test, the integrated system."""
+EVOLVE, ROBOT_LIKE, SYSTEM, HAND_DESIGNED = "evolve", "robot-like", "nav1d-system", "hand-designed"
+"""The kinds of job: an evolution run, the landmark robot-like test, the integrated system, the
+hand-designed reactive navigator on fresh starts (nothing evolved)."""
 
 
 @dataclass(frozen=True)
@@ -84,13 +87,18 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                "quantified)", preset="predator-avoidance",
                note="the task's arena, pursuers, sensors, fitness and success rule are dnnevo's "
                     "(docs/paper.md); a task written in Python (dnnevo.robots.pursuit)"),
-    Experiment("reactive-navigation", "robots", EVOLVE,
+    Experiment("reactive-navigation-hand", "robots", HAND_DESIGNED,
                "§3.2: a hand-designed network with static and cyclic detectors reaches a goal "
-               "(not quantified; not evolved)", preset="reactive-navigation",
-               note="dnnevo's evolved comparison, which the paper does not make: networks evolved "
-                    "to reach a goal past a U-shaped trap, without detectors; the hand-designed "
-                    "network and its detectors are examples/reactive_navigation.py "
+               "(not quantified; not evolved)",
+               note="the paper's own experiment: nothing is evolved; dnnevo's hand-designed network "
+                    "(dnnevo/robots/data/navigator.json) in an open room, a U-shaped trap and a "
+                    "cul-de-sac, from the same fresh starts with and without the detectors "
                     "(docs/reactive-navigation.md)"),
+    Experiment("reactive-navigation", "robots", EVOLVE,
+               "not in the paper (§3.2's network is hand-designed)", preset="reactive-navigation",
+               note="dnnevo's evolved comparison, which the paper does not make: networks evolved "
+                    "to reach a goal past a U-shaped trap, without detectors; the paper's own "
+                    "experiment is reactive-navigation-hand"),
     Experiment("nav1d-classifier", "nav1d", EVOLVE, "§4.2: solved at generation 5",
                preset="nav1d-classifier"),
     Experiment("nav1d-far", "nav1d", EVOLVE, "§4.2: solved at generation 0", preset="nav1d-far"),

@@ -4,7 +4,8 @@ embedded) in the reproduction's folder.
 It holds the paper-vs-dnnevo table (success rates over seeds with their Wilson intervals, final
 champions passing on fresh conditions, median first-success generations with bootstrap
 intervals, step artefacts, wall times), the robot-like test's confusion matrices, the integrated
-navigation system's goal rates, every run's figures for the first seed of each experiment, a
+navigation system's goal rates, the hand-designed reactive navigator's arrivals with and without
+its detectors, every run's figures for the first seed of each experiment, a
 fitness figure over all seeds, and the machine and settings the runs ran with.
 
 The report is made of :class:`Block` s, rendered to Markdown and to HTML by the same code, so the
@@ -28,7 +29,8 @@ from dnnevo.experiments import plan
 from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
 from dnnevo.evaluation.assessment import Assessment
-from dnnevo.experiments.jobs import ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings
+from dnnevo.experiments.jobs import HAND_CONDITIONS, ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings, hand_counts
+from dnnevo.robots.navigation import WORLDS
 from dnnevo.runs import RunDir, save_figure, write_atomic
 from dnnevo.tasks import nav1d
 from dnnevo.experiments.scheduler import Outcome
@@ -98,9 +100,22 @@ def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[st
         verdicts = [Assessment.from_dict(o.result["assessment"]).verdict for o in done if o.result]
         passed = sum(v == "pass" for v in verdicts)
         return (*head, "-", _k_of_n(passed, len(verdicts)) if verdicts else "-", "-", "-", _median_wall(walls))
+    if e.kind == plan.HAND_DESIGNED:
+        counts = [hand_counts(o.result) for o in done if o.result]
+        return (*head, "-", _hand_pooled(counts) if counts else "-", "-", "-", _median_wall(walls))
     rates = [o.result["goal_rate"] for o in done if o.result]
     text = f"goal in {', '.join(_pct(r) for r in rates)} of trials" if rates else "-"
     return (*head, "-", text, "-", "-", _median_wall(walls))
+
+
+def _hand_pooled(counts: Sequence[dict[str, dict[str, tuple[int, int]]]]) -> str:
+    """The hand-designed navigator's arrivals, world by world, with and without its detectors,
+    pooled over seeds (each seed draws its own starts)."""
+    parts = []
+    for world in WORLDS:
+        pooled = {c: tuple(sum(x[world][c][i] for x in counts) for i in (0, 1)) for c in HAND_CONDITIONS}
+        parts.append(f"{world} {_k_of_n(*pooled['with'])} / {_k_of_n(*pooled['without'])}")
+    return "goal reached with / without detectors: " + "; ".join(parts)
 
 
 SUMMARY_HEADER = ("experiment", "paper", "runs done", "seeds meeting the rule during the run (95% interval)",
@@ -132,6 +147,13 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
                          f"{_pct(overall.interval[1])})", f"[[{p}, {q}], [{s}, {t}]]",
                          ", ".join(f"{r.name} {_pct(r.rate)}" for r in a.rates[:-1]), a.verdict,
                          f"{o.result['wall_s']:.0f} s"))
+        elif e.kind == plan.HAND_DESIGNED:
+            res = o.result
+            counts = hand_counts(res)
+            rows.append((str(job.seed), *(f"{_k_of_n(*counts[w]['with'])} / {_k_of_n(*counts[w]['without'])}"
+                                          for w in WORLDS),
+                         f"{res['starts']} starts per world, seed {res['seed']}, trials of {res['steps']} steps",
+                         f"{res['wall_s']:.0f} s"))
         else:
             res = o.result
             later = res["goal_rate_by_trial"]["all"][1:]
@@ -148,6 +170,8 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
                           "per landmark", "verdict (95% rule)", "wall"),
         plan.SYSTEM: ("seed", "goal reached (95% interval, by environment)", "classifier right",
                       "goal rate in trials 2-5", "conditions", "wall"),
+        plan.HAND_DESIGNED: ("seed", *(f"{w}: goal reached with / without detectors (95% intervals)" for w in WORLDS),
+                             "conditions", "wall"),
     }[e.kind]
     rows = [row + ("",) * (len(header) - len(row)) for row in rows]
     return Block("table", rows=(header, *rows))

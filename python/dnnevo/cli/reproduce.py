@@ -29,14 +29,17 @@ continues it."""
 DESCRIPTION = """\
 Run every experiment of the paper over seeds and write a report: landmark recognition (ideal
 training, then the robot-like test of the champions), predator avoidance and reactive navigation
-(family robots), one-dimensional navigation (the three subnetworks, the goal seekers evolved on
-chains, both integrated systems, the single network) and sequence learning (1-bit, alternating,
-the incremental 2-bit route from those two runs, direct 2-bit, and beyond the paper direct 2-bit
-with 16 neurons, 3-bit). --only classic runs the field's benchmarks written as Python tasks
-instead (walker, categorical perception, double pole). Each evolution has its own run folder
-OUT/EXPERIMENT/seed-N and its result in OUT/EXPERIMENT/seed-N.json (the robot-like test and the
-integrated systems are tests of other runs and have only the result). The report, OUT/report.md
-and OUT/report.html, covers the seeds and families of the command that wrote it."""
+(family robots: the paper's hand-designed network with and without its detectors on fresh
+starts, nothing evolved, then dnnevo's evolved comparison), one-dimensional navigation (the
+three subnetworks, the goal seekers evolved on chains, both integrated systems, the single
+network) and sequence learning (1-bit, alternating, the incremental 2-bit route from those two
+runs, direct 2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). --only classic
+runs the field's benchmarks written as Python tasks instead (walker, categorical perception,
+double pole). Each evolution has its own run folder OUT/EXPERIMENT/seed-N and its result in
+OUT/EXPERIMENT/seed-N.json (the robot-like test, the integrated systems and the hand-designed
+navigator are tests and have only the result; the navigator's starts per world are
+--eval-trials, else 200, or 20 with --quick). The report, OUT/report.md and OUT/report.html,
+covers the seeds and families of the command that wrote it."""
 
 EXAMPLE = """examples:
   dnnevo reproduce --quick --seeds 0-1 --out runs/repro-quick     about a minute on 2 cores

@@ -180,7 +180,7 @@ def test_collect_takes_in_experiments_added_since_and_refuses_a_changed_one(tmp_
     source = tmp_path / "source"
     shutil.copytree(reproduction, source)
     manifest = json.loads((source / "reproduce.json").read_text())
-    older = {**manifest, "configs": {k: v for k, v in manifest["configs"].items() if k != "predator-avoidance"}}
+    older = {**manifest, "configs": {k: v for k, v in manifest["configs"].items() if k != "landmark-robust"}}
     dest.mkdir()
     (dest / "reproduce.json").write_text(json.dumps(older, indent=1) + "\n")
     r = _results("collect", source, dest, "--seeds", "0", "--only", "landmark", "--commit", "abc1234")
@@ -193,6 +193,18 @@ def test_collect_takes_in_experiments_added_since_and_refuses_a_changed_one(tmp_
     r = _results("collect", source, dest, "--seeds", "0", "--only", "landmark", "--commit", "abc1234")
     assert r.returncode == 2 and "another reproduction's settings" in r.stderr
     assert (dest / "reproduce.json").read_bytes() == before
+
+
+def test_a_family_collected_again_at_another_commit_names_both(tmp_path: Path, reproduction: Path) -> None:
+    """A reproduction continued at a later commit is collected again: the family keeps the
+    commit of its earlier runs beside the new one."""
+    dest = tmp_path / "results"
+    for commit in ("abc1234", "abc1234", "def5678"):
+        r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", commit)
+        assert r.returncode == 0, r.stderr
+    provenance = json.loads((dest / "provenance.json").read_text())
+    assert provenance["families"]["landmark"]["commit"] == "abc1234, def5678"
+    assert provenance["commit"] == "abc1234, def5678"
 
 
 def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, repo: Path) -> None:

@@ -254,12 +254,22 @@ def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
     return {**held, "configs": {**mine, **{k: v for k, v in theirs.items() if k not in mine}}}
 
 
+def _commits(before: Any, commit: str) -> str:
+    """The commits a family's collected runs were made at: those of its earlier collection and
+    ``commit``. A reproduction continued at a later commit (runs are deterministic, so a later
+    commit of the same code gives the same bits) keeps the commits of its earlier runs named."""
+    earlier = before.get("commit") if isinstance(before, dict) else None
+    names = [c.strip() for c in earlier.split(",")] if isinstance(earlier, str) else []
+    return ", ".join(dict.fromkeys([*filter(None, names), commit]))
+
+
 def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             seeds: Sequence[int] = DEFAULT_SEEDS, commit: str | None = None) -> list[str]:
     """Copies the finished results of ``families`` (default the paper's) over ``seeds`` from the
     reproduction folder ``source`` into ``dest``, each checked against its run folder as
     ``dnnevo reproduce`` checks it, with ``reproduce.json`` and ``provenance.json``. Returns the
-    ids of the jobs copied. ``dest`` must hold the same reproduction (same settings) or none."""
+    ids of the jobs copied. ``dest`` must hold the same reproduction (same settings) or none. A
+    family collected again (its reproduction continued) names the commits of both collections."""
     settings_file = source / SETTINGS_FILE
     if not settings_file.exists():
         raise DnnevoError(f"{source} holds no {SETTINGS_FILE}: not a reproduction's folder")
@@ -301,7 +311,8 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
         if done:
             ends = [p.stat().st_mtime for p in done]
             starts = [e - float(read_json(p)["wall_s"]) for p, e in zip(done, ends)]
-            times[family] = {"command": _command(seeds, family, settings), "commit": named.group(1),
+            times[family] = {"command": _command(seeds, family, settings),
+                             "commit": _commits(old.get("families", {}).get(family), named.group(1)),
                              "runs": len(done), "planned": len(plan.jobs(list(seeds), [family])),
                              "elapsed_s": round(max(ends) - min(starts))}
     write_atomic(dest / SETTINGS_FILE, json.dumps(manifest, indent=1) + "\n")

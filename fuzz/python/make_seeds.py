@@ -20,7 +20,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT / "fuzz" / "corpus"
 TINY = ["--set", "population=4", "--set", "generations=3", "--set", "size=2"]
-RESULTS = ("landmark-robot", "nav1d-system", "landmark", "nav1d-near")
+RESULTS = ("landmark-robot", "nav1d-system", "landmark", "nav1d-near", "reactive-navigation-hand")
 
 
 def dnnevo(*args: object) -> None:

@@ -20,11 +20,25 @@ The fitness values of dnnevo and NumPy are compared network by network (atol 1e-
     python bench/sequence.py [--repeats 7] [--numpy-repeats 1] [--quick]
 
 Exits with 1 if the two codes disagree; a missed target is reported, not an error.
+
+With --presets, it times instead the three costliest experiments of `dnnevo reproduce` at their
+paper sizes (sequence-3bit, sequence-2bit-direct, sequence-2bit-direct16: P = 1000, N = 10, 10
+and 16), seed 0: --warm generations run untimed (a GA's population fills with copies of its
+parents over the first generations, and dnnevo scores each distinct genome once), then
+each of --timed generations is timed twice, as the evaluation alone
+(dnnevo.evaluate on the population) and as the whole generation on the Rust side
+(GeneticAlgorithm.step: evaluation, validation of the 10 best candidates, breeding). Both wall
+and CPU seconds (all threads of the process) are printed, medians over the timed generations,
+with the share of distinct genomes in them and the projected wall time of the preset's whole
+run. The script uses only public API, so the same script times an older build:
+
+    python bench/sequence.py --presets [--warm 10] [--timed 5]
 """
 
 from __future__ import annotations
 
 import argparse
+import resource
 import statistics
 import sys
 import time
@@ -54,14 +68,73 @@ def numpy_fitness(cfg, params, generation: int, seed: int):
     return f
 
 
+PRESETS = ("sequence-3bit", "sequence-2bit-direct", "sequence-2bit-direct16")
+
+
+def cpu_seconds() -> float:
+    """CPU seconds of this process so far, every thread's."""
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
+def clocked(fn):
+    """(wall seconds, CPU seconds) of one call `fn()`."""
+    wall, cpu = time.perf_counter(), cpu_seconds()
+    fn()
+    return time.perf_counter() - wall, cpu_seconds() - cpu
+
+
+def presets_part(args) -> int:
+    describe_machine()
+    print(f"workload: the three costliest presets of dnnevo reproduce at their paper sizes, seed 0; "
+          f"{args.warm} untimed generations, then {args.timed} timed (medians); all cores")
+    print()
+    header = (f"{'preset':<24}  {'N':>2}  {'gens':>4}  {'distinct':>8}  {'eval wall s':>11}  "
+              f"{'eval CPU s':>10}  {'gen wall s':>10}  {'gen CPU s':>9}  {'run (proj.)':>11}")
+    print(header)
+    print("-" * len(header))
+    start = time.perf_counter()
+    for name in PRESETS:
+        cfg = dnnevo.presets.get(name)
+        ga = dnnevo.GeneticAlgorithm(cfg, seed=0)
+        for _ in range(args.warm):
+            ga.step()
+        evals, gens, distinct = [], [], []
+        for _ in range(args.timed):
+            genomes = ga.ask().genomes
+            distinct.append(len(np.unique(genomes.view(np.uint64), axis=0)) / len(genomes))
+            evals.append(clocked(lambda: dnnevo.evaluate(cfg.task, genomes, generation=ga.generation,
+                                                         seed=0, config=cfg)))
+            gens.append(clocked(ga.step))
+        med = lambda xs, i: statistics.median(x[i] for x in xs)  # noqa: E731
+        run = med(gens, 0) * cfg.generations
+        print(f"{name:<24}  {cfg.size:>2}  {cfg.generations:>4}  {statistics.median(distinct):>8.0%}  "
+              f"{med(evals, 0):>11.3f}  {med(evals, 1):>10.3f}  {med(gens, 0):>10.3f}  "
+              f"{med(gens, 1):>9.3f}  {run / 60:>9.1f} m")
+    print(f"total benchmark time: {time.perf_counter() - start:.1f} s")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--presets", action="store_true",
+                    help="time the three costliest paper presets instead (see above)")
+    ap.add_argument("--warm", type=int, default=10,
+                    help="with --presets: untimed generations first (default 10)")
+    ap.add_argument("--timed", type=int, default=5,
+                    help="with --presets: timed generations (default 5)")
     ap.add_argument("--repeats", type=int, default=7,
                     help="timed dnnevo runs; the median is reported (default 7)")
     ap.add_argument("--numpy-repeats", type=int, default=1,
                     help="timed NumPy generations (default 1; about 1-2 s each)")
     ap.add_argument("--quick", action="store_true", help="fewer repeats (figures are rougher)")
     args = ap.parse_args(argv)
+    if args.presets:
+        if args.quick:
+            args.warm, args.timed = min(args.warm, 3), min(args.timed, 2)
+        if args.warm < 0 or args.timed < 1:
+            ap.error("--warm must be >= 0 and --timed >= 1")
+        return presets_part(args)
     if args.quick:
         args.repeats = min(args.repeats, 3)
         args.numpy_repeats = 1

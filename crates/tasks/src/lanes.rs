@@ -9,6 +9,8 @@
 //!
 //! A lane's result never depends on its neighbours, so both give the same bits for a pair.
 
+use std::borrow::Borrow;
+use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;
 
 use ctrnn::{Block, Error, Lanes, Network, Population, Result, LANES};
@@ -23,6 +25,41 @@ use crate::common::{interrupted, Diverged};
 /// [`Error::Interrupted`] between trials once `cancel` is set; a divergence names its network.
 pub fn by_block<A, T: Send>(
     networks: &[Network],
+    trials: usize,
+    cancel: Option<&AtomicBool>,
+    start: impl Fn(usize) -> A + Sync,
+    trial: impl Fn(&mut A, usize, &mut Block, usize) -> std::result::Result<(), Diverged> + Sync,
+    finish: impl Fn(A) -> Vec<T> + Sync,
+) -> Result<Vec<T>> {
+    blocks(networks, &|p| p, trials, cancel, start, trial, finish)
+}
+
+/// [`by_block`] on `networks` that stand for others: a divergence on `networks[p]` names
+/// network `names[p]`.
+pub fn by_block_named<A, T: Send>(
+    networks: &[&Network],
+    names: &[usize],
+    trials: usize,
+    cancel: Option<&AtomicBool>,
+    start: impl Fn(usize) -> A + Sync,
+    trial: impl Fn(&mut A, usize, &mut Block, usize) -> std::result::Result<(), Diverged> + Sync,
+    finish: impl Fn(A) -> Vec<T> + Sync,
+) -> Result<Vec<T>> {
+    debug_assert_eq!(networks.len(), names.len());
+    blocks(
+        networks,
+        &|p| names[p],
+        trials,
+        cancel,
+        start,
+        trial,
+        finish,
+    )
+}
+
+fn blocks<N: Borrow<Network> + Sync, A, T: Send>(
+    networks: &[N],
+    name: &(dyn Fn(usize) -> usize + Sync),
     trials: usize,
     cancel: Option<&AtomicBool>,
     start: impl Fn(usize) -> A + Sync,
@@ -44,12 +81,64 @@ pub fn by_block<A, T: Send>(
                 if interrupted(cancel) {
                     return Err(Error::Interrupted);
                 }
-                trial(&mut acc, first, block, t).map_err(|d| d.error(|lane| first + lane))?;
+                trial(&mut acc, first, block, t).map_err(|d| d.error(|lane| name(first + lane)))?;
             }
             Ok(finish(acc))
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(per_block.into_iter().flatten().collect())
+}
+
+/// The networks of a batch with duplicates told apart: networks equal bit for bit in every
+/// parameter and in their state are one kind. Where every network meets the same trials, a lane's
+/// results depend only on its network (never on its neighbours), so one network of each kind can
+/// run for all of its kind with the same bits. A GA population is full of such copies: children
+/// that neither crossover nor mutation changed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Kinds {
+    /// The index of each kind's first network, in order of first appearance.
+    pub firsts: Vec<usize>,
+    /// The kind of every network: an index into `firsts`.
+    pub kind: Vec<usize>,
+}
+
+impl Kinds {
+    /// The kinds of `networks`.
+    pub fn of(networks: &[Network]) -> Kinds {
+        let mut seen: HashMap<Vec<u64>, usize> = HashMap::with_capacity(networks.len());
+        let mut firsts = Vec::new();
+        let kind = networks
+            .iter()
+            .enumerate()
+            .map(|(p, net)| {
+                let shape = [net.size() as u64, net.n_inputs() as u64];
+                let key: Vec<u64> = shape
+                    .into_iter()
+                    .chain(
+                        [
+                            net.tau(),
+                            net.theta(),
+                            net.weights(),
+                            net.sensor_weights(),
+                            net.state(),
+                        ]
+                        .iter()
+                        .flat_map(|part| part.iter().map(|x| x.to_bits())),
+                    )
+                    .collect();
+                *seen.entry(key).or_insert_with(|| {
+                    firsts.push(p);
+                    firsts.len() - 1
+                })
+            })
+            .collect();
+        Kinds { firsts, kind }
+    }
+
+    /// Whether every network is of its own kind.
+    pub fn all_distinct(&self) -> bool {
+        self.firsts.len() == self.kind.len()
+    }
 }
 
 /// The (network, trial) pairs of `networks` x `trials`, network-major, cut into groups of

@@ -8,7 +8,7 @@ use ctrnn::genome::{self, Layout, Ranges};
 use ctrnn::{Network, Purpose, Stream};
 
 pub use crate::common::Diverged;
-pub use crate::lanes::{by_block, by_pair, pairs};
+pub use crate::lanes::{by_block, by_pair, pairs, Kinds};
 
 /// `count` random networks of `layout` over the paper's ranges: network `i` is genome `i` of the
 /// genetic algorithm's initial population for `seed`, drawn from

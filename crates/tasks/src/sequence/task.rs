@@ -6,7 +6,7 @@ use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Valida
 use serde::{Deserialize, Serialize};
 
 use crate::common::check_inputs;
-use crate::lanes::{by_block, by_pair, pairs};
+use crate::lanes::{by_block_named, by_pair, pairs, Kinds};
 use crate::Aggregate;
 
 use super::config::*;
@@ -198,9 +198,21 @@ impl SequenceTask {
                 .collect()
         };
         let order = self.trial_order(seed, generation);
+        // Copies of a network meet the same trials (unless each draws its own), so one of each
+        // kind runs for all; a GA population is a third to a half copies.
+        let kinds = if config.independent_conditions {
+            None
+        } else {
+            Some(Kinds::of(networks)).filter(|k| !k.all_distinct() && same_shape(networks))
+        };
+        let (run, names): (Vec<&Network>, Vec<usize>) = match &kinds {
+            Some(kinds) => kinds.firsts.iter().map(|&p| (&networks[p], p)).unzip(),
+            None => networks.iter().enumerate().map(|(p, net)| (net, p)).unzip(),
+        };
         // Lane-major within a block: [lane][trial][trigger].
-        let r = by_block(
-            networks,
+        let r = by_block_named(
+            &run,
+            &names,
             n_trials,
             cancel,
             |len| vec![0.0; len * n_trials * k],
@@ -238,6 +250,18 @@ impl SequenceTask {
             },
             |out| out,
         )?;
+        let r = match &kinds {
+            Some(kinds) => {
+                let per = n_trials * k;
+                kinds
+                    .kind
+                    .iter()
+                    .flat_map(|&j| &r[j * per..(j + 1) * per])
+                    .copied()
+                    .collect()
+            }
+            None => r,
+        };
         let mean_r: Vec<f64> = r.chunks(k).map(mean).collect();
         let base = self.bases(&mean_r);
         let fitness = mean_r
@@ -560,4 +584,12 @@ impl Task for SequenceTask {
                 .collect(),
         ))
     }
+}
+
+/// Whether every network has the first one's N and M (a population needs it; without, the
+/// population's own error names the first network that differs).
+fn same_shape(networks: &[Network]) -> bool {
+    networks
+        .iter()
+        .all(|n| (n.size(), n.n_inputs()) == (networks[0].size(), networks[0].n_inputs()))
 }

@@ -1,7 +1,7 @@
 use std::sync::atomic::AtomicBool;
 
 use ctrnn::{Error, Integrator, Lanes, Network, LANES};
-use tasks::testing::{by_block, by_pair, pairs, Diverged};
+use tasks::testing::{by_block, by_pair, pairs, Diverged, Kinds};
 
 /// One self-inhibiting neuron driven by its sensor: with a tiny tau, Euler diverges.
 fn neuron(tau: f64) -> Network {
@@ -69,4 +69,18 @@ fn blocks_return_results_in_network_order() {
     )
     .unwrap()
     .is_empty());
+}
+
+#[test]
+fn kinds_tell_copies_apart_bit_for_bit() {
+    let (a, b) = (neuron(1.0), neuron(2.0));
+    let mut a_moved = a.clone();
+    a_moved.set_state(Some(&[0.5])).unwrap();
+    // Equal values with other bits are told apart (never wrongly merged).
+    let minus_zero = Network::new(vec![1.0], vec![-0.0], vec![-5.0], vec![1.0], None).unwrap();
+    let kinds = Kinds::of(&[a.clone(), b.clone(), a.clone(), a_moved, b, minus_zero]);
+    assert_eq!(kinds.firsts, vec![0, 1, 3, 5]);
+    assert_eq!(kinds.kind, vec![0, 1, 0, 2, 1, 3]);
+    assert!(!kinds.all_distinct());
+    assert!(Kinds::of(&[a]).all_distinct());
 }

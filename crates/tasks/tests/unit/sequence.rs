@@ -236,6 +236,47 @@ fn evaluation_does_not_depend_on_threads() {
 }
 
 #[test]
+fn copies_in_a_batch_score_as_if_each_ran() {
+    // A population of copies (as a GA breeds them) runs one network of each kind; every copy's
+    // R, and so every fitness, has the bits of the network run alone.
+    let t = task(SequenceConfig {
+        perf_base: PerfBase::GenerationMean,
+        ..small()
+    });
+    let distinct = random_networks(23, 8);
+    let picks: Vec<usize> = (0..70).map(|i| (i * 7 + i / 5) % 23).collect();
+    let nets: Vec<Network> = picks.iter().map(|&i| distinct[i].clone()).collect();
+    let scores = t.scores(&nets, 2, 6, None).unwrap();
+    let per = scores.trials * scores.triggers;
+    let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    for (p, &i) in picks.iter().enumerate() {
+        let alone = t.scores(&distinct[i..i + 1], 2, 6, None).unwrap();
+        assert_eq!(
+            bits(&scores.r[p * per..(p + 1) * per]),
+            bits(&alone.r),
+            "network {p}"
+        );
+    }
+    // The generation's base and every fitness as when each copy ran in its own lanes: the same
+    // batch made of distinct networks (each nudged apart in its state, which a trial resets).
+    let nudged: Vec<Network> = nets
+        .iter()
+        .enumerate()
+        .map(|(p, n)| {
+            let mut state = vec![0.0; n.size()];
+            state[0] = p as f64 * 1e-3;
+            let mut n = n.clone();
+            n.set_state(Some(&state)).unwrap();
+            n
+        })
+        .collect();
+    let apart = t.scores(&nudged, 2, 6, None).unwrap();
+    assert_eq!(bits(&scores.r), bits(&apart.r));
+    assert_eq!(bits(&scores.base), bits(&apart.base));
+    assert_eq!(bits(&scores.fitness), bits(&apart.fitness));
+}
+
+#[test]
 fn independent_conditions_use_each_individuals_timings() {
     let t = task(SequenceConfig {
         independent_conditions: true,

@@ -428,8 +428,11 @@ impl Evolution {
             .iter()
             .map(|&i| genome_key(&self.population[i * g..(i + 1) * g]))
             .collect();
+        // Each genome once: not one the last generation validated, nor a copy of a candidate
+        // before it (a GA's best are often copies of one parent).
+        let mut asked = std::collections::HashSet::with_capacity(chosen.len());
         let fresh: Vec<usize> = (0..chosen.len())
-            .filter(|&k| !self.cache.run.contains_key(&keys[k]))
+            .filter(|&k| !self.cache.run.contains_key(&keys[k]) && asked.insert(&keys[k]))
             .collect();
         let batch: Vec<Network> = fresh.iter().map(|&k| nets[chosen[k]].clone()).collect();
         let scores = if batch.is_empty() {

@@ -225,6 +225,37 @@ fn fitness_told_from_outside_is_validated_as_a_task_validates_it() {
 }
 
 #[test]
+fn copies_among_the_candidates_are_validated_once() {
+    // Ten copies of one network lead the population: the validation sees it once, and every
+    // copy gets its validation.
+    let evo = |seeds: &[Network]| {
+        Evolution::new(Excite.layout(), config(), 3, seeds, Fill::Random).unwrap()
+    };
+    let one = evo(&[]).networks().unwrap().remove(7);
+    let mut copies = evo(&vec![one.clone(); 10]);
+    let mut fitness = vec![0.1; 40];
+    fitness[..10].fill(0.9);
+    let mut batches = vec![];
+    let rate = |net: &Network| net.tau()[0] / 100.0;
+    copies
+        .tell_validating(&fitness, |batch| {
+            batches.push(batch.len());
+            Ok(batch
+                .iter()
+                .map(|n| Validation {
+                    rate: rate(n),
+                    score: 0.0,
+                })
+                .collect())
+        })
+        .unwrap();
+    assert_eq!(batches, vec![1]);
+    let champion = copies.champion.unwrap();
+    assert_eq!(champion.genes, genome::encode(&one));
+    assert_eq!(champion.validation.unwrap().rate, rate(&one));
+}
+
+#[test]
 fn a_validation_told_from_outside_is_checked() {
     let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
     let fitness = vec![0.5; 40];

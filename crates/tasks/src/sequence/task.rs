@@ -510,9 +510,13 @@ impl SequenceTask {
             let timings: Vec<Vec<(usize, usize)>> = (0..per_target)
                 .map(|j| self.fresh_timings(purpose, seed, i * per_target + j))
                 .collect();
-            let pairs = pairs(nets.len(), per_target);
+            // Lanes run in lockstep until the longest trial of their group ends: pairs go to
+            // groups by their trial's length (a stable sort), so that few lanes idle. A lane's
+            // results do not depend on its neighbours; they are put back in pair order below.
+            let mut pairs = pairs(nets.len(), per_target);
+            pairs.sort_by_key(|&(_, j)| self.trial_steps(&timings[j]));
             let groups: Vec<&[(usize, usize)]> = pairs.chunks(LANES).collect();
-            let judged = by_pair(nets, &groups, cancel, |lanes, lane_pairs, len| {
+            let sorted = by_pair(nets, &groups, cancel, |lanes, lane_pairs, len| {
                 let lane_timings = lane_pairs.map(|(_, j)| timings[j].as_slice());
                 let outcome = run_lanes(config, lanes, bits, lane_timings, true, false, |_, _| {})?;
                 Ok((0..len)
@@ -524,11 +528,29 @@ impl SequenceTask {
                     })
                     .collect())
             })?;
+            let mut judged = vec![(0.0, false); sorted.len()];
+            for (&(n, j), result) in pairs.iter().zip(sorted) {
+                judged[n * per_target + j] = result;
+            }
             for (n, trials) in judged.chunks(per_target).enumerate() {
                 out[n].push(trials.to_vec());
             }
         }
         Ok(out)
+    }
+
+    /// Time steps of a trial with `timing` that stops after its last trigger window, as
+    /// validation and assessment trials do.
+    fn trial_steps(&self, timing: &[(usize, usize)]) -> usize {
+        let c = &self.config;
+        let cycles: usize = timing
+            .iter()
+            .map(|&(d, g)| c.trigger_steps + d + c.reinforcement_steps + g)
+            .sum();
+        match timing.last() {
+            Some(&(d, g)) => cycles - (d + c.reinforcement_steps + g),
+            None => 0,
+        }
     }
 }
 

@@ -23,6 +23,11 @@ def test_the_source_commit_is_the_checkout_s_and_says_when_it_is_dirty(tmp_path:
     git(tmp_path, "-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "one")
     head = git(tmp_path, "rev-parse", "--short=12", "HEAD")
     assert examples.source_commit(code) == head
+    # A new module not yet added to the checkout makes it dirty, as a changed one does.
+    (tmp_path / "new_module.py").write_text("y = 1\n")
+    assert examples.source_commit(code) == f"{head}-dirty"
+    (tmp_path / "new_module.py").unlink()
+    assert examples.source_commit(code) == head
     code.write_text("x = 2\n")
     assert examples.source_commit(code) == f"{head}-dirty"
     # A file the checkout does not track (an installed wheel's copy) names no commit.

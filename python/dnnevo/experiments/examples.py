@@ -97,7 +97,7 @@ def seeds_run(one_seed: Callable[..., Any], seeds: int, workers: int, *args: Any
 def source_commit(module: Path) -> str | None:
     """The commit of the git checkout that the Python file ``module`` is tracked in (an editable
     install runs the checkout's Python code), with ``-dirty`` when the checkout has uncommitted
-    changes; None when the file is tracked by none (an installed wheel) or git is missing."""
+    changes or files it does not track (and does not ignore); None when the file is tracked by none (an installed wheel) or git is missing."""
 
     def git(*args: str) -> subprocess.CompletedProcess[str]:
         return subprocess.run(["git", "-C", str(module.parent), *args], capture_output=True, text=True, timeout=30)
@@ -106,7 +106,7 @@ def source_commit(module: Path) -> str | None:
         if git("ls-files", "--error-unmatch", module.name).returncode != 0:
             return None
         head = git("rev-parse", "--short=12", "HEAD")
-        status = git("status", "--porcelain", "--untracked-files=no")
+        status = git("status", "--porcelain")  # a new module not yet added is a change too
     except (OSError, subprocess.SubprocessError):
         return None
     if head.returncode != 0 or status.returncode != 0:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import errno
 import fcntl
 import io
 import json
@@ -49,6 +50,8 @@ from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth, first_d
 __all__ = ["FIGURES", "LOCK_NAME", "RUN_FILES", "RunDir"]
 
 LOCK_NAME = ".dnnevo.lock"
+#: Why a folder's lock file cannot be made that says the folder cannot be written at all.
+_UNWRITABLE = frozenset({errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT})
 RUN_FILES = ("config.toml", "log.csv", "best.json", "checkpoint.json")
 #: Every file ``show``, ``plot`` and ``analyze`` derive from a run; ``--force`` removes them with
 #: the run's files.
@@ -102,8 +105,9 @@ class RunDir:
         try:
             fd = os.open(self.lock_file, flags, FILE_MODE)
         except OSError as e:
-            # The folder itself is what cannot be written (read-only, no permission, full).
-            raise WriteError(f"{self.path} cannot be written: {write_failure(e)}") from None
+            if e.errno in _UNWRITABLE:  # the folder itself cannot be written
+                raise WriteError(f"{self.path} cannot be written: {write_failure(e)}") from None
+            raise DnnevoError(f"cannot open the lock file {self.lock_file}: {e.strerror}") from None
         try:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)

@@ -134,6 +134,7 @@ def test_a_tampered_result_is_refused(tmp_path: Path) -> None:
     ("reactive-navigation-hand", (), lambda d: d.update(starts=20)),
     ("reactive-navigation-hand", (), lambda d: d.update(seed=d["seed"] + 1)),
     ("reactive-navigation-hand", (), lambda d: d.update(steps="1200")),
+    ("reactive-navigation-hand", (), lambda d: d.update(steps=600)),  # trials of another length
 ])
 def test_a_result_of_the_wrong_shape_is_named(tmp_path: Path, experiment: str, needs: tuple[str, ...],
                                               edit: Any) -> None:

@@ -207,10 +207,12 @@ def hand_counts(found: dict[str, Any]) -> dict[str, dict[str, tuple[int, int]]]:
     """The hand-designed navigator's counts in a result, ``(arrived, starts)`` by world
     (:data:`~dnnevo.robots.navigation.WORLDS`) and condition (:data:`HAND_CONDITIONS`), checked:
     every world and condition there and nothing else, each count an integer, ``arrived`` from 0
-    to ``starts``, ``starts`` the result's, and its ``seed`` and ``steps`` integers too. Raises
+    to ``starts``, ``starts`` the result's, its ``seed`` an integer and its ``steps``
+:data:`HAND_STEPS` (a result of trials of another length is not pooled with these). Raises
     ValueError, KeyError or TypeError otherwise."""
     _count(found["seed"], "seed")
-    _count(found["steps"], "steps", 1)
+    if _count(found["steps"], "steps", 1) != HAND_STEPS:  # trials of another length
+        raise ValueError(f"steps is {found['steps']}; this dnnevo's trials take {HAND_STEPS}")
     starts = _count(found["starts"], "starts", 1)
     worlds = found["worlds"]
     if not isinstance(worlds, dict) or sorted(worlds) != sorted(navigation.WORLDS):

@@ -48,6 +48,7 @@ import numpy.typing as npt
 
 from dnnevo import _core, plot
 from dnnevo.analysis import events
+from dnnevo.closedloop import named
 from dnnevo.closedloop.loop import Rollout
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
@@ -356,6 +357,7 @@ def pursuer_appears(config: EvolutionConfig, net: _core.Network, seed: int, titl
         out[:, found["sonars"]:] = 0.0
         return out
 
+    limit = int(named.closed_loop(config).settings["max_steps"])  # type: ignore[call-overload]
     natural = user.record(config, net, episodes, seed=seed, probe=probe)
     m = found["sonars"]
     at_start = sum(bool((e.inputs[0, m:] > 0).any()) for e in natural)
@@ -364,10 +366,13 @@ def pursuer_appears(config: EvolutionConfig, net: _core.Network, seed: int, titl
     groups = {name: [_event(e, t, before, after, found["settings"], left, right)
                      for e in recorded for t in appears(e.inputs[:, m:], quiet=before)]
               for name, recorded in (("trained world", natural), (hidden_name, probed))}
+    for evs in groups.values():
+        for ev in evs:  # an episode that ended inside the window before the step limit: caught
+            ev["caught"] = ev["at"] + after >= ev["length"] and ev["length"] < limit
     t_axis = np.asarray(np.arange(-before, after + 1) * loop_dt, dtype=np.float64)
     doc: dict[str, Any] = {**a, "seed": seed, "purpose": "evaluate", "visible_at_start": at_start,
                            "t": t_axis.tolist(), "series": SERIES,
-                           "groups": {name: _group(evs, before) for name, evs in groups.items()}}
+                           "groups": {name: _group(evs, before, round(1.0 / loop_dt)) for name, evs in groups.items()}}
     lines = [f"pursuer appears: in the trained world the pursuer sensor reads a pursuer from the first step in "
              f"{at_start}/{episodes} fresh episodes (seed {seed}); one appears after {a['before_s']:g} s unseen "
              f"{len(groups['trained world'])} times"]
@@ -390,11 +395,12 @@ def pursuer_appears(config: EvolutionConfig, net: _core.Network, seed: int, titl
     return ViewResult("pursuer_appears", doc, lines, {"analysis-pursuer.png": fig})
 
 
-def _group(evs: list[dict[str, Any]], zero: int) -> dict[str, Any]:
+def _group(evs: list[dict[str, Any]], zero: int, per_second: int) -> dict[str, Any]:
     """One group's numbers: counts for the summary, and each series' mean and standard deviation
-    over the events at each step (None where no event has a value)."""
+    over the events at each step (None where no event has a value); ``per_second`` steps make a
+    second."""
     lasted = [e for e in evs if np.isfinite(e["distance"][-1])]
-    second = zero + 10
+    second = zero + per_second
     after = np.array([e["away_speed"][zero:] for e in evs]) if evs else np.zeros((0, 1))
     with warnings.catch_warnings():  # a step that every appearance's episode has ended by is NaN
         warnings.simplefilter("ignore", RuntimeWarning)
@@ -408,7 +414,7 @@ def _group(evs: list[dict[str, Any]], zero: int) -> dict[str, Any]:
             "moves_away": sum(bool(np.mean(e["away_speed"][zero:]) > 0) for e in lasted),
             "farther": sum(bool(e["distance"][-1] > e["distance"][zero]) for e in lasted),
             "turns_away_1s": sum(bool(np.nanmean(e["turn_away"][zero:second + 1]) > 0) for e in evs),
-            "caught": sum(bool(np.isnan(e["distance"][-1])) for e in evs),
+            "caught": sum(bool(e["caught"]) for e in evs),
         }
         for name in (*SERIES, "rates"):
             if evs:

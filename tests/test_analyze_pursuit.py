@@ -4,6 +4,7 @@ refusal for a Python task that declares nothing."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -11,7 +12,9 @@ import numpy as np
 import pytest
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
-from dnnevo import analysis
+from dnnevo import analysis, presets
+from dnnevo.closedloop import named
+from dnnevo.errors import ConfigError
 from dnnevo.analysis import events
 from dnnevo.robots import Pursuit
 from dnnevo.robots.pursuit import appears
@@ -67,6 +70,20 @@ def test_recorded_episodes_are_the_judged_ones_and_replay_exactly(run: Path) -> 
     assert np.allclose(1.0 / (1.0 + np.exp(-(states - net.theta))), outputs, atol=1e-12)
     again = user.record(config, net, 1, seed=3)[0]
     assert np.array_equal(again.inputs, inputs)
+    # The judged episodes: as long, one by one, as those `dnnevo assess --seed 3` runs.
+    recorded = user.record(config, net, 6, seed=3)
+    _, _, judged = named.closed_loop(config).judged(net, 6, 3, "evaluate")
+    assert [len(e.outputs) for e in recorded] == judged.lengths.ravel().tolist()
+
+
+@pytest.mark.parametrize("bad", [dict(main_input=1.0), dict(main_input=True), dict(output_neuron="0"),
+                                 dict(output_neuron=6), dict(input_names="abc"),
+                                 dict(conditions={"x": ["a"] * 12}), dict(conditions={"x": [float("nan")] * 12})])
+def test_a_wrong_declaration_is_one_line_naming_it(bad: dict[str, object], monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(Pursuit, "analysis", dataclasses.replace(Pursuit.analysis, **bad))  # type: ignore[arg-type]
+    name = next(iter(bad))
+    with pytest.raises(ConfigError, match=r"Pursuit\.analysis" + (": condition 'x'" if name == "conditions" else rf"\.{name}")):
+        user.analysed(presets.get("predator-avoidance"))
 
 
 def test_a_pursuer_appears_when_it_comes_within_the_sensors_reach() -> None:

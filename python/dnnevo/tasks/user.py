@@ -16,6 +16,7 @@ real trials are fresh episodes recorded step by step (:func:`record`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -113,23 +114,35 @@ def analysed(config: EvolutionConfig) -> UserTask:
     if not isinstance(a, Analysis):
         raise ConfigError(_refusal(config.task))
     m, where = config.n_inputs, f"{cls.__name__}.analysis"
+
+    def index(name: str, value: Any, n: int, what: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < n:
+            raise ConfigError(f"{where}.{name} is {value!r}; the {what} are 0..{n - 1}")
+        return value
+
+    if isinstance(a.input_names, str) or not all(isinstance(x, str) for x in a.input_names):
+        raise ConfigError(f"{where}.input_names is {a.input_names!r}; expected a list of names")
     if len(a.input_names) != m:
         raise ConfigError(f"{where} names {len(a.input_names)} inputs; the run's network has {m}")
     if not a.conditions:
         raise ConfigError(f"{where} has no conditions; it needs at least one input vector")
+    conditions = {}
     for name, v in a.conditions.items():
-        if len(v) != m:
-            raise ConfigError(f"{where}: condition {name!r} has {len(v)} values; the network has {m} inputs")
-    if not 0 <= a.main_input < m:
-        raise ConfigError(f"{where}.main_input is {a.main_input}; the inputs are 0..{m - 1}")
-    if not 0 <= a.output_neuron < config.size:
-        raise ConfigError(f"{where}.output_neuron is {a.output_neuron}; the neurons are 0..{config.size - 1}")
+        try:
+            values = [float(x) for x in v]
+        except (TypeError, ValueError):
+            raise ConfigError(f"{where}: condition {name!r} is {v!r}; expected {m} numbers") from None
+        if len(values) != m or not all(math.isfinite(x) for x in values):
+            raise ConfigError(f"{where}: condition {name!r} is {v!r}; expected {m} finite numbers, one per input")
+        conditions[str(name)] = values
+    index("main_input", a.main_input, m, "inputs")
+    index("output_neuron", a.output_neuron, config.size, "neurons")
     if isinstance(a.episodes, bool) or not isinstance(a.episodes, int) or a.episodes < 1:
         raise ConfigError(f"{where}.episodes is {a.episodes!r}; expected a whole number >= 1")
     task = UserTask(config.task)
     task.analysis = a
     task.INPUT_NAMES = list(a.input_names)
-    task.ANALYSIS_CONDITIONS = {name: [float(x) for x in v] for name, v in a.conditions.items()}
+    task.ANALYSIS_CONDITIONS = conditions
     task.MAIN_INPUT, task.OUTPUT_NEURON = a.main_input, a.output_neuron
     task.ANALYSIS_VIEWS = tuple(a.views)
     return task

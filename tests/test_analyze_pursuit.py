@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 from cli_helpers import assert_one_line_error, assert_png, run_cli
 
+import dnnevo
 from dnnevo import analysis, presets
 from dnnevo.closedloop import named
-from dnnevo.errors import ConfigError
+from dnnevo.errors import ConfigError, TaskError
 from dnnevo.analysis import events
 from dnnevo.robots import Pursuit
 from dnnevo.robots.pursuit import appears
@@ -136,3 +137,26 @@ def test_the_analysis_declaration_leaves_the_runs_digest_alone() -> None:
     config = presets.get("predator-avoidance")
     digest = named.closed_loop(config).digest()
     assert digest == "9cd751a8cf583ae73f4345f0bbc6415a4e8386ae9044bfb5529ef83ddd52f7f4"
+
+
+def test_a_task_that_breaks_the_protocol_while_recorded_is_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Recording checks the observations as a rollout does, and shows the task read-only rates."""
+    config = presets.get("predator-avoidance")
+    net = dnnevo.Network.random(config.size, config.n_inputs, seed=1)
+    real = Pursuit.step
+
+    def wrong_shape(self, rates, active):  # type: ignore[no-untyped-def]
+        obs, reward, done = real(self, rates, active)
+        return obs[:, :3], reward, done
+
+    monkeypatch.setattr(Pursuit, "step", wrong_shape)
+    with pytest.raises(TaskError, match=r"Pursuit\.step returned observations of shape \(2, 3\)"):
+        user.record(config, net, 2, seed=0)
+
+    def writes(self, rates, active):  # type: ignore[no-untyped-def]
+        rates[:] = 0.0
+        return real(self, rates, active)
+
+    monkeypatch.setattr(Pursuit, "step", writes)
+    with pytest.raises(ValueError, match="read-only"):
+        user.record(config, net, 2, seed=0)

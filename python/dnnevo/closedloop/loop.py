@@ -28,7 +28,7 @@ from dnnevo._checks import nonnegative
 from dnnevo.closedloop.environment import Environment
 from dnnevo.errors import InvalidArgumentError, TaskError
 
-__all__ = ["Rollout", "rollout"]
+__all__ = ["Rollout", "observations", "read_only", "rollout"]
 
 
 @dataclass(frozen=True)
@@ -78,7 +78,7 @@ def rollout(
                         f"have {m} inputs")
     rng = np.random.default_rng(_core.condition_seed(seed, generation, purpose))
     labels = np.tile(np.arange(episodes, dtype=np.int64), batch.networks)
-    obs = _observations(_call(env, "reset", labels, rng), env, "reset", rows, m)
+    obs = observations(_call(env, "reset", labels, rng), env, "reset", rows, m)
     active = np.ones(rows, dtype=bool)
     ended = np.empty(rows, dtype=bool)
     returns = np.zeros(rows)
@@ -86,7 +86,7 @@ def rollout(
     rates = np.empty((rows, batch.size))
     # The environment sees read-only views: it can neither change what the loop keeps nor
     # hand the rates back as the next observations to be written over.
-    seen_rates, seen_active = _read_only(rates), _read_only(active)
+    seen_rates, seen_active = read_only(rates), read_only(active)
     step = env.step
     # The loop is the hot path: one call of the batch and one of the environment per time step,
     # and three whole-array operations. The checks cost nothing while the environment keeps to
@@ -109,7 +109,7 @@ def rollout(
             raise TaskError(f"{_name(env)}.step returned {type(out).__name__}; expected a tuple "
                             "(observations, rewards, done)") from None
         if type(obs) is not np.ndarray or obs.shape != (rows, m) or obs.dtype.char not in "df":
-            obs = _observations(obs, env, "step", rows, m)
+            obs = observations(obs, env, "step", rows, m)
         if np.may_share_memory(obs, rates):
             obs = obs.copy()  # the batch writes the rates while it reads the observations
         if type(reward) is not np.ndarray or reward.shape != (rows,) or reward.dtype.kind not in "biuf":
@@ -154,9 +154,11 @@ def _numeric(value: Any, env: Any, what: str) -> npt.NDArray[Any]:
     return arr
 
 
-def _observations(value: Any, env: Any, method: str, rows: int, m: int) -> npt.NDArray[Any]:
-    """The observations as a (B, M) float array for the batch: the environment's own array when it
-    is already float64 or float32 (the batch checks that a running row's are finite)."""
+def observations(value: Any, env: Any, method: str, rows: int, m: int) -> npt.NDArray[Any]:
+    """The observations that ``env.method`` returned, as a (B, M) = (``rows``, ``m``) float array
+    for the batch: the environment's own array when it is already float64 or float32 (the batch
+    checks that a running row's are finite). Another shape, or values that are not numbers, is a
+    :class:`~dnnevo.TaskError` naming the method."""
     obs = value if isinstance(value, np.ndarray) else _numeric(value, env, f"observations from {method}")
     if obs.shape != (rows, m):
         raise TaskError(f"{_name(env)}.{method} returned observations of shape {obs.shape}; "
@@ -190,7 +192,8 @@ def _check_rewards(reward: npt.NDArray[Any], returns: npt.NDArray[np.float64], e
                     "sum below 1.8e308 (scale the rewards down if it overflowed)")
 
 
-def _read_only(array: npt.NDArray[Any]) -> npt.NDArray[Any]:
+def read_only(array: npt.NDArray[Any]) -> npt.NDArray[Any]:
+    """A read-only view of ``array``, which shows its later changes: what a task is shown."""
     view = array.view()
     view.flags.writeable = False
     return view

@@ -27,6 +27,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo.closedloop import named
+from dnnevo.closedloop.loop import observations, read_only
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, rate
@@ -184,12 +185,16 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
     batch = _core.Batch([net], replicas=episodes, dt=s.dt, substeps=s.substeps, method=method)
     batch.reset()
     rng = np.random.default_rng(_core.condition_seed(seed, 0, "evaluate"))
-    obs = np.asarray(env.reset(np.arange(episodes, dtype=np.int64), rng), dtype=float)
+    m = batch.n_inputs
+    # Checked as a rollout checks them: a task that breaks the protocol is a one-line TaskError.
+    obs = np.asarray(observations(env.reset(np.arange(episodes, dtype=np.int64), rng), env, "reset", episodes, m),
+                     dtype=float)
     active = np.ones(episodes, dtype=bool)
     lengths = np.full(episodes, max_steps, dtype=np.int64)
     if max_steps < 1:
         raise ConfigError(f"task_params.max_steps is {max_steps}: no step to record")
     rates = np.empty((episodes, batch.size))
+    seen_rates, seen_active = read_only(rates), read_only(active)  # the task may not write them
     ins: list[_Array] = []
     outs: list[_Array] = []
     probed: list[dict[str, npt.NDArray[Any]]] = []
@@ -201,8 +206,8 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
         outs.append(rates.copy())
         if probe is not None:
             probed.append({k: np.array(v) for k, v in probe(env).items()})
-        seen, _, done = env.step(rates, active)
-        obs = np.asarray(seen, dtype=float)
+        seen, _, done = env.step(seen_rates, seen_active)
+        obs = np.array(observations(seen, env, "step", episodes, m), dtype=float)  # a copy: never the rates
         ended = active & np.asarray(done, dtype=bool)
         lengths[ended] = t + 1
         active &= ~ended

@@ -498,7 +498,8 @@ impl Evolution {
                 break;
             }
             let key = genome_key(&self.population[i * g..(i + 1) * g]);
-            let at_finer_step = match self.cache.finer.get(&key) {
+            // A copy of a candidate checked before, this generation or the last, is not checked again.
+            let at_finer_step = match finer.get(&key).or_else(|| self.cache.finer.get(&key)) {
                 Some(v) => *v,
                 None => self.validate_one_finer(task, &nets[i], cancel)?,
             };

@@ -494,6 +494,31 @@ fn the_step_check_keeps_artefacts_from_the_championship_and_leaves_evolution_unc
 }
 
 #[test]
+fn copies_among_the_would_be_champions_are_step_checked_once() {
+    // A population of copies of one step artefact: every candidate's validation at the run's
+    // step beats the worse of its two, so each copy would be checked in turn; one check does.
+    let task = Jumpy::default();
+    let first = Evolution::new(task.layout(), step_checked(), 5, &[], Fill::Mutants).unwrap();
+    let mut genes = genome::encode(&first.networks().unwrap()[0]);
+    genes[0] = f64::from_bits(genes[0].to_bits() | 1);
+    let one = genome::decode(task.layout(), &genes).unwrap();
+    assert!(artefact(&one));
+    let mut copies = Evolution::new(
+        task.layout(),
+        step_checked(),
+        5,
+        &vec![one.clone(); 40],
+        Fill::Mutants,
+    )
+    .unwrap();
+    copies.step(&task, None).unwrap();
+    assert_eq!(task.checked.load(std::sync::atomic::Ordering::Relaxed), 1);
+    // The champion holds the worse of its two validations: the finer step's.
+    let held = copies.champion.as_ref().unwrap().validation.unwrap();
+    assert_eq!(held, at_finer_step(&one));
+}
+
+#[test]
 fn step_checked_runs_resume_identically_and_old_checkpoints_read_unchanged() {
     let task = Jumpy::default();
     let mut a = Evolution::new(task.layout(), step_checked(), 6, &[], Fill::Mutants).unwrap();

@@ -109,6 +109,11 @@ def test_the_sonar_features_are_of_the_champions_test_trials() -> None:
     assert y.tolist() == [0, 0, 1, 1]
     again = [observer.features(landmark.record(cfg, net, 2, seed=9, trial=3).input, landmark_transfer.NEAR)]
     assert np.array_equal(x[3], again[0])
+    # ... and those recorded trials are the ones assess judges, trial by trial, in the same order.
+    judged = landmark.assess(cfg, net, 2, seed=9)["trials"]
+    recorded = [(lm, landmark.record(cfg, net, lm, seed=9, trial=t).classification)
+                for t, lm in enumerate([1, 1, 2, 2])]
+    assert [(lm, f) for lm, f in judged] == recorded
 
 
 def test_a_tiny_run_makes_a_record_that_renders(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

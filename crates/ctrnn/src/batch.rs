@@ -7,6 +7,10 @@
 //! every row's firing rates. Rows can be left out of a step (an ended episode), reset to zero (a
 //! new one), or given any state.
 //!
+//! A batch can also hold fewer rows than `P * E` ([`Batch::with_rows`]) and hand a row to another
+//! network when the row's episode ends ([`Batch::assign`]): a closed-loop rollout then keeps every
+//! row busy with the episodes still waiting, instead of stepping ended rows' environments.
+//!
 //! One row fed the same inputs gives the same bits as [`Network::run`]: both step through the
 //! same kernel in the same order of operations.
 
@@ -45,6 +49,8 @@ pub struct Batch {
     replicas: usize,
     integ: Integrator,
     networks: Vec<Network>,
+    /// The network each row runs, an index into `networks`.
+    network_of: Vec<usize>,
     blocks: Vec<Block>,
     /// Each block's work arrays, reused from step to step so that a step allocates nothing.
     slots: Vec<Slot>,
@@ -74,23 +80,57 @@ impl Batch {
         replicas: usize,
         integ: Integrator,
     ) -> Result<Self> {
+        let rows = (networks.len() as u128).saturating_mul(replicas as u128);
+        Self::with_rows(
+            networks,
+            replicas,
+            usize::try_from(rows).unwrap_or(usize::MAX),
+            integ,
+        )
+    }
+
+    /// `rows` rows (at least one, at most `networks.len() * replicas`) for `replicas` episodes of
+    /// each of `networks`: row `r` starts as replica `r % replicas` of network `r / replicas`,
+    /// as in [`Batch::new`], which holds every replica. [`Batch::assign`] then gives a row to
+    /// another network.
+    pub fn with_rows<N: Borrow<Network>>(
+        networks: &[N],
+        replicas: usize,
+        rows: usize,
+        integ: Integrator,
+    ) -> Result<Self> {
         integ.validate()?;
         if replicas == 0 {
             return Err(Error::InvalidArgument(
                 "replicas is 0; a batch needs at least 1 replica per network".into(),
             ));
         }
-        let rows = (networks.len() as u128).saturating_mul(replicas as u128);
-        if rows > MAX_BATCH_ROWS {
+        if networks.is_empty() {
+            return Err(Error::InvalidArgument(
+                "a batch needs at least 1 network".into(),
+            ));
+        }
+        let all = (networks.len() as u128).saturating_mul(replicas as u128);
+        if rows as u128 > MAX_BATCH_ROWS {
+            let what = if rows as u128 == all {
+                format!(
+                    "{} networks x {replicas} replicas make {all} rows",
+                    networks.len()
+                )
+            } else {
+                format!("rows is {rows}")
+            };
             return Err(Error::InvalidArgument(format!(
-                "{} networks x {replicas} replicas make {rows} rows; the limit is {MAX_BATCH_ROWS} (2^24)",
-                networks.len()
+                "{what}; the limit is {MAX_BATCH_ROWS} (2^24)"
+            )));
+        }
+        if rows == 0 || rows as u128 > all {
+            return Err(Error::InvalidArgument(format!(
+                "rows is {rows}; expected 1 to networks x replicas = {all}"
             )));
         }
         let networks: Vec<Network> = networks.iter().map(|n| n.borrow().clone()).collect();
-        let first = networks
-            .first()
-            .ok_or_else(|| Error::InvalidArgument("a batch needs at least 1 network".into()))?;
+        let first = &networks[0];
         let (n, m) = (first.size(), first.n_inputs());
         if let Some(p) = networks
             .iter()
@@ -102,7 +142,6 @@ impl Batch {
                 networks[p].n_inputs()
             )));
         }
-        let rows = networks.len() * replicas;
         let slot = Slot {
             on: 0,
             inputs: vec![[0.0; LANES]; m],
@@ -115,6 +154,7 @@ impl Batch {
             replicas,
             integ,
             networks,
+            network_of: (0..rows).map(|r| r / replicas).collect(),
             blocks: Vec::new(),
             slots: vec![slot; rows.div_ceil(LANES)],
             row_at: (0..rows).collect(),
@@ -124,7 +164,7 @@ impl Batch {
         Ok(batch)
     }
 
-    /// Rows B = networks x replicas.
+    /// Rows B: networks x replicas, or as many as [`Batch::with_rows`] was given.
     pub fn rows(&self) -> usize {
         self.row_at.len()
     }
@@ -158,7 +198,7 @@ impl Batch {
             .map(|rows| {
                 let refs: Vec<&Network> = rows
                     .iter()
-                    .map(|&r| &self.networks[r / self.replicas])
+                    .map(|&r| &self.networks[self.network_of[r]])
                     .collect();
                 let mut block = Block::new(&refs)?;
                 if let Some(states) = states {
@@ -390,6 +430,50 @@ impl Batch {
     pub fn reset(&mut self, rows: Option<&[bool]>) -> Result<()> {
         let zeros = vec![0.0; self.rows() * self.size];
         self.set_states(&zeros, rows)
+    }
+
+    /// The network each row runs, as an index into the batch's networks.
+    pub fn network_of(&self) -> &[usize] {
+        &self.network_of
+    }
+
+    /// Gives row `rows[i]` to network `networks[i]` (an index into the batch's networks); the row
+    /// then starts from that network's state, as in [`Batch::new`], and every other row keeps its
+    /// state. Fails, with the batch as it was, on indices out of range, a row named twice or
+    /// slices of different lengths.
+    pub fn assign(&mut self, rows: &[usize], networks: &[usize]) -> Result<()> {
+        if rows.len() != networks.len() {
+            return Err(Error::InvalidArgument(format!(
+                "{} rows and {} networks; expected one network per row",
+                rows.len(),
+                networks.len()
+            )));
+        }
+        let (b_len, p_len) = (self.rows(), self.networks.len());
+        let mut named = vec![false; b_len];
+        for (&r, &p) in rows.iter().zip(networks) {
+            if r >= b_len {
+                return Err(Error::InvalidArgument(format!(
+                    "row {r} is out of range; the batch has {b_len} rows"
+                )));
+            }
+            if p >= p_len {
+                return Err(Error::InvalidArgument(format!(
+                    "network {p} is out of range; the batch has {p_len} networks"
+                )));
+            }
+            if std::mem::replace(&mut named[r], true) {
+                return Err(Error::InvalidArgument(format!(
+                    "row {r} is named twice; a row runs one network"
+                )));
+            }
+        }
+        for (&r, &p) in rows.iter().zip(networks) {
+            self.network_of[r] = p;
+            let at = self.lane_of[r];
+            self.blocks[at / LANES].set_lane(at % LANES, &self.networks[p])?;
+        }
+        Ok(())
     }
 }
 

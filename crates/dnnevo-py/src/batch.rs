@@ -19,10 +19,13 @@ use crate::population::networks_from;
 /// P networks times E replicas, stepped together one time step per call: the core of a
 /// closed-loop task, where each step's inputs come from the last step's outputs.
 ///
-/// ``Batch(networks, *, replicas=1, dt=0.1, substeps=1, method="euler")`` holds B = P * E rows;
-/// row ``p * replicas + e`` is replica ``e`` of ``networks[p]`` (a sequence of Networks of one
-/// shape, or a dict of stacked arrays as for ``run_population``). Each row starts from its
-/// network's state.
+/// ``Batch(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method="euler")`` holds B = P
+/// * E rows; row ``p * replicas + e`` is replica ``e`` of ``networks[p]`` (a sequence of Networks
+/// of one shape, or a dict of stacked arrays as for ``run_population``). Each row starts from its
+/// network's state. With ``rows`` (1 to P * E) it holds only the first ``rows`` of those rows,
+/// and ``assign(rows, networks)`` hands rows to other networks (indices into ``networks``), each
+/// starting from its new network's state: a rollout keeps fewer rows busy this way, starting a
+/// waiting episode in a row whose episode ended. ``network_of`` is each row's network.
 ///
 /// - ``step(inputs, *, active=None, out=None)`` holds ``inputs`` (B, M), float64 or float32, for
 ///   ``substeps`` steps of ``dt`` and returns every stepped row's firing rates ``f(v - theta)``,
@@ -164,13 +167,37 @@ fn chosen_rows(obj: Option<&Bound<'_, PyAny>>, rows: usize) -> PyResult<Option<V
     Ok(Some(out))
 }
 
+/// Non-negative integer indices from a 1-D integer array or a sequence of ints (an empty list
+/// is no index).
+fn indices(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<usize>> {
+    let np = obj.py().import("numpy")?;
+    let arr = np.call_method1("asarray", (obj,))?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    let ndim: usize = arr.getattr("ndim")?.extract()?;
+    let size: usize = arr.getattr("size")?.extract()?;
+    if ndim != 1 || !(kind == "i" || kind == "u" || size == 0) {
+        return Err(arg_err(format!(
+            "{name} is a {} array of {ndim} dimensions; expected a 1-D array of indices",
+            arr.getattr("dtype")?.str()?
+        )));
+    }
+    let values: Vec<i128> = arr.call_method0("tolist")?.extract()?;
+    values
+        .into_iter()
+        .map(|v| {
+            usize::try_from(v).map_err(|_| arg_err(format!("{name} holds {v}; indices are >= 0")))
+        })
+        .collect()
+}
+
 #[pymethods]
 impl PyBatch {
     #[new]
-    #[pyo3(signature = (networks, *, replicas=AnyInt::from(1), dt=0.1, substeps=AnyInt::from(1), method="euler"), text_signature = "(networks, *, replicas=1, dt=0.1, substeps=1, method='euler')")]
+    #[pyo3(signature = (networks, *, replicas=AnyInt::from(1), rows=None, dt=0.1, substeps=AnyInt::from(1), method="euler"), text_signature = "(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method='euler')")]
     fn new(
         networks: &Bound<'_, PyAny>,
         replicas: AnyInt,
+        rows: Option<AnyInt>,
         dt: f64,
         substeps: AnyInt,
         method: &str,
@@ -178,12 +205,18 @@ impl PyBatch {
         let integ = integrator(dt, &substeps, method)?;
         let replicas: usize = replicas.to("replicas", "[1, 2**64)")?;
         let nets = networks_from(networks)?;
+        let inner = match rows {
+            None => ctrnn::Batch::new(&nets, replicas, integ),
+            Some(rows) => {
+                ctrnn::Batch::with_rows(&nets, replicas, rows.to("rows", "[1, 2**64)")?, integ)
+            }
+        };
         Ok(PyBatch {
-            inner: ctrnn::Batch::new(&nets, replicas, integ).py_err()?,
+            inner: inner.py_err()?,
         })
     }
 
-    /// Rows B = networks * replicas.
+    /// Rows B: networks * replicas, or as many as `rows` said.
     #[getter]
     fn rows(&self) -> usize {
         self.inner.rows()
@@ -304,6 +337,22 @@ impl PyBatch {
             }
         }
         Ok(out)
+    }
+
+    /// The network each row runs, an index into the batch's networks, a (B,) int64 copy.
+    #[getter]
+    fn network_of<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let of: Vec<i64> = self.inner.network_of().iter().map(|&p| p as i64).collect();
+        PyArray1::from_vec(py, of)
+    }
+
+    /// Gives row `rows[i]` to network `networks[i]` (row and network indices, 1-D integer arrays
+    /// of one length); those rows start from their new network's state, the others keep theirs.
+    #[pyo3(signature = (rows, networks), text_signature = "($self, rows, networks)")]
+    fn assign(&mut self, rows: &Bound<'_, PyAny>, networks: &Bound<'_, PyAny>) -> PyResult<()> {
+        let rows = indices(rows, "rows")?;
+        let networks = indices(networks, "networks")?;
+        self.inner.assign(&rows, &networks).py_err()
     }
 
     /// Sets the chosen rows' states to zero (every row when `rows` is None).

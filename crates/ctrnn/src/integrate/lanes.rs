@@ -261,6 +261,40 @@ impl<const L: usize> Lanes<L> {
             row[l] = v;
         }
     }
+    /// Puts network `net` (of this block's N and M) in real lane `l`, parameters and state,
+    /// as [`Lanes::new`] would have; the other lanes are unchanged.
+    pub fn set_lane(&mut self, l: usize, net: &Network) -> Result<()> {
+        if l >= self.len || (net.size(), net.n_inputs()) != (self.size, self.n_inputs) {
+            return Err(Error::InvalidArgument(format!(
+                "lane {l} of {} cannot take a network of N = {}, M = {} (the block's: N = {}, M = {})",
+                self.len,
+                net.size(),
+                net.n_inputs(),
+                self.size,
+                self.n_inputs
+            )));
+        }
+        let put = |rows: &mut Rows<L>, source: &[f64], order: &mut dyn Iterator<Item = usize>| {
+            for (row, q) in rows.iter_mut().zip(order) {
+                row[l] = source[q];
+            }
+        };
+        let n = self.size;
+        put(&mut self.tau, net.tau(), &mut (0..n));
+        put(&mut self.theta, net.theta(), &mut (0..n));
+        put(&mut self.weights, net.weights(), &mut weight_order(n));
+        put(
+            &mut self.sensor_weights,
+            net.sensor_weights(),
+            &mut (0..n * self.n_inputs),
+        );
+        put(&mut self.state, net.state(), &mut (0..n));
+        // The step sizes dt / tau and the rates are computed again at the next step.
+        self.scratch.dt = f64::NAN;
+        self.scratch.fresh = false;
+        self.scratch.held = false;
+        Ok(())
+    }
     /// Copies the state of lane `l` into `into` (length N).
     pub fn lane_state(&self, l: usize, into: &mut [f64]) {
         copy_lane(&self.state, l, into);

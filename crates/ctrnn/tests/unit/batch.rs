@@ -241,3 +241,92 @@ fn packing_the_running_rows_does_not_change_their_bits() {
         );
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    /// A batch of fewer rows whose rows are handed to other networks as it runs: each row ends
+    /// where `Network::run` of its last network, on the inputs of the steps it took part in since
+    /// the row was handed to it, ends, bit for bit, and rows not handed over keep their state through an `assign`.
+    #[test]
+    fn assigned_rows_equal_network_run_bit_for_bit(
+        n in 1usize..6, m in 1usize..3, p in 1usize..12, e in 1usize..3, fewer in 0usize..20,
+        steps in 2usize..8, rk4 in any::<bool>(), seed in 0u64..1000,
+    ) {
+        let nets = random_networks(p, n, m, seed);
+        let integ = integrator(rk4, 2);
+        let rows = (p * e).saturating_sub(fewer).max(1);
+        let mut batch = Batch::with_rows(&nets, e, rows, integ).unwrap();
+        prop_assert_eq!(batch.rows(), rows);
+        let mut owner: Vec<usize> = (0..rows).map(|r| r / e).collect();
+        let mut since = vec![0usize; rows];
+        // Most rows sit out every other step, so that the running rows are packed together
+        // (moved between lanes) before some of them are handed over.
+        let on = |r: usize, t: usize| r.is_multiple_of(4) || t.is_multiple_of(2);
+        let mut rates = vec![0.0; rows * n];
+        for t in 0..steps {
+            // At each step, every third row from an offset moves to another network.
+            let moved: Vec<usize> = (0..rows).filter(|r| (r + t + seed as usize).is_multiple_of(3)).collect();
+            let to: Vec<usize> = moved.iter().map(|r| (r * 5 + t) % p).collect();
+            batch.assign(&moved, &to).unwrap();
+            for (&r, &q) in moved.iter().zip(&to) {
+                owner[r] = q;
+                since[r] = t;
+            }
+            prop_assert_eq!(batch.network_of(), &owner[..]);
+            let x: Vec<f64> = (0..rows * m).map(|k| input(k / m, t, k % m)).collect();
+            let mask: Vec<bool> = (0..rows).map(|r| on(r, t)).collect();
+            batch.step(&x, Some(&mask), &mut rates, None).unwrap();
+        }
+        let states = batch.states();
+        for r in 0..rows {
+            let mut single = nets[owner[r]].clone();
+            let own: Vec<f64> = (since[r]..steps)
+                .filter(|&t| on(r, t))
+                .flat_map(|t| (0..m).map(move |k| input(r, t, k)))
+                .collect();
+            single.run(&own, own.len() / m, &integ).unwrap();
+            prop_assert_eq!(bits(single.state()), bits(&states[r * n..(r + 1) * n]), "row {}", r);
+        }
+    }
+}
+
+#[test]
+fn fewer_rows_and_bad_assignments_are_refused_and_change_nothing() {
+    let nets = random_networks(3, 2, 1, 7);
+    let integ = integrator(false, 1);
+    for rows in [0, 7] {
+        let err = Batch::with_rows(&nets, 2, rows, integ).unwrap_err();
+        assert!(
+            err.to_string().contains(&format!(
+                "rows is {rows}; expected 1 to networks x replicas = 6"
+            )),
+            "{err}"
+        );
+    }
+    let mut batch = Batch::with_rows(&nets, 2, 4, integ).unwrap();
+    assert_eq!(batch.network_of(), &[0, 0, 1, 1]);
+    let mut rates = vec![0.0; 4 * 2];
+    batch
+        .step(&[0.5, -0.5, 1.0, 0.0], None, &mut rates, None)
+        .unwrap();
+    let before = bits(&batch.states());
+    for (rows, to, says) in [
+        (
+            vec![4],
+            vec![0],
+            "row 4 is out of range; the batch has 4 rows",
+        ),
+        (
+            vec![0],
+            vec![3],
+            "network 3 is out of range; the batch has 3 networks",
+        ),
+        (vec![1, 1], vec![0, 2], "row 1 is named twice"),
+        (vec![1], vec![], "1 rows and 0 networks"),
+    ] {
+        let err = batch.assign(&rows, &to).unwrap_err();
+        assert!(err.to_string().contains(says), "{err}");
+        assert_eq!(bits(&batch.states()), before);
+        assert_eq!(batch.network_of(), &[0, 0, 1, 1]);
+    }
+}

@@ -74,3 +74,35 @@ def test_observations_kept_and_scaled() -> None:
 def test_bad_settings_are_config_errors(kwargs: dict, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         GymEnvironment("CartPole-v1", **kwargs)
+
+
+@pytest.mark.parametrize("mode", ["next_step", "same_step", "disabled"])
+def test_fewer_rows_than_episodes_give_the_same_episodes_in_separate_environments(mode: str) -> None:
+    """restart resets a separate sub-environment with its episode number's seed, whatever the
+    autoreset mode, so queued episodes are the episodes of a rollout that runs them all at once."""
+    nets = networks(6)
+    everything = rollout(nets, GymEnvironment("CartPole-v1", actions="threshold", vectorization_mode="sync"),
+                         episodes=3, max_steps=200, seed=5)
+    env = GymEnvironment("CartPole-v1", actions="threshold", vectorization_mode="sync",
+                         autoreset_mode=mode)
+    queued = rollout(nets, env, episodes=3, max_steps=200, seed=5, rows=4)
+    assert env.envs.num_envs == 4
+    assert np.array_equal(queued.returns, everything.returns)
+    assert np.array_equal(queued.lengths, everything.lengths)
+
+
+def test_a_native_vector_environment_starts_queued_episodes_at_its_next_step() -> None:
+    """CartPoleVectorEnv resets an ended sub-environment at its next step (next-step autoreset):
+    the row waits out that step, and its new episode begins from a fresh start, so a copied
+    network's episodes are as long as they are when every episode runs at once (within the
+    spread of starting states), and every episode is counted once."""
+    controller = networks(1)
+    nets = controller * 10
+    everything = rollout(nets, GymEnvironment("CartPole-v1", actions="threshold"), episodes=2,
+                         max_steps=500, seed=3)
+    queued = rollout(nets, GymEnvironment("CartPole-v1", actions="threshold"), episodes=2,
+                     max_steps=500, seed=3, rows=4)
+    assert queued.lengths.shape == (10, 2) and queued.lengths.min() >= 1
+    assert np.array_equal(queued.returns, queued.lengths.astype(float))  # reward 1 per step
+    lo, hi = np.percentile(everything.lengths, [0, 100])
+    assert lo - 5 <= np.median(queued.lengths) <= hi + 5

@@ -5,9 +5,9 @@
 :class:`FarSeeker` is the paper's landmark-far goal seeker written this way, as an example.
 """
 
-from dnnevo.closedloop.environment import Environment
+from dnnevo.closedloop.environment import Environment, RestartingEnvironment
 from dnnevo.closedloop.far_seeker import FarSeeker
 from dnnevo.closedloop.fitness import ClosedLoop
 from dnnevo.closedloop.loop import Rollout, rollout
 
-__all__ = ["ClosedLoop", "Environment", "FarSeeker", "Rollout", "rollout"]
+__all__ = ["ClosedLoop", "Environment", "FarSeeker", "RestartingEnvironment", "Rollout", "rollout"]

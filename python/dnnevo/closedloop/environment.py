@@ -2,7 +2,8 @@
 
 Write a class with these three members and :func:`dnnevo.closedloop.rollout` runs a population
 in it. Every method works on all rows at once (NumPy arrays with one row per episode); nothing
-is called per network.
+is called per network. A fourth, ``restart`` (:class:`RestartingEnvironment`), lets a rollout
+run more episodes than it has rows.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Environment"]
+__all__ = ["Environment", "RestartingEnvironment"]
 
 
 class Environment(Protocol):
@@ -44,4 +45,27 @@ class Environment(Protocol):
         :meth:`step` returns for such rows is ignored. ``observations`` has shape ``(B, M)``,
         ``rewards`` ``(B,)`` (summed into each episode's return) and ``done`` ``(B,)`` booleans,
         True where the episode ended at this step.
+        """
+
+
+class RestartingEnvironment(Environment, Protocol):
+    """An :class:`Environment` that can also start a new episode in some rows while the others
+    run on, so that a rollout with fewer rows than episodes (``rollout(..., rows=R)``) keeps every
+    row busy: when an episode ends, the next waiting one starts in its row.
+    """
+
+    def restart(self, rows: npt.NDArray[np.bool_], episodes: npt.NDArray[np.int64]
+                ) -> npt.ArrayLike | None:
+        """Starts episode ``episodes[r]`` in each row ``r`` where ``rows`` is True, after the row's
+        last episode ended, and returns the observations, shape ``(B, M)``, whose chosen rows are
+        the new episodes' first (the other rows' are not read).
+
+        Give each new episode the conditions of its episode number, drawn in :meth:`reset`
+        (which sees every episode number: a rollout has at least one row per number), so that
+        the returns are those of a rollout that runs every episode at once.
+
+        Return None when the environment starts the new episodes with its next :meth:`step`
+        instead, as a vector environment with next-step autoreset does: those rows then sit out
+        that step (``active`` is False for them), and the observations it returns for them are
+        the new episodes' first.
         """

@@ -39,14 +39,29 @@ class FarSeeker:
     def reset(self, episodes: npt.NDArray[np.int64], rng: np.random.Generator) -> npt.NDArray[np.float64]:
         """Even episodes seek the left end, odd ones the right; the landmark is on the other side.
         The conditions are fixed, so ``rng`` is not used."""
-        self.goal_right = episodes % 2 == 1
-        self.landmark = np.where(self.goal_right, -self.landmark_offset, self.landmark_offset)
-        self.x = np.zeros(len(episodes))
+        rows = len(episodes)
+        self.goal_right, self.landmark = np.empty(rows, dtype=bool), np.empty(rows)
+        self.x = np.empty(rows)
         # The goal's end as a signed limit: seeking the right end, x >= 20 reaches it; seeking the
         # left one, -x >= 20. Steps then work in place on these buffers.
-        self.sign = np.where(self.goal_right, 1.0, -1.0)
-        self._a, self._b = np.empty(len(episodes)), np.empty(len(episodes))
-        self._on = np.empty((len(episodes), 1))
+        self.sign = np.empty(rows)
+        self._a, self._b = np.empty(rows), np.empty(rows)
+        self._on = np.empty((rows, 1))
+        return self._start(np.ones(rows, dtype=bool), episodes)
+
+    def restart(self, rows: npt.NDArray[np.bool_], episodes: npt.NDArray[np.int64]
+                ) -> npt.NDArray[np.float64]:
+        """Starts episode ``episodes[r]`` at 0 in each row ``r`` where ``rows`` is True, after
+        the row's last episode ended (a rollout with fewer rows than episodes)."""
+        return self._start(rows, episodes)
+
+    def _start(self, rows: npt.NDArray[np.bool_], episodes: npt.NDArray[np.int64]
+               ) -> npt.NDArray[np.float64]:
+        goal_right = episodes[rows] % 2 == 1
+        self.goal_right[rows] = goal_right
+        self.landmark[rows] = np.where(goal_right, -self.landmark_offset, self.landmark_offset)
+        self.x[rows] = 0.0
+        self.sign[rows] = np.where(goal_right, 1.0, -1.0)
         return self._sense()
 
     def step(self, rates: npt.NDArray[np.float64], active: npt.NDArray[np.bool_]

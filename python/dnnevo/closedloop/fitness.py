@@ -28,7 +28,11 @@ from dnnevo.closedloop.loop import Rollout, rollout
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
 from dnnevo.errors import ConfigError, TaskError
 
-__all__ = ["ClosedLoop"]
+__all__ = ["ROLLOUT_KEYS", "ClosedLoop"]
+
+#: The keys of a named task's ``task_params`` that set the rollout (every other key goes to the
+#: environment's class), as :meth:`ClosedLoop.configured` records them.
+ROLLOUT_KEYS = ("episodes", "max_steps", "validation_episodes", "rows")
 
 
 _INTEGRATOR = IntegratorConfig()
@@ -61,6 +65,10 @@ class ClosedLoop:
     ``episodes`` episodes of at most ``max_steps`` time steps, each of ``substeps`` integration
     steps of ``dt`` (by default the run config's defaults, as for a task named in a config).
     The champion is chosen on ``validation_episodes`` episodes of their own (:meth:`validate`).
+    ``rows`` runs at most that many episodes at once, starting a waiting episode in a row whose
+    episode ended (:func:`~dnnevo.closedloop.rollout`; the environment needs ``restart``);
+    validation and judging, which may run more episodes per network, run at least one row per
+    episode number.
 
     A run folder names it after the environment's class (or ``name``, ``"python:module.Class"``)
     and records the rollout's settings in ``config.toml``, with a digest of the class's source,
@@ -72,7 +80,7 @@ class ClosedLoop:
     def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int,
                  dt: float = _INTEGRATOR.dt, substeps: int = _INTEGRATOR.substeps,
                  method: str = _INTEGRATOR.method, name: str | None = None,
-                 validation_episodes: int = VALIDATION_EPISODES) -> None:
+                 validation_episodes: int = VALIDATION_EPISODES, rows: int | None = None) -> None:
         if isinstance(validation_episodes, bool) or not isinstance(validation_episodes, int | np.integer) \
                 or validation_episodes < 1:
             raise ConfigError(f"validation_episodes is {validation_episodes!r}; expected a whole "
@@ -81,6 +89,11 @@ class ClosedLoop:
         self.settings = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps,
                              method=method)
         self.validation_episodes = int(validation_episodes)
+        if rows is not None and (isinstance(rows, bool) or not isinstance(rows, int | np.integer)
+                                 or rows < episodes):
+            raise ConfigError(f"rows is {rows!r}; expected a whole number of rows, at least "
+                              f"episodes ({episodes}), or None (every episode at once)")
+        self.rows = None if rows is None else int(rows)
         kind = type(env)
         module, qualname = kind.__module__, kind.__qualname__
         if name is not None:
@@ -98,11 +111,15 @@ class ClosedLoop:
         self.fitness_source = "\n".join([source, fingerprint(attributes), fingerprint(recorded)])
 
     def _recorded(self) -> dict[str, Any]:
-        """The settings a run records: the rollout's, and the validation set's size when it is not
-        the default (so that runs from before it was a setting keep their digest)."""
-        if self.validation_episodes == VALIDATION_EPISODES:
-            return dict(self.settings)
-        return {**self.settings, "validation_episodes": self.validation_episodes}
+        """The settings a run records: the rollout's, the validation set's size when it is not
+        the default and ``rows`` when set (so that runs from before they were settings keep their
+        digest)."""
+        recorded = dict(self.settings)
+        if self.validation_episodes != VALIDATION_EPISODES:
+            recorded["validation_episodes"] = self.validation_episodes
+        if self.rows is not None:
+            recorded["rows"] = self.rows
+        return recorded
 
     def digest(self) -> str:
         """SHA-256 of :attr:`fitness_source`, as ``config.toml``'s ``fitness_sha256`` records it."""
@@ -115,7 +132,7 @@ class ClosedLoop:
         command that builds the task from the config builds it with its defaults, and the digest
         then tells whether that is the same task."""
         s = self._recorded()
-        params = {k: s[k] for k in ("episodes", "max_steps", "validation_episodes") if k in s}
+        params = {k: s[k] for k in ROLLOUT_KEYS if k in s}
         return dataclasses.replace(
             config,
             task=f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}",
@@ -130,8 +147,7 @@ class ClosedLoop:
         and the rollout."""
         name = f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}"
         rule, threshold = success_rule(self.env, name)
-        run = {**self.settings, "episodes": episodes}
-        result = rollout([network], self.env, seed=seed, purpose=purpose, **run)
+        result = rollout([network], self.env, seed=seed, purpose=purpose, **self._run(episodes))
         return self._rule(rule, result.returns[0], result.lengths[0]), threshold, result
 
     def validate(self, networks: Sequence[_core.Network], *, seed: int
@@ -143,8 +159,8 @@ class ClosedLoop:
         that meet the environment's success rule (0 for an environment without one), the score
         the mean return. :func:`dnnevo.evolve` chooses the champion by them among the top
         ``config.validation_candidates`` by fitness; set it to 0 to choose by fitness alone."""
-        run = {**self.settings, "episodes": self.validation_episodes}
-        result = rollout(networks, self.env, seed=seed, purpose="validate", **run)
+        result = rollout(networks, self.env, seed=seed, purpose="validate",
+                         **self._run(self.validation_episodes))
         shape = result.returns.shape
         rule = getattr(self.env, "success", None)
         if rule is None or getattr(self.env, "success_rate", None) is None:
@@ -153,6 +169,12 @@ class ClosedLoop:
             ok = self._rule(rule, result.returns.ravel(), result.lengths.ravel())
             rates = ok.reshape(shape).mean(axis=1)
         return rates, result.returns.mean(axis=1)
+
+    def _run(self, episodes: int) -> dict[str, Any]:
+        """The rollout's settings for ``episodes`` episodes per network: at least one row per
+        episode number when ``rows`` is set."""
+        rows = None if self.rows is None else max(self.rows, episodes)
+        return {**self.settings, "episodes": episodes, "rows": rows}
 
     def _rule(self, rule: Any, returns: npt.NDArray[np.float64],
               lengths: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
@@ -178,10 +200,11 @@ class ClosedLoop:
 
     def __call__(self, networks: Sequence[_core.Network], *, generation: int = 0,
                  seed: int = 0) -> npt.NDArray[np.float64]:
-        return rollout(networks, self.env, seed=seed, generation=generation, **self.settings).fitness
+        return rollout(networks, self.env, seed=seed, generation=generation,
+                       **self._run(self.settings["episodes"])).fitness
 
     def __repr__(self) -> str:
-        settings = ", ".join(f"{k}={v!r}" for k, v in self.settings.items())
+        settings = ", ".join(f"{k}={v!r}" for k, v in self._recorded().items())
         return f"ClosedLoop({type(self.env).__name__}(), {settings})"
 
 

@@ -20,6 +20,8 @@ environment does after an episode's end is never read: with the next-step mode (
 default) the step after the end resets the sub-environment; with the same-step mode the last
 observation is the next episode's first; with autoreset disabled, stepping an ended
 sub-environment is an error, so ended sub-environments are reset at once with ``reset_mask``.
+With fewer rows than episodes (``rollout(..., rows=R)``), :meth:`GymEnvironment.restart` starts
+a waiting episode in an ended row (see there).
 
 **Common random numbers.** A vector environment made of separate environments (the ``"sync"``
 vectorization mode) is seeded sub-environment by sub-environment, episode number by episode
@@ -77,6 +79,7 @@ class GymEnvironment:
         if self.columns.size and (self.columns.min() < 0 or self.columns.max() >= width):
             raise ConfigError(f"observations is {list(self.columns)}; {env_id} has {width} components")
         self.observation_size = int(self.columns.size)
+        self.every_column = bool(np.array_equal(self.columns, np.arange(width)))
         self.scale = np.broadcast_to(np.asarray(observation_scale, dtype=np.float64),
                                      (self.observation_size,)).copy()
         if actions == "box":
@@ -115,25 +118,50 @@ class GymEnvironment:
         rows = len(episodes)
         envs = self.envs if self.envs is not None and self.envs.num_envs == rows else self._make(rows)
         seeds = rng.integers(0, 2**31 - 1, size=int(episodes.max()) + 1)
+        self.seeds = seeds  # each episode number's, for restart
         if self.vectorization_mode == "vector_entry_point":
             obs, _ = envs.reset(seed=int(seeds[0]))
         else:
             obs, _ = envs.reset(seed=[int(s) for s in seeds[episodes]])
+        self.fresh = obs
         return self._observe(obs)
+
+    def restart(self, rows: npt.NDArray[np.bool_], episodes: npt.NDArray[np.int64]
+                ) -> npt.NDArray[np.float64] | None:
+        """Starts episode ``episodes[r]`` in each sub-environment ``r`` where ``rows`` is True,
+        after its last episode ended. Separate sub-environments (``"sync"``, ``"async"``) are
+        reset with that episode number's seed. A natively vectorised environment is not reset
+        row by row: with the next-step autoreset mode it starts the new episodes at its next
+        step (None: the rollout has those rows wait it out); with the same-step mode the last
+        observations are already the new episodes' first, and with autoreset disabled
+        :meth:`step` has already reset the ended sub-environments."""
+        if self.vectorization_mode != "vector_entry_point":
+            seeds = [int(self.seeds[e]) if on else None for on, e in zip(rows, episodes, strict=True)]
+            obs, _ = self.envs.reset(seed=seeds, options={"reset_mask": np.array(rows, dtype=bool)})
+            return self._observe(obs)
+        if self.envs.metadata.get("autoreset_mode", gym.vector.AutoresetMode.NEXT_STEP) \
+                == gym.vector.AutoresetMode.NEXT_STEP:
+            return None
+        return self._observe(self.fresh)
 
     def step(self, rates: npt.NDArray[np.float64], active: npt.NDArray[np.bool_]
              ) -> tuple[npt.NDArray[np.float64], npt.NDArray[Any], npt.NDArray[np.bool_]]:
         """One step of every sub-environment with the actions the rates choose."""
         obs, reward, terminated, truncated, _ = self.envs.step(self._act(rates))
         done = np.logical_or(terminated, truncated)
+        self.fresh = obs
         if self.disabled and done.any():
             # Autoreset disabled: an ended sub-environment must be reset before its next step.
-            self.envs.reset(options={"reset_mask": done})
+            self.fresh, _ = self.envs.reset(options={"reset_mask": done})
         return self._observe(obs), np.asarray(reward), done
 
     def _observe(self, obs: npt.NDArray[Any]) -> npt.NDArray[np.float64]:
-        flat = np.asarray(obs, dtype=np.float64).reshape(len(obs), -1)
-        return flat[:, self.columns] * self.scale
+        """The kept components, scaled, as a new C-contiguous float64 array (the batch reads it
+        without a copy)."""
+        flat = np.asarray(obs).reshape(len(obs), -1)
+        if not self.every_column:
+            flat = flat[:, self.columns]
+        return np.multiply(flat, self.scale, out=np.empty((len(obs), self.observation_size)))
 
     def _act(self, rates: npt.NDArray[np.float64]) -> npt.NDArray[Any]:
         chosen = rates[:, self.outputs]

@@ -58,9 +58,19 @@ def rollout(
     seed: int = 0,
     generation: int = 0,
     purpose: str = "trial",
+    rows: int | None = None,
 ) -> Rollout:
     """Runs ``episodes`` episodes of every network in ``env``, all at once, for at most
     ``max_steps`` time steps of ``substeps`` integration steps of ``dt`` each.
+
+    ``rows`` runs at most that many episodes at once (at least ``episodes``; more than all
+    ``P * episodes`` runs them all): when an episode ends, the next waiting one starts in its
+    row, through the environment's ``restart`` method
+    (:class:`~dnnevo.closedloop.Environment`). Rows then stay busy until the last episodes,
+    where a vector environment that steps every row would spend most of its time on rows whose
+    episode has ended. Every episode still starts from network state 0 and meets the conditions
+    of its episode number, so an environment with common conditions gives the same returns
+    either way.
 
     The conditions come from ``rng = numpy.random.default_rng(condition_seed(seed,
     generation, purpose))``: the same for every network of a generation (common random numbers)
@@ -70,6 +80,15 @@ def rollout(
     if nonnegative("episodes", episodes) < 1:
         raise InvalidArgumentError("episodes is 0; it must be at least 1")
     nonnegative("max_steps", max_steps)
+    if rows is not None:
+        if nonnegative("rows", rows) < episodes:
+            raise InvalidArgumentError(f"rows is {rows}; it must be at least episodes ({episodes}), "
+                                       "so that the first reset sees every episode number")
+        if rows < len(networks) * episodes:
+            return _queued(networks, env, episodes=episodes, max_steps=max_steps, rows=rows,
+                           rng=np.random.default_rng(_core.condition_seed(seed, generation, purpose)),
+                           batch=_core.Batch(networks, replicas=episodes, rows=rows, dt=dt,
+                                             substeps=substeps, method=method))
     batch = _core.Batch(networks, replicas=episodes, dt=dt, substeps=substeps, method=method)
     batch.reset()
     rows, m = batch.rows, batch.n_inputs
@@ -89,37 +108,14 @@ def rollout(
     seen_rates, seen_active = read_only(rates), read_only(active)
     step = env.step
     # The loop is the hot path: one call of the batch and one of the environment per time step,
-    # and three whole-array operations. The checks cost nothing while the environment keeps to
-    # the protocol; when it does not, the slow path finds what is wrong and says so.
+    # and three whole-array operations.
     for t in range(max_steps):
-        try:
-            batch.step(obs, active=active, out=rates)
-        except InvalidArgumentError as e:
-            if not str(e).startswith("inputs["):
-                raise  # not the environment's doing: an integration that diverged
-            raise TaskError(f"{_name(env)}.{'step' if t else 'reset'} returned observations that "
-                            f"are not finite ({e})") from None
+        _step_batch(batch, obs, active, rates, env, t)
         try:
             out = step(seen_rates, seen_active)
         except Exception as e:
             raise TaskError(f"{_name(env)}.step raised {type(e).__name__}: {e}") from e
-        try:
-            obs, reward, done = out
-        except (TypeError, ValueError):
-            raise TaskError(f"{_name(env)}.step returned {type(out).__name__}; expected a tuple "
-                            "(observations, rewards, done)") from None
-        if type(obs) is not np.ndarray or obs.shape != (rows, m) or obs.dtype.char not in "df":
-            obs = observations(obs, env, "step", rows, m)
-        if np.may_share_memory(obs, rates):
-            obs = obs.copy()  # the batch writes the rates while it reads the observations
-        if type(reward) is not np.ndarray or reward.shape != (rows,) or reward.dtype.kind not in "biuf":
-            reward = _row_values(reward, env, rows)
-        if type(done) is not np.ndarray:
-            done = np.asarray(done)
-        if done.shape != (rows,) or done.dtype.char != "?":
-            raise TaskError(f"{_name(env)}.step returned done of type {type(done).__name__}, dtype "
-                            f"{getattr(done, 'dtype', '?')} and shape {np.shape(done)}; expected a "
-                            f"bool array of shape (B,) = ({rows},)")
+        obs, reward, done = _outputs(out, env, rows, m, rates)
         np.add(returns, reward, out=returns, where=active)
         np.logical_and(active, done, out=ended)
         if ended.any():  # rare: most steps end no episode
@@ -133,6 +129,142 @@ def rollout(
         _check_rewards(reward, returns, env, active)
     shape = (batch.networks, episodes)
     return Rollout(returns=returns.reshape(shape), lengths=lengths.reshape(shape))
+
+
+def _queued(networks: Sequence[_core.Network], env: Any, *, episodes: int, max_steps: int,
+            rows: int, rng: np.random.Generator, batch: _core.Batch) -> Rollout:
+    """:func:`rollout` with ``rows`` rows, fewer than its episodes: a row whose episode ends
+    starts the next waiting one (episode ``q`` is episode ``q % E`` of network ``q // E``)."""
+    restart = getattr(env, "restart", None)
+    if restart is None:
+        raise TaskError(f"{_name(env)} has no restart method; without one, rows must be None or "
+                        f"at least P x episodes = {len(networks) * episodes}")
+    total, m = len(networks) * episodes, batch.n_inputs
+    if getattr(env, "observation_size", m) != m:
+        raise TaskError(f"{_name(env)}.observation_size is {env.observation_size}; the networks "
+                        f"have {m} inputs")
+    batch.reset()
+    episode = np.arange(rows, dtype=np.int64)  # the episode each row runs
+    following = rows  # the next waiting episode
+    obs = observations(_call(env, "reset", episode % episodes, rng), env, "reset", rows, m)
+    active = np.ones(rows, dtype=bool)  # rows whose network steps
+    waiting = np.zeros(rows, dtype=bool)  # rows whose episode starts with the next step's observations
+    ended = np.empty(rows, dtype=bool)
+    row_returns = np.zeros(rows)
+    start = np.zeros(rows, dtype=np.int64)  # the step count at which each row's episode began
+    returns, lengths = np.zeros(total), np.zeros(total, dtype=np.int64)
+    rates = np.empty((rows, batch.size))
+    seen_rates, seen_active = read_only(rates), read_only(active)
+    limit = max_steps  # the step count at which the oldest running episode reaches max_steps
+    t = 0
+    while True:
+        _step_batch(batch, obs, active, rates, env, t)
+        try:
+            out = env.step(seen_rates, seen_active)
+        except Exception as e:
+            raise TaskError(f"{_name(env)}.step raised {type(e).__name__}: {e}") from e
+        obs, reward, done = _outputs(out, env, rows, m, rates)
+        t += 1
+        np.add(row_returns, reward, out=row_returns, where=active)
+        np.logical_and(active, done, out=ended)
+        if t >= limit:
+            ended |= active & (t - start >= max_steps)
+        if waiting.any():  # these rows' observations are their episodes' first
+            active |= waiting
+            waiting[:] = False
+        if not ended.any():
+            continue
+        if not np.isfinite(row_returns).all():
+            _check_rewards(reward, row_returns, env, active)
+        finished = np.flatnonzero(ended)
+        returns[episode[finished]] = row_returns[finished]
+        lengths[episode[finished]] = t - start[finished]
+        again = finished[:total - following]
+        active[finished[len(again):]] = False
+        if len(again):
+            obs = _restart(env, restart, batch, again, following, episodes, obs, active, waiting)
+            episode[again] = np.arange(following, following + len(again))
+            following += len(again)
+            row_returns[again] = 0.0
+            start[again] = t + waiting[again]
+        running = active | waiting
+        if not running.any():
+            break
+        limit = int(start[running].min()) + max_steps
+    shape = (len(networks), episodes)
+    return Rollout(returns=returns.reshape(shape), lengths=lengths.reshape(shape))
+
+
+def _restart(env: Any, restart: Any, batch: _core.Batch, again: npt.NDArray[np.int64],
+             following: int, episodes: int, obs: npt.NDArray[Any], active: npt.NDArray[np.bool_],
+             waiting: npt.NDArray[np.bool_]) -> npt.NDArray[Any]:
+    """Starts episodes ``following, following + 1, ...`` in rows ``again`` (network state 0),
+    and returns the next observations: ``obs`` with the restarted rows' first observations, or
+    ``obs`` as it is when the environment starts them with its next step (``restart`` returned
+    None; those rows then wait out that step)."""
+    rows, m = len(active), batch.n_inputs
+    batch.assign(again, np.arange(following, following + len(again)) // episodes)
+    batch.reset(again)
+    chosen = np.zeros(rows, dtype=bool)
+    chosen[again] = True
+    numbers = np.zeros(rows, dtype=np.int64)
+    numbers[again] = np.arange(following, following + len(again)) % episodes
+    try:
+        first = restart(read_only(chosen), read_only(numbers))
+    except Exception as e:
+        raise TaskError(f"{_name(env)}.restart raised {type(e).__name__}: {e}") from e
+    if first is None:
+        active[again] = False
+        waiting[again] = True
+        return obs
+    first = observations(first, env, "restart", rows, m)
+    if not np.isfinite(first[again]).all():
+        r = int(again[np.flatnonzero(~np.isfinite(first[again]).all(axis=1))[0]])
+        raise TaskError(f"{_name(env)}.restart returned observations that are not finite "
+                        f"(row {r}: {first[r].tolist()})")
+    if first is obs:
+        return obs
+    merged = np.array(obs, dtype=np.float64)
+    merged[again] = first[again]
+    return merged
+
+
+def _step_batch(batch: _core.Batch, obs: npt.NDArray[Any], active: npt.NDArray[np.bool_],
+                rates: npt.NDArray[np.float64], env: Any, t: int) -> None:
+    """One step of the rows in ``active``; observations that are not finite are the
+    environment's error, a diverging integration is not."""
+    try:
+        batch.step(obs, active=active, out=rates)
+    except InvalidArgumentError as e:
+        if not str(e).startswith("inputs["):
+            raise  # not the environment's doing: an integration that diverged
+        raise TaskError(f"{_name(env)}.{'step' if t else 'reset'} returned observations that "
+                        f"are not finite ({e})") from None
+
+
+def _outputs(out: Any, env: Any, rows: int, m: int, rates: npt.NDArray[np.float64]
+             ) -> tuple[npt.NDArray[Any], npt.NDArray[Any], npt.NDArray[np.bool_]]:
+    """What ``env.step`` returned, checked: ``(observations, rewards, done)``. The checks cost
+    nothing while the environment keeps to the protocol; when it does not, the slow path finds
+    what is wrong and says so."""
+    try:
+        obs, reward, done = out
+    except (TypeError, ValueError):
+        raise TaskError(f"{_name(env)}.step returned {type(out).__name__}; expected a tuple "
+                        "(observations, rewards, done)") from None
+    if type(obs) is not np.ndarray or obs.shape != (rows, m) or obs.dtype.char not in "df":
+        obs = observations(obs, env, "step", rows, m)
+    if np.may_share_memory(obs, rates):
+        obs = obs.copy()  # the batch writes the rates while it reads the observations
+    if type(reward) is not np.ndarray or reward.shape != (rows,) or reward.dtype.kind not in "biuf":
+        reward = _row_values(reward, env, rows)
+    if type(done) is not np.ndarray:
+        done = np.asarray(done)
+    if done.shape != (rows,) or done.dtype.char != "?":
+        raise TaskError(f"{_name(env)}.step returned done of type {type(done).__name__}, dtype "
+                        f"{getattr(done, 'dtype', '?')} and shape {np.shape(done)}; expected a "
+                        f"bool array of shape (B,) = ({rows},)")
+    return obs, reward, done
 
 
 def _name(env: Any) -> str:

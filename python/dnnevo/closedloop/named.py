@@ -3,7 +3,8 @@ it from ``config.toml`` alone.
 
 ``config.task = "python:module.Class"`` names the environment class; ``task_params`` holds the
 rollout's ``episodes`` and ``max_steps``, optionally the size of the validation set the champion
-is chosen on (``validation_episodes``, default 40) and, besides them, the keyword arguments of
+is chosen on (``validation_episodes``, default 40), the most episodes run at once (``rows``,
+default all) and, besides them, the keyword arguments of
 the class;
 ``config.integrator`` says how the networks are integrated. For example, ``config.toml``::
 
@@ -31,14 +32,11 @@ import os
 import sys
 from typing import Any
 
-from dnnevo.closedloop.fitness import ClosedLoop
+from dnnevo.closedloop.fitness import ROLLOUT_KEYS, ClosedLoop
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, TaskError
 
 __all__ = ["ROLLOUT_KEYS", "closed_loop", "environment_class", "is_closed_loop", "is_python_task"]
-
-#: The keys of ``task_params`` that set the rollout; every other key goes to the class.
-ROLLOUT_KEYS = ("episodes", "max_steps", "validation_episodes")
 
 #: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
 _MEMBERS = ("observation_size", "reset", "step")

@@ -338,7 +338,7 @@ def pursuer_appears(config: EvolutionConfig, net: _core.Network, seed: int, titl
     as the mean over the appearances with ±1 standard deviation. Appearances in the unchanged
     episodes, if there are at least 2, are drawn too."""
     a = APPEARS
-    params = {k: v for k, v in config.task_params.items() if k not in ("episodes", "max_steps", "validation_episodes")}
+    params = {k: v for k, v in config.task_params.items() if k not in named.ROLLOUT_KEYS}
     loop_dt = float(Pursuit(**params).settings["dt"])
     hidden, before, after = (round(a[k] / loop_dt) for k in ("hidden_s", "before_s", "after_s"))
     episodes = int(a["episodes"])

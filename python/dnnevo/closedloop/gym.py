@@ -158,17 +158,18 @@ class GymEnvironment:
     def _observe(self, obs: npt.NDArray[Any]) -> npt.NDArray[np.float64]:
         """The kept components, scaled, as a new C-contiguous float64 array (the batch reads it
         without a copy)."""
-        flat = np.asarray(obs).reshape(len(obs), -1)
+        flat = obs if isinstance(obs, np.ndarray) and obs.ndim == 2 else \
+            np.asarray(obs).reshape(len(obs), -1)
         if not self.every_column:
             flat = flat[:, self.columns]
         return np.multiply(flat, self.scale, out=np.empty((len(obs), self.observation_size)))
 
     def _act(self, rates: npt.NDArray[np.float64]) -> npt.NDArray[Any]:
+        if self.actions == "threshold":
+            return (rates[:, self.outputs[0]] > 0.5).astype(np.int64)
         chosen = rates[:, self.outputs]
         if self.actions == "argmax":
             return np.argmax(chosen, axis=1)
-        if self.actions == "threshold":
-            return (chosen[:, 0] > 0.5).astype(np.int64)
         action = self.low + chosen * self.span
         return action.reshape((len(rates), *self.action_shape))
 

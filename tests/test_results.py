@@ -196,15 +196,49 @@ def test_collect_takes_in_experiments_added_since_and_refuses_a_changed_one(tmp_
 
 
 def test_a_family_collected_again_at_another_commit_names_both(tmp_path: Path, reproduction: Path) -> None:
-    """A reproduction continued at a later commit is collected again: the family keeps the
-    commit of its earlier runs beside the new one."""
+    """A reproduction continued at a later commit (or in another session, on another machine) is
+    collected again: the runs it adds are counted with the earlier ones, the family keeps the
+    commit and the machine of its earlier runs beside the new ones, and the elapsed times add up.
+    Collecting the same results again changes nothing."""
     dest = tmp_path / "results"
-    for commit in ("abc1234", "abc1234", "def5678"):
+    r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", "abc1234")
+    assert r.returncode == 0, r.stderr
+    first = json.loads((dest / "provenance.json").read_text())["families"]["landmark"]
+    # The earlier session had not finished the robot-like test.
+    (dest / "landmark-robot" / "seed-0.json").unlink()
+    provenance = json.loads((dest / "provenance.json").read_text())
+    provenance["families"]["landmark"].update(runs=3, elapsed_s=100, machines=["Earlier CPU, SIMD kernel avx2"])
+    (dest / "provenance.json").write_text(json.dumps(provenance))
+    for commit in ("def5678", "fed9999"):
         r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", commit)
         assert r.returncode == 0, r.stderr
     provenance = json.loads((dest / "provenance.json").read_text())
-    assert provenance["families"]["landmark"]["commit"] == "abc1234, def5678"
-    assert provenance["commit"] == "abc1234, def5678"
+    family = provenance["families"]["landmark"]
+    assert family["commit"] == provenance["commit"] == "abc1234, def5678"
+    assert family["runs"] == first["runs"] == 4
+    assert family["elapsed_s"] >= 100  # the earlier time, and the new run's (under a second here)
+    assert family["machines"][0] == "Earlier CPU, SIMD kernel avx2" and len(family["machines"]) == 2
+
+
+def test_a_result_that_differs_from_the_one_collected_is_refused(tmp_path: Path, reproduction: Path) -> None:
+    """Runs are deterministic: a result collected before and made again must agree but for its
+    wall times; when it does not, collect names the job and the field and writes nothing."""
+    dest = tmp_path / "results"
+    r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", "abc1234")
+    assert r.returncode == 0, r.stderr
+    kept = dest / "landmark" / "seed-0.json"
+    result = json.loads(kept.read_text())
+    result["wall_s"] += 1000.0  # wall times may differ
+    kept.write_text(json.dumps(result))
+    r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", "def5678")
+    assert r.returncode == 0, r.stderr
+    result["run"]["best_fitness"] = 0.123
+    kept.write_text(json.dumps(result))
+    before = {p: p.read_bytes() for p in dest.rglob("*.json")}
+    r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", "def5678")
+    assert r.returncode != 0
+    assert "landmark/seed-0: the result in" in r.stderr and "run.best_fitness" in r.stderr
+    assert {p: p.read_bytes() for p in dest.rglob("*.json")} == before
 
 
 def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, repo: Path) -> None:

@@ -42,7 +42,7 @@ import math
 import re
 import statistics
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -50,7 +50,7 @@ from typing import Any
 from dnnevo.errors import DnnevoError
 from dnnevo.experiments import examples, jobs, plan, report
 from dnnevo.experiments.scheduler import Outcome, Task
-from dnnevo.runs import RunFileError, short, write_atomic
+from dnnevo.runs import RunFileError, first_difference, short, write_atomic
 from dnnevo.runs.files import checked, read_json
 
 __all__ = ["RESULTS_DIR", "SETTINGS_FILE", "PROVENANCE_FILE", "Results", "load", "collect", "blocks", "render",
@@ -157,6 +157,10 @@ def _read_provenance(path: Path) -> dict[str, Any]:
             raise RunFileError(f"{path}: families.{family} is {short(info)}; expected an object with "
                                "command and commit (strings), runs and planned (counts) and elapsed_s "
                                "(seconds)")
+        machines = info.get("machines", [])
+        if not isinstance(machines, list) or not all(isinstance(m, str) for m in machines):
+            raise RunFileError(f"{path}: families.{family}.machines is {short(machines)}; expected a "
+                               "list of strings")
     return prov
 
 
@@ -254,6 +258,22 @@ def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
     return {**held, "configs": {**mine, **{k: v for k, v in theirs.items() if k not in mine}}}
 
 
+def _timeless(result: Any) -> Any:
+    """A job's result without its wall times (``wall_s`` at any depth): what two machines that
+    ran the same job must agree on."""
+    if isinstance(result, dict):
+        return {k: _timeless(v) for k, v in result.items() if k != "wall_s"}
+    if isinstance(result, list):
+        return [_timeless(v) for v in result]
+    return result
+
+
+def _machine_name(env: Mapping[str, Any]) -> str:
+    """The CPU and SIMD kernel of a reproduction's environment table, as a family's
+    ``machines`` lists them."""
+    return f"{env.get('CPU', 'unknown CPU')}, SIMD kernel {env.get('SIMD kernel', 'unknown')}"
+
+
 def _commits(before: Any, commit: str) -> str:
     """The commits a family's collected runs were made at: those of its earlier collection and
     ``commit``. A reproduction continued at a later commit (runs are deterministic, so a later
@@ -269,7 +289,10 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
     reproduction folder ``source`` into ``dest``, each checked against its run folder as
     ``dnnevo reproduce`` checks it, with ``reproduce.json`` and ``provenance.json``. Returns the
     ids of the jobs copied. ``dest`` must hold the same reproduction (same settings) or none. A
-    family collected again (its reproduction continued) names the commits of both collections."""
+    family collected again (its reproduction continued, maybe in another session on another
+    machine) names the commits and machines of every collection, counts the runs ``dest`` then
+    holds and adds the new runs' elapsed time to the earlier; a result ``dest`` already holds is
+    kept, and must be the same but for its wall times (else nothing is written)."""
     settings_file = source / SETTINGS_FILE
     if not settings_file.exists():
         raise DnnevoError(f"{source} holds no {SETTINGS_FILE}: not a reproduction's folder")
@@ -298,7 +321,22 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
     chosen = {family: [job for job in plan.jobs(list(seeds), [family])
                        if jobs.read_result(source, job, settings) is not None]  # checked against its run
               for family in plan.families(families)}
+    # A result collected before (another session's reproduction, maybe another machine) must be
+    # the same but for its wall times: runs are deterministic. It is kept as it was.
+    for finished in chosen.values():
+        for job in list(finished):
+            kept = jobs.result_path(dest, job)
+            if not kept.exists():
+                continue
+            diff = first_difference(_timeless(read_json(kept)),
+                                    _timeless(read_json(jobs.result_path(source, job))))
+            if diff is not None:
+                raise DnnevoError(f"{job.id}: the result in {source} differs from the one in {dest} "
+                                  f"at {diff[0]} ({short(diff[2])} against {short(diff[1])}); runs "
+                                  "are deterministic, so one of them was made by other code")
+            finished.remove(job)
     dest.mkdir(parents=True, exist_ok=True)
+    old_machine = _machine_name(old.get("environment", {}))
     copied, times = [], {}
     for family, finished in chosen.items():
         done = []
@@ -308,13 +346,21 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             write_atomic(out, src.read_text(encoding="utf-8"))
             copied.append(job.id)
             done.append(src)
+        before = old.get("families", {}).get(family)
         if done:
             ends = [p.stat().st_mtime for p in done]
             starts = [e - float(read_json(p)["wall_s"]) for p, e in zip(done, ends)]
+            earlier = [] if before is None else before.get("machines", [old_machine])
             times[family] = {"command": _command(seeds, family, settings),
-                             "commit": _commits(old.get("families", {}).get(family), named.group(1)),
-                             "runs": len(done), "planned": len(plan.jobs(list(seeds), [family])),
-                             "elapsed_s": round(max(ends) - min(starts))}
+                             "commit": _commits(before, named.group(1)),
+                             "runs": sum(jobs.result_path(dest, j).exists()
+                                         for j in plan.jobs(list(seeds), [family])),
+                             "planned": len(plan.jobs(list(seeds), [family])),
+                             "elapsed_s": round(max(ends) - min(starts))
+                             + (0 if before is None else before["elapsed_s"]),
+                             "machines": list(dict.fromkeys([*earlier, _machine_name(env)]))}
+        elif before is not None and "machines" not in before:
+            times[family] = {**before, "machines": [old_machine]}
     write_atomic(dest / SETTINGS_FILE, json.dumps(manifest, indent=1) + "\n")
     families_done = {**old.get("families", {}), **times}
     provenance = {
@@ -419,6 +465,10 @@ def _machine(results: Results) -> list[report.Block]:
         text = (f"All families: {_duration(total_run)} of run time, {_duration(total_elapsed)} elapsed on "
                 f"{env.get('cores', '?')} cores. Elapsed is {prov.get('elapsed', 'per family')}. Commands: "
                 + "; ".join(f"`{info['command']}`" for info in families.values()) + ".")
+        spread = {f: info["machines"] for f, info in families.items() if len(info.get("machines", [])) > 1}
+        if spread:
+            text += (" Run times add up runs made on different machines: "
+                     + "; ".join(f"{f} on {' and '.join(m)}" for f, m in spread.items()) + ".")
     else:
         text = "No time recorded yet."
     out.append(report.Block("p", text.strip()))

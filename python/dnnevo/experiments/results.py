@@ -268,6 +268,14 @@ def _timeless(result: Any) -> Any:
     return result
 
 
+def _machines(provenance: Mapping[str, Any]) -> list[str]:
+    """Every machine a reproduction's collected runs were made on: each family's, or the
+    environment's for a family collected before families named theirs."""
+    first = _machine_name(provenance.get("environment", {}))
+    return list(dict.fromkeys(m for info in provenance.get("families", {}).values()
+                              for m in info.get("machines", [first]))) or [first]
+
+
 def _machine_name(env: Mapping[str, Any]) -> str:
     """The CPU and SIMD kernel of a reproduction's environment table, as a family's
     ``machines`` lists them."""
@@ -363,10 +371,13 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             times[family] = {**before, "machines": [old_machine]}
     write_atomic(dest / SETTINGS_FILE, json.dumps(manifest, indent=1) + "\n")
     families_done = {**old.get("families", {}), **times}
+    commits = [c for f in families_done.values() for c in f["commit"].split(", ")]
     provenance = {
         "seeds": sorted(seeds),
-        "commit": ", ".join(dict.fromkeys(f["commit"] for f in families_done.values())) or named.group(1),
-        "environment": env,
+        "commit": ", ".join(dict.fromkeys(commits)) or named.group(1),
+        # The machine of the first collection: the one the reproduction began on (each family
+        # names its own machines).
+        "environment": old.get("environment") or env,
         "families": families_done,
         "elapsed": "per family, from the first job's start to the last job's end, taken from the result "
                    "files' times and wall times; it includes any pause when the reproduction spanned sessions",
@@ -399,13 +410,12 @@ def _summary(results: Results, family: str | None) -> list[report.Block]:
     done = sum(1 for j in order if j.id in results.found and (family is None or j.spec.family == family))
     planned = sum(1 for j in order if family is None or j.spec.family == family)
     prov = results.provenance
-    env = prov.get("environment", {})
     if results.settings is None:
         text = f"No results yet in {RESULTS_DIR.as_posix()}/: every experiment is {NOT_RUN}."
     else:
         text = (f"From the reference reproduction in {RESULTS_DIR.as_posix()}/ (`dnnevo reproduce --seeds "
                 f"{_seeds_text(results.seeds)}`, commit {prov.get('commit', 'unknown')}, "
-                f"{env.get('CPU', 'unknown CPU')}, SIMD kernel {env.get('SIMD kernel', 'unknown')}): "
+                f"{' and '.join(_machines(prov))}): "
                 f"{done} of {planned} runs done. Intervals are 95%: Wilson for rates, percentile bootstrap "
                 "for medians.")
         if results.settings["settings"].get("quick"):

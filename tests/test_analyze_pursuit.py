@@ -75,6 +75,8 @@ def test_recorded_episodes_are_the_judged_ones_and_replay_exactly(run: Path) -> 
     recorded = user.record(config, net, 6, seed=3)
     _, _, judged = named.closed_loop(config).judged(net, 6, 3, "evaluate")
     assert [len(e.outputs) for e in recorded] == judged.lengths.ravel().tolist()
+    # ... and their rewards add up to the judged returns (summed in the same order).
+    assert [np.cumsum(e.rewards)[-1] for e in recorded] == judged.returns.ravel().tolist()
 
 
 @pytest.mark.parametrize("bad", [dict(main_input=1.0), dict(main_input=True), dict(output_neuron="0"),

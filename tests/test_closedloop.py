@@ -418,11 +418,16 @@ def test_a_task_class_named_on_the_command_line_runs_resumes_and_is_judged(tmp_p
     judged = dnnevo_command(tmp_path, "assess", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
     assert judged.returncode in (0, 1, 3), judged.stderr
     assert "fresh episodes (seed 3)" in judged.stdout and "needs" in judged.stdout
+    drawn = dnnevo_command(tmp_path, "plot", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
+    assert drawn.returncode == 0, drawn.stderr
+    assert (folder / "episodes.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     # show reads the folder without importing the task: it works with the module gone.
     (tmp_path / "seeker_cli.py").unlink()
     shown = dnnevo_command(tmp_path, "show", "runs/seeker_cli.Seeker-seed0")
     assert shown.returncode == 0 and "8/8 generations" in shown.stdout, shown.stderr
     gone = dnnevo_command(tmp_path, "resume", "runs/seeker_cli.Seeker-seed0", "--generations", "9")
+    assert gone.returncode == 2 and "cannot import seeker_cli" in gone.stderr
+    gone = dnnevo_command(tmp_path, "plot", "runs/seeker_cli.Seeker-seed0")
     assert gone.returncode == 2 and "cannot import seeker_cli" in gone.stderr
 
 

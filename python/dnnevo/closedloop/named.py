@@ -20,8 +20,8 @@ attributes and the rollout's settings (``fitness_sha256``): ``resume`` and ``ass
 task that no longer matches it.
 
 Building the task imports ``module``: a run folder that names a Python task names code to run,
-as a pickle does. Only the commands that run a task import it (``run``, ``resume``, ``assess``);
-``dnnevo show`` never does. The module is looked up on ``sys.path`` and then in the current
+as a pickle does. Only the commands that run a task import it (``run``, ``resume``, ``assess``,
+``plot``, ``analyze``); ``dnnevo show`` never does. The module is looked up on ``sys.path`` and then in the current
 folder.
 """
 

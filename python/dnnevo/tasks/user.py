@@ -25,13 +25,13 @@ from typing import Any, Literal, cast
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo import _core
+from dnnevo import _core, plot
 from dnnevo.closedloop import named
 from dnnevo.closedloop.loop import observations, read_only
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, rate
-from dnnevo.runs import RunDir
+from dnnevo.runs import RunDir, save_figure
 from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
 from dnnevo.tasks.protocol import Analysis, View
 
@@ -41,6 +41,9 @@ _Array = npt.NDArray[np.float64]
 
 #: ``dnnevo assess``'s default count of fresh episodes.
 DEFAULT_TRIALS = 200
+
+#: Fresh episodes that ``dnnevo plot`` draws (:meth:`UserTask.draw`).
+DRAWN_EPISODES = 3
 
 
 class UserTask:
@@ -87,8 +90,27 @@ class UserTask:
 
     def draw(self, run: RunDir, config: EvolutionConfig, seed: int, *,
              animate: bool = False) -> list[str]:
-        """No figures of its own (yet)."""
-        return []
+        """``episodes.png``: the champion on the first :data:`DRAWN_EPISODES` of the fresh
+        episodes that :meth:`judge` draws from ``seed``, one panel each: every observation
+        (scaled onto its band, its range in the label) and every neuron's firing rate over the
+        episode, with the episode's return and length. Imports the task's module."""
+        champion = run.read_best(config, run.read_config()[1])
+        episodes = record(config, champion, DRAWN_EPISODES, seed=seed)
+        fig, axes = plot.subplots(1, len(episodes), figsize=(4.5 * len(episodes), 1.5 + 0.6 * (
+            config.n_inputs + config.size)), layout="constrained", squeeze=False)
+        for e, (ax, ep) in enumerate(zip(axes[0], episodes, strict=True)):
+            shown = {}
+            for k in range(ep.inputs.shape[1]):
+                x = ep.inputs[:, k]
+                low, high = float(x.min()), float(x.max())
+                span = high - low
+                shown[f"input {k} [{low:.3g}, {high:.3g}]"] = (x - low) / span if span > 0 else x * 0 + 0.5
+            plot.plot_traces(shown, ep.outputs, ax, title=(
+                f"episode {e}: return {np.cumsum(ep.rewards)[-1]:.4g}, {len(ep.rewards)} steps"))
+        fig.suptitle(f"{run.path.name}: the champion on fresh episodes (seed {seed})", fontsize=10)
+        save_figure(fig, run.path / "episodes.png")
+        plot.close(fig)
+        return ["episodes.png"]
 
     def recorded_trials(self, config: EvolutionConfig, net: _core.Network, *,
                         seed: int) -> list[tuple[_Array, _Array]]:
@@ -159,6 +181,8 @@ class Episode:
     """(T, M)."""
     outputs: _Array
     """(T, N)."""
+    rewards: _Array
+    """(T,): the reward of each step."""
     probes: dict[str, npt.NDArray[Any]]
     """Each probed name's values, (T, ...)."""
 
@@ -197,6 +221,7 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
     seen_rates, seen_active = read_only(rates), read_only(active)  # the task may not write them
     ins: list[_Array] = []
     outs: list[_Array] = []
+    paid: list[_Array] = []
     probed: list[dict[str, npt.NDArray[Any]]] = []
     for t in range(max_steps):
         if shown is not None:
@@ -206,15 +231,17 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
         outs.append(rates.copy())
         if probe is not None:
             probed.append({k: np.array(v) for k, v in probe(env).items()})
-        seen, _, done = env.step(seen_rates, seen_active)
+        seen, reward, done = env.step(seen_rates, seen_active)
+        paid.append(np.array(np.broadcast_to(np.asarray(reward, dtype=float), (episodes,))))
         obs = np.array(observations(seen, env, "step", episodes, m), dtype=float)  # a copy: never the rates
         ended = active & np.asarray(done, dtype=bool)
         lengths[ended] = t + 1
         active &= ~ended
         if not active.any():
             break
-    stacked_in, stacked_out = np.stack(ins, axis=1), np.stack(outs, axis=1)
+    stacked_in, stacked_out, stacked_paid = np.stack(ins, axis=1), np.stack(outs, axis=1), np.stack(paid, axis=1)
     names = probed[0].keys() if probed else ()
     stacked = {k: np.stack([p[k] for p in probed], axis=1) for k in names}
-    return [Episode(stacked_in[e, :n], stacked_out[e, :n], {k: v[e, :n] for k, v in stacked.items()})
+    return [Episode(stacked_in[e, :n], stacked_out[e, :n], stacked_paid[e, :n],
+                    {k: v[e, :n] for k, v in stacked.items()})
             for e, n in enumerate(lengths.tolist())]

@@ -132,6 +132,9 @@ def test_rows_need_a_restart_and_at_least_one_row_per_episode_number() -> None:
     with pytest.raises(dnnevo.ConfigError, match=r"rows is 1; expected a whole number of rows, at "
                                                  r"least episodes \(2\)"):
         ClosedLoop(FarSeeker(), episodes=2, max_steps=5, rows=1)
+    # A fitness function refuses rows without restart at once, before any run folder is made.
+    with pytest.raises(dnnevo.ConfigError, match=r"rows is 4, but NoRestart has no restart method"):
+        ClosedLoop(NoRestart(), episodes=2, max_steps=5, rows=4)
 
 
 def test_a_batch_of_fewer_rows_hands_rows_to_other_networks() -> None:

@@ -93,6 +93,9 @@ class ClosedLoop:
                                  or rows < episodes):
             raise ConfigError(f"rows is {rows!r}; expected a whole number of rows, at least "
                               f"episodes ({episodes}), or None (every episode at once)")
+        if rows is not None and not callable(getattr(env, "restart", None)):
+            raise ConfigError(f"rows is {rows}, but {type(env).__name__} has no restart method to start "
+                              "a waiting episode in an ended one's row (docs/closed-loop.md#more-episodes-than-rows)")
         self.rows = None if rows is None else int(rows)
         kind = type(env)
         module, qualname = kind.__module__, kind.__qualname__

@@ -24,10 +24,16 @@ use crate::integrate::{Integrator, CANCEL_CHECK_STEPS, LANES};
 use crate::limits::{check_work, MAX_BATCH_ROWS};
 use crate::network::Network;
 use crate::population::Block;
+use crate::spin;
 
 /// Block-steps (blocks x N x N x substeps) from which a step runs its blocks on all cores; below
 /// it, handing the blocks to the thread pool costs more than it saves.
 const PARALLEL_WORK: usize = 1 << 14;
+
+/// Block-steps from which a smaller step shares its blocks with the spinning helpers of
+/// [`spin`], which are awake between the steps of a closed loop; below it, a step is over
+/// before a helper would have taken its first chunk.
+const SPIN_WORK: usize = 1 << 8;
 
 /// `P` networks times `E` replicas, stepped together one input row per call.
 ///
@@ -335,12 +341,15 @@ impl Batch {
             Ok(())
         };
         let busy = self.slots.iter().filter(|s| s.on != 0).count();
-        if busy * n * n * integ.substeps >= PARALLEL_WORK && busy > 1 {
+        let amount = busy * n * n * integ.substeps;
+        if amount >= PARALLEL_WORK && busy > 1 {
             self.blocks
                 .par_iter_mut()
                 .zip(self.slots.par_iter_mut())
                 .enumerate()
                 .try_for_each(|(b, (block, slot))| work(b, block, slot))?;
+        } else if amount >= SPIN_WORK && busy > 1 {
+            spin::try_for_each_zip(&mut self.blocks, &mut self.slots, work)?;
         } else {
             self.blocks
                 .iter_mut()

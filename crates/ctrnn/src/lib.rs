@@ -29,6 +29,7 @@ pub mod network;
 pub mod population;
 mod rows;
 pub mod simd;
+mod spin;
 // Internals for ctrnn's own integration tests (tests/unit); not public API.
 #[doc(hidden)]
 pub mod testing;

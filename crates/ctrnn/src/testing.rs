@@ -123,3 +123,8 @@ pub mod analysis {
         move || draws.next()
     }
 }
+
+/// The spinning helpers that share a batch's small steps.
+pub mod spin {
+    pub use crate::spin::helpers;
+}

@@ -330,3 +330,80 @@ fn fewer_rows_and_bad_assignments_are_refused_and_change_nothing() {
         assert_eq!(batch.network_of(), &[0, 0, 1, 1]);
     }
 }
+
+/// Steps small enough for the spinning helpers: `steps` steps of `p` networks x 2 replicas, each
+/// row sitting out the steps its random mask says; every row's state and rates.
+fn small_steps(nets: &[Network], steps: usize, seed: u64) -> (Vec<u64>, Vec<u64>) {
+    let (rows, n, m) = (nets.len() * 2, nets[0].size(), nets[0].n_inputs());
+    let mut batch = Batch::new(nets, 2, integrator(true, 2)).unwrap();
+    let mut rates = vec![0.0; rows * n];
+    let mut state = seed;
+    let mut coin = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        state >> 62 != 0 // true three times in four
+    };
+    for t in 0..steps {
+        let x: Vec<f64> = (0..rows * m).map(|k| input(k / m, t, k % m)).collect();
+        let mask: Vec<bool> = (0..rows).map(|_| coin()).collect();
+        batch.step(&x, Some(&mask), &mut rates, None).unwrap();
+    }
+    (bits(&batch.states()), bits(&rates))
+}
+
+/// The helpers that share small steps change no bit: the same steps, with random rows left out,
+/// give the same states and rates as on one thread (a step from a rayon worker runs its blocks
+/// in order on that thread), also with two batches stepping at once from two threads.
+#[test]
+fn small_steps_shared_with_the_helpers_give_the_bits_of_one_thread() {
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    for seed in 0..6 {
+        // 200 rows in 13 blocks of N = 5: too small for rayon, large enough for the helpers.
+        let nets = random_networks(100, 5, 2, seed);
+        let alone = one.install(|| small_steps(&nets, 30, seed));
+        assert_eq!(small_steps(&nets, 30, seed), alone, "seed {seed}");
+        let (a, b) = std::thread::scope(|s| {
+            let a = s.spawn(|| small_steps(&nets, 30, seed));
+            let b = s.spawn(|| small_steps(&nets, 30, seed));
+            (a.join().unwrap(), b.join().unwrap())
+        });
+        assert_eq!(a, alone, "seed {seed}, first of two at once");
+        assert_eq!(b, alone, "seed {seed}, second of two at once");
+    }
+    assert!(ctrnn::testing::spin::helpers() < std::thread::available_parallelism().unwrap().get());
+}
+
+/// A step shared with the helpers fails as one thread would: with the lowest diverging row
+/// (though a helper may meet a higher one first), and with `Interrupted` when cancelled.
+#[test]
+fn small_steps_shared_with_the_helpers_fail_as_one_thread() {
+    let calm = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    // 256 rows in 16 blocks, 500 Euler steps each: rows 50 and 200 (blocks 3 and 12) diverge.
+    let nets: Vec<Network> = (0..256)
+        .map(|r| {
+            if r == 50 || r == 200 {
+                fast.clone()
+            } else {
+                calm.clone()
+            }
+        })
+        .collect();
+    for _ in 0..20 {
+        let mut batch = Batch::new(&nets, 1, integrator(false, 500)).unwrap();
+        let mut rates = vec![0.0; 256];
+        let err = batch.step(&[1.0; 256], None, &mut rates, None).unwrap_err();
+        assert!(err.to_string().contains("of row 50 "), "{err}");
+    }
+    let mut batch = Batch::new(&nets[..100], 1, integrator(false, 100)).unwrap();
+    let mut rates = vec![0.0; 100];
+    let cancel = AtomicBool::new(true);
+    let err = batch
+        .step(&[1.0; 100], None, &mut rates, Some(&cancel))
+        .unwrap_err();
+    assert!(matches!(err, Error::Interrupted));
+}

@@ -7,7 +7,8 @@
 //! - [`by_pair`] assesses a few networks on many trials: (network, trial) pairs [`LANES`] at a
 //!   time, groups in parallel, so that one network still fills every lane and core.
 //!
-//! A lane's result never depends on its neighbours, so both give the same bits for a pair.
+//! A lane's result never depends on its neighbours, so both give the same bits for a pair. When
+//! blocks or groups fail, the error is the first one's in order, whatever the threads.
 
 use std::borrow::Borrow;
 use std::collections::HashMap;
@@ -85,7 +86,10 @@ fn blocks<N: Borrow<Network> + Sync, A, T: Send>(
             }
             Ok(finish(acc))
         })
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<Vec<Result<_>>>();
+    // In block order, so that the error reported (the first block's) does not depend on which
+    // thread failed first.
+    let per_block = per_block.into_iter().collect::<Result<Vec<_>>>()?;
     Ok(per_block.into_iter().flatten().collect())
 }
 
@@ -178,6 +182,8 @@ pub fn by_pair<T: Send>(
             let mut lanes = Lanes::<LANES>::new(&refs)?;
             run(&mut lanes, lane_pairs, group.len()).map_err(|d| d.error(|lane| lane_pairs[lane].0))
         })
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<Vec<Result<_>>>();
+    // In group order, as in `by_block`.
+    let per_group = per_group.into_iter().collect::<Result<Vec<_>>>()?;
     Ok(per_group.into_iter().flatten().collect())
 }

@@ -215,6 +215,34 @@ fn batched_evaluation_equals_run_trial() {
 }
 
 #[test]
+fn the_error_of_several_diverging_networks_names_the_first_whatever_the_threads() {
+    let t = task(small());
+    let mut nets = random_networks(160, 2);
+    // Two networks whose Euler steps are unstable (dt / tau = 10), in blocks 4 and 5 of 10: with
+    // two threads, one runs blocks 0-4 in order and the other starts at block 5, so the later
+    // network's divergence is found first.
+    let fast = |net: &Network| {
+        let tau = vec![0.01; net.size()];
+        let (theta, w, s) = (net.theta(), net.weights(), net.sensor_weights());
+        Network::new(tau, theta.to_vec(), w.to_vec(), s.to_vec(), None).unwrap()
+    };
+    nets[70] = fast(&nets[70]);
+    nets[85] = fast(&nets[85]);
+    for threads in [1, 2, 2, 2, 2, 2] {
+        let e = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| t.evaluate(&nets, 0, 0, None))
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("network 70 "),
+            "{threads} threads: {e}"
+        );
+    }
+}
+
+#[test]
 fn evaluation_does_not_depend_on_threads() {
     let t = task(small());
     let nets = random_networks(37, 2);

@@ -343,11 +343,17 @@ impl Batch {
         let busy = self.slots.iter().filter(|s| s.on != 0).count();
         let amount = busy * n * n * integ.substeps;
         if amount >= PARALLEL_WORK && busy > 1 {
-            self.blocks
+            // The lowest failing block's error, as in order: not whichever thread failed first.
+            let failed = self
+                .blocks
                 .par_iter_mut()
                 .zip(self.slots.par_iter_mut())
                 .enumerate()
-                .try_for_each(|(b, (block, slot))| work(b, block, slot))?;
+                .filter_map(|(b, (block, slot))| work(b, block, slot).err().map(|e| (b, e)))
+                .min_by_key(|&(b, _)| b);
+            if let Some((_, e)) = failed {
+                return Err(e);
+            }
         } else if amount >= SPIN_WORK && busy > 1 {
             spin::try_for_each_zip(&mut self.blocks, &mut self.slots, work)?;
         } else {

@@ -377,8 +377,9 @@ fn small_steps_shared_with_the_helpers_give_the_bits_of_one_thread() {
     assert!(ctrnn::testing::spin::helpers() < std::thread::available_parallelism().unwrap().get());
 }
 
-/// A step shared with the helpers fails as one thread would: with the lowest diverging row
-/// (though a helper may meet a higher one first), and with `Interrupted` when cancelled.
+/// A step shared with the helpers, or with rayon's threads, fails as one thread would: with the
+/// lowest diverging row (though another thread may meet a higher one first), and with
+/// `Interrupted` when cancelled.
 #[test]
 fn small_steps_shared_with_the_helpers_fail_as_one_thread() {
     let calm = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
@@ -393,11 +394,14 @@ fn small_steps_shared_with_the_helpers_fail_as_one_thread() {
             }
         })
         .collect();
-    for _ in 0..20 {
-        let mut batch = Batch::new(&nets, 1, integrator(false, 500)).unwrap();
-        let mut rates = vec![0.0; 256];
-        let err = batch.step(&[1.0; 256], None, &mut rates, None).unwrap_err();
-        assert!(err.to_string().contains("of row 50 "), "{err}");
+    // 500 substeps make a step for the helpers; 2000, one big enough for rayon's threads.
+    for substeps in [500, 2000] {
+        for _ in 0..20 {
+            let mut batch = Batch::new(&nets, 1, integrator(false, substeps)).unwrap();
+            let mut rates = vec![0.0; 256];
+            let err = batch.step(&[1.0; 256], None, &mut rates, None).unwrap_err();
+            assert!(err.to_string().contains("of row 50 "), "{substeps}: {err}");
+        }
     }
     let mut batch = Batch::new(&nets[..100], 1, integrator(false, 100)).unwrap();
     let mut rates = vec![0.0; 100];

@@ -162,22 +162,32 @@ impl Population {
         } else {
             self.blocks.iter().map(|_| None).collect()
         };
-        self.blocks
+        // The lowest failing block's error, as in order: not whichever thread failed first.
+        let failed = self
+            .blocks
             .par_iter_mut()
             .zip(chunks.par_iter_mut())
             .enumerate()
-            .try_for_each(|(b, (block, chunk))| {
+            .filter_map(|(b, (block, chunk))| {
                 let row = |t, row: &mut [[f64; LANES]]| fill(b, t, row);
                 let real = block.len();
-                block.run_rows(steps, integ, cancel, row, |t, state| {
-                    if let Some(chunk) = chunk.as_deref_mut() {
-                        for l in 0..real {
-                            let at = (l * steps + t) * n;
-                            copy_lane(state, l, &mut chunk[at..at + n]);
+                block
+                    .run_rows(steps, integ, cancel, row, |t, state| {
+                        if let Some(chunk) = chunk.as_deref_mut() {
+                            for l in 0..real {
+                                let at = (l * steps + t) * n;
+                                copy_lane(state, l, &mut chunk[at..at + n]);
+                            }
                         }
-                    }
-                })
-            })?;
+                    })
+                    .and_then(|()| block.check_finite(|l| format!("network {}", b * LANES + l)))
+                    .err()
+                    .map(|e| (b, e))
+            })
+            .min_by_key(|&(b, _)| b);
+        if let Some((_, e)) = failed {
+            return Err(e);
+        }
         Ok(if record { out } else { self.states() })
     }
 }

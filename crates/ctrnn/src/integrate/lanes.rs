@@ -406,7 +406,8 @@ impl<const L: usize> Lanes<L> {
 
     /// Runs `steps` input rows. `row(t, inputs)` fills the sensors of row `t`; after each row
     /// `record(t, state)` may read the state (one `[f64; L]` per neuron). Stops with
-    /// [`Error::Interrupted`] when `cancel` is set.
+    /// [`Error::Interrupted`] when `cancel` is set. The states are not checked: call
+    /// [`Lanes::check_finite`] after.
     pub fn run_rows(
         &mut self,
         steps: usize,
@@ -419,8 +420,7 @@ impl<const L: usize> Lanes<L> {
         with_backend!(
             simd::kernel(),
             self.run_rows_with(steps, integ, cancel, row, record)
-        )?;
-        self.check_finite()
+        )
     }
 
     #[inline(always)]
@@ -487,15 +487,18 @@ impl<const L: usize> Lanes<L> {
         (work, &mut self.state)
     }
 
-    /// An Euler step with `dt / tau > 2` oscillates with growing amplitude; say so rather than
-    /// return infinities.
-    fn check_finite(&self) -> Result<()> {
+    /// Fails when a real lane's state is not finite, naming the first such neuron and lane (lane
+    /// `l` as `name(l)`: what the caller knows it as). An Euler step with `dt / tau > 2`
+    /// oscillates with growing amplitude; say so rather than return infinities.
+    pub fn check_finite(&self, name: impl Fn(usize) -> String) -> Result<()> {
         for (i, row) in self.state.iter().enumerate() {
             if let Some(l) = (0..self.len).find(|&l| !row[l].is_finite()) {
                 return Err(Error::InvalidArgument(format!(
-                    "integration diverged: state[{i}] of network {l} in its block became {}; \
-                     use a smaller dt (dt / tau = {} here; Euler needs it well below 2)",
-                    row[l], self.scratch.h[i][l]
+                    "integration diverged: state[{i}] of {} became {}; use a smaller dt \
+                     (dt / tau = {} here; Euler needs it well below 2)",
+                    name(l),
+                    row[l],
+                    self.scratch.h[i][l]
                 )));
             }
         }

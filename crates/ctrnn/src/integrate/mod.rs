@@ -74,6 +74,7 @@ impl Network {
             },
             |t, state| copy_lane(state, 0, &mut states[t * n..(t + 1) * n]),
         )?;
+        lanes.check_finite(|_| "the network".into())?;
         lanes.lane_state(0, self.state_mut());
         Ok(states)
     }

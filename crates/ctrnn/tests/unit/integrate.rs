@@ -116,7 +116,10 @@ fn divergence_is_reported_not_returned() {
         ..Integrator::default()
     };
     let e = net.run(&[0.0], 1, &huge).unwrap_err().to_string();
-    assert!(e.contains("diverged"), "{e}");
+    assert!(
+        e.contains("diverged: state[0] of the network became"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -83,3 +83,44 @@ fn input_shape_is_checked() {
         .to_string();
     assert!(e.contains("P x T x M = 4"), "{e}");
 }
+
+/// A population whose networks diverge names the first of them by its index in the population,
+/// whatever the threads: not its lane in its block, nor the block a thread met first.
+#[test]
+fn a_diverging_population_names_its_first_diverging_network() {
+    let calm = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    // 160 networks in 10 blocks: 70 (block 4) and 85 (block 5) diverge. With two threads, one
+    // runs blocks 0-4 in order and the other starts at block 5.
+    let nets: Vec<Network> = (0..160)
+        .map(|p| {
+            if p == 70 || p == 85 {
+                fast.clone()
+            } else {
+                calm.clone()
+            }
+        })
+        .collect();
+    for threads in [1, 2, 2, 2, 2] {
+        let e = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let mut pop = Population::new(&nets).unwrap();
+                pop.run(
+                    Inputs::Shared(&[1.0; 1000]),
+                    1000,
+                    &Integrator::default(),
+                    false,
+                    None,
+                )
+            })
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("state[0] of network 70 became"),
+            "{threads} threads: {e}"
+        );
+    }
+}

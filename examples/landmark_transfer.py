@@ -18,7 +18,9 @@ bigger room with the landmark off-centre). In each world, on the same test trial
   worlds' trials only (leave one world out), which says whether the features themselves
   transfer.
 
-A champion meets the issue's goal in a world when it is right in more than 85% of the trials and
+The judging is :mod:`dnnevo.tasks.landmark_transfer`'s, which the reproduction's
+``landmark-worlds`` and ``landmark-robust-worlds`` jobs also run. A champion meets the issue's
+goal in a world when it is right in more than 85% of the trials and
 the 95% Wilson interval's lower end is above 80%::
 
     python examples/landmark_transfer.py /root/dnnevo-reference/landmark \\
@@ -36,54 +38,20 @@ import re
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
-from dnnevo.evaluation import observer
 from dnnevo.evaluation.stats import wilson
 from dnnevo.experiments import examples
 from dnnevo.runs import RunDir
-from dnnevo.tasks import landmark, landmark_worlds
+from dnnevo.tasks import landmark_transfer as transfer
+from dnnevo.tasks.landmark_transfer import FIT_SEED, HELD_OUT, PLACES, TEST_SEED, meets
 
 REFERENCE = [Path("/root/dnnevo-reference/landmark"), Path("/root/dnnevo-reference/landmark-robust")]
 """The champions judged by default: the reference reproduction's ``landmark`` and
 ``landmark-robust`` runs, seeds 0-9."""
-
-FIT_SEED = 47_001
-"""The seed of the trials the threshold rule and the observer are fitted on."""
-TEST_SEED = 47_002
-"""The seed of the trials everything is judged on. Runs draw their training and validation
-trials from their own run seeds (0-9) under other stream purposes; ``dnnevo sweep`` and the docs
-judge on 1000003 + seed, 3000003, 5000011 and 7: no run or earlier figure used 47001 or 47002."""
-
-NEAR = 0.25
-"""The input above which the sonar "reads near": a range under 0.5 / 0.25 = 2 m."""
-
-THRESHOLD_COLUMNS = [observer.FEATURES.index("mean"), observer.FEATURES.index("fraction near")]
-"""The features the single-threshold rule may use: the input's mean and the fraction near."""
-
-GOAL_RATE, GOAL_LOWER = 0.85, 0.80
-"""The issue's goal for a champion in a world: rate above 85%, interval's lower end above 80%."""
-
-
-@dataclass(frozen=True)
-class Place:
-    """A world champions are judged in: its config overlay and whether trials are robot-like."""
-
-    name: str
-    world: landmark_worlds.World
-    robot_like: bool = False
-
-
-PLACES = [Place("training", landmark_worlds.TRAINING),
-          Place("robot-like", landmark_worlds.TRAINING, robot_like=True),
-          *(Place(name, w) for name, w in landmark_worlds.WORLDS.items())]
-HELD_OUT = list(landmark_worlds.WORLDS)
 
 
 def champions(folder: Path) -> list[tuple[str, Path]]:
@@ -103,64 +71,14 @@ def load(run: Path) -> tuple[EvolutionConfig, _core.Network]:
     return config, rd.read_best(config, table)
 
 
-def sonar_features(config: EvolutionConfig, net: _core.Network, per_landmark: int, seed: int,
-                   robot_like: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Features and labels (0: landmark 1, 1: landmark 2) of the trials ``assess`` draws from
-    ``seed``: trial t of ``2 per_landmark``, landmark 1 first (the sonar does not depend on the
-    network, which the recorder only needs to run)."""
-    rows, labels = [], []
-    for t in range(2 * per_landmark):
-        which = 1 if t < per_landmark else 2
-        rec = landmark.record(config, net, which, seed=seed, trial=t, robot_like=robot_like)
-        rows.append(observer.features(rec.input, NEAR))
-        labels.append(which - 1)
-    return np.array(rows), np.array(labels)
-
-
-def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int) -> dict[str, dict[str, Any]]:
-    """Each place's threshold rule and observer, fitted on ``fit`` trials per landmark from
-    FIT_SEED and judged on ``test`` from TEST_SEED; held-out worlds also get the observer fitted
-    on the other held-out worlds."""
-    data = {}
-    for place in PLACES:
-        cfg = landmark_worlds.config(base, place.world)
-        data[place.name] = (sonar_features(cfg, net, fit, FIT_SEED, place.robot_like),
-                            sonar_features(cfg, net, test, TEST_SEED, place.robot_like))
-    out = {}
-    for name, ((xf, yf), (xt, yt)) in data.items():
-        rule = observer.fit_threshold(xf, yf, THRESHOLD_COLUMNS)
-        model = observer.fit_logistic(xf, yf)
-        result = {"threshold": int(np.sum(rule.predict(xt) == yt)), "observer": int(np.sum(model.predict(xt) == yt)),
-                  "n": len(yt), "rule": f"{observer.FEATURES[rule.feature]} {'>' if rule.sign > 0 else '<'} "
-                                        f"{rule.threshold:.3g} says landmark 2"}
-        if name in HELD_OUT:
-            others = [data[o][0] for o in HELD_OUT if o != name]
-            lowo = observer.fit_logistic(np.vstack([x for x, _ in others]), np.concatenate([y for _, y in others]))
-            result["observer, other worlds"] = int(np.sum(lowo.predict(xt) == yt))
-        out[name] = result
-    return out
-
-
 def judge(run: Path, trials: int) -> dict[str, int]:
     """Trials right of ``run``'s champion in each place (of ``2 trials``), and under
     ``"<place> one answer"`` the trials given its commoner answer."""
-    config, net = load(run)
-    out = {}
-    for place in PLACES:
-        report = landmark.assess(landmark_worlds.config(config, place.world), net, trials, TEST_SEED,
-                                 robot_like=place.robot_like)
-        (a, b), (c, d) = report["confusion"]
-        out[place.name] = a + d
-        out[f"{place.name} one answer"] = max(a + c, b + d)
-    return out
+    return transfer.judge(*load(run), trials)
 
 
 def pct(k: int, n: int) -> str:
     return f"{100 * k / n:.1f}"
-
-
-def meets(k: int, n: int) -> bool:
-    return k / n > GOAL_RATE and wilson(k, n)[0] > GOAL_LOWER
 
 
 def table(families: dict[str, dict[str, dict[str, int]]], base: dict[str, dict[str, Any]],
@@ -229,7 +147,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                                                          for p in PLACES), flush=True)
     first = champions(folders[0])[0][1]
     base_cfg, base_net = load(first)
-    base = bounds(base_cfg, base_net, args.fit_trials, args.trials)
+    base = transfer.bounds(base_cfg, base_net, args.fit_trials, args.trials)
     columns, rows, summary = table(families, base, args.trials)
     print()
     print(" | ".join(columns))

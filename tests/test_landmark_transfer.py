@@ -16,6 +16,7 @@ from dnnevo import presets
 from dnnevo.evaluation import observer
 from dnnevo.experiments import examples, results
 from dnnevo.tasks import landmark, landmark_worlds
+from dnnevo.tasks import landmark_transfer as transfer
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "examples"))
@@ -75,9 +76,9 @@ def test_logistic_regression_recovers_a_known_rule() -> None:
 
 def test_the_threshold_rule_sees_only_its_fitting_trials(monkeypatch: pytest.MonkeyPatch) -> None:
     """The bounds fit on FIT_SEED's trials and judge on TEST_SEED's, the champions' test seed."""
-    assert landmark_transfer.FIT_SEED != landmark_transfer.TEST_SEED
+    assert transfer.FIT_SEED != transfer.TEST_SEED
     seen: list[tuple[int, int]] = []
-    sense = landmark_transfer.sonar_features
+    sense = transfer.sonar_features
 
     def spy(config, net, per_landmark, seed, robot_like):  # type: ignore[no-untyped-def]
         seen.append((seed, per_landmark))
@@ -90,13 +91,13 @@ def test_the_threshold_rule_sees_only_its_fitting_trials(monkeypatch: pytest.Mon
         fits.append(np.asarray(x))
         return fit(x, y, columns)
 
-    monkeypatch.setattr(landmark_transfer, "sonar_features", spy)
+    monkeypatch.setattr(transfer, "sonar_features", spy)
     monkeypatch.setattr(observer, "fit_threshold", fit_spy)
-    monkeypatch.setattr(landmark_transfer, "PLACES", landmark_transfer.PLACES[:1])
+    monkeypatch.setattr(transfer, "PLACES", transfer.PLACES[:1])
     cfg = presets.get("landmark")
     net = dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=1)
-    out = landmark_transfer.bounds(cfg, net, 3, 2)
-    assert seen == [(landmark_transfer.FIT_SEED, 3), (landmark_transfer.TEST_SEED, 2)]
+    out = transfer.bounds(cfg, net, 3, 2)
+    assert seen == [(transfer.FIT_SEED, 3), (transfer.TEST_SEED, 2)]
     assert len(fits) == 1 and len(fits[0]) == 6  # fitted on the 2 x 3 fitting trials alone
     assert out["training"]["n"] == 4
 
@@ -105,15 +106,44 @@ def test_the_sonar_features_are_of_the_champions_test_trials() -> None:
     """The bounds judge the very trials ``assess`` draws: trial t of a seed is the same sonar."""
     cfg = presets.get("landmark")
     net = dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=2)
-    x, y = landmark_transfer.sonar_features(cfg, net, 2, 9, False)
+    x, y = transfer.sonar_features(cfg, net, 2, 9, False)
     assert y.tolist() == [0, 0, 1, 1]
-    again = [observer.features(landmark.record(cfg, net, 2, seed=9, trial=3).input, landmark_transfer.NEAR)]
+    again = [observer.features(landmark.record(cfg, net, 2, seed=9, trial=3).input, transfer.NEAR)]
     assert np.array_equal(x[3], again[0])
     # ... and those recorded trials are the ones assess judges, trial by trial, in the same order.
     judged = landmark.assess(cfg, net, 2, seed=9)["trials"]
     recorded = [(lm, landmark.record(cfg, net, lm, seed=9, trial=t).classification)
                 for t, lm in enumerate([1, 1, 2, 2])]
     assert [(lm, f) for lm, f in judged] == recorded
+
+
+# What examples/landmark_transfer.py computed for this network before its judging moved into
+# dnnevo.tasks.landmark_transfer (judge: 6 trials per landmark; bounds: fitted on 5, judged on 6).
+BEFORE_JUDGE = {"training": 6, "training one answer": 12, "robot-like": 6, "robot-like one answer": 12,
+                "follower": 6, "follower one answer": 12, "sonar": 6, "sonar one answer": 12,
+                "room": 7, "room one answer": 11}
+BEFORE_BOUNDS = {
+    "training": {"threshold": 11, "observer": 12, "n": 12, "rule": "mean > 0.218 says landmark 2"},
+    "robot-like": {"threshold": 11, "observer": 11, "n": 12, "rule": "mean > 0.2 says landmark 2"},
+    "follower": {"threshold": 12, "observer": 12, "n": 12, "rule": "mean > 0.262 says landmark 2",
+                 "observer, other worlds": 11},
+    "sonar": {"threshold": 12, "observer": 12, "n": 12, "rule": "mean > 0.235 says landmark 2",
+              "observer, other worlds": 11},
+    "room": {"threshold": 10, "observer": 12, "n": 12, "rule": "mean > 0.145 says landmark 2",
+             "observer, other worlds": 6},
+}
+
+
+def test_the_library_answers_as_the_example_did() -> None:
+    """The example's record stays what it was: the judging it now calls gives its earlier answer."""
+    cfg = presets.get("landmark-robust")
+    net = dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=5)
+    assert transfer.judge(cfg, net, 6) == BEFORE_JUDGE
+    assert transfer.bounds(cfg, net, 5, 6) == BEFORE_BOUNDS
+    # A subset of places answers as the whole does, place by place.
+    some = [transfer.place(n) for n in ["training", *transfer.HELD_OUT]]
+    assert transfer.bounds(cfg, net, 5, 6, some) == {p.name: BEFORE_BOUNDS[p.name] for p in some}
+    assert transfer.judge(cfg, net, 6, some[1:2]) == {"follower": 6, "follower one answer": 12}
 
 
 def test_a_tiny_run_makes_a_record_that_renders(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

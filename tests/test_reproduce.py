@@ -26,7 +26,7 @@ from dnnevo.experiments import report
 from dnnevo.experiments import runsview
 from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError
-from dnnevo.runs import RunFileError
+from dnnevo.runs import RunDir, RunFileError
 
 QUICK = jobs.Settings(quick=True, eval_trials=10, dt_check=False)
 
@@ -65,7 +65,9 @@ def test_the_graph_puts_every_job_after_what_it_needs() -> None:
         assert all(n.endswith(f"/seed-{job.seed}") for n in job.needs)
         seen.add(job.id)
     assert len(order) == 3 * len(plan.EXPERIMENTS)
-    assert {j.experiment for j in plan.jobs([0], only=["landmark"])} == {"landmark", "landmark-robot", "landmark-robust", "landmark-robust-robot"}
+    assert {j.experiment for j in plan.jobs([0], only=["landmark"])} == {
+        "landmark", "landmark-robot", "landmark-worlds", "landmark-robust", "landmark-robust-robot",
+        "landmark-robust-worlds"}
     with pytest.raises(ConfigError, match="families are"):
         plan.jobs([0], only=["vision"])
     with pytest.raises(ConfigError, match="distinct"):
@@ -117,6 +119,11 @@ def test_a_tampered_result_is_refused(tmp_path: Path) -> None:
 @pytest.mark.parametrize(("experiment", "needs", "edit"), [
     ("landmark-robot", ("landmark",), lambda d: d["assessment"].pop("confusion")),
     ("landmark-robot", ("landmark",), lambda d: d["assessment"].update(confusion=[[1, 2]])),
+    ("landmark-worlds", ("landmark",), lambda d: d["worlds"]["sonar"].update(right=21)),
+    ("landmark-worlds", ("landmark",), lambda d: d["worlds"]["training"].update({"observer, other worlds": 3})),
+    ("landmark-worlds", ("landmark",), lambda d: d["worlds"].pop("room")),
+    ("landmark-worlds", ("landmark",), lambda d: d.update(test_seed=7)),
+    ("landmark-worlds", ("landmark",), lambda d: d.update(trials=11)),
     ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"), lambda d: d.pop("wall_s")),
     ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"), lambda d: d.update(wall_s="abc")),
     ("nav1d-system", ("nav1d-classifier", "nav1d-far", "nav1d-near"),
@@ -146,6 +153,52 @@ def test_a_result_of_the_wrong_shape_is_named(tmp_path: Path, experiment: str, n
     jobs.result_path(tmp_path, job).write_text(json.dumps(data))
     with pytest.raises(RunFileError, match="not a valid job result"):
         jobs.read_result(tmp_path, job, QUICK)
+
+
+def test_the_held_out_worlds_job_judges_each_world_is_checked_and_renders(tmp_path: Path) -> None:
+    from dnnevo.experiments.scheduler import Outcome, Task
+    from dnnevo.tasks import landmark_transfer
+
+    landmark = plan.Job("landmark", 0, ())
+    worlds = plan.Job("landmark-worlds", 0, ("landmark/seed-0",))
+    done = jobs.run_job(landmark, tmp_path, QUICK, 1)
+    t0 = time.perf_counter()
+    found = jobs.run_job(worlds, tmp_path, QUICK, 1)
+    assert time.perf_counter() - t0 < 10  # quick reproductions stay quick
+    assert jobs.read_result(tmp_path, worlds, QUICK) == found
+    # The library's figures for the champion, on the example's trials (10 per landmark here).
+    run = RunDir(tmp_path / landmark.id)
+    config, table = run.read_config()
+    net = run.read_best(config, table)
+    places = [landmark_transfer.place(p) for p in jobs.WORLD_PLACES]
+    right = landmark_transfer.judge(config, net, 10, places)
+    bounds = landmark_transfer.bounds(config, net, 10, 10, places)
+    assert found["trials"] == found["fit_trials"] == 10 and found["test_seed"] == landmark_transfer.TEST_SEED
+    for p in jobs.WORLD_PLACES:
+        assert found["worlds"][p] == {"right": right[p], "one answer": right[f"{p} one answer"], **bounds[p]}
+    # A damaged field is one line naming it.
+    path = jobs.result_path(tmp_path, worlds)
+    path.write_text(json.dumps({**found, "worlds": {**found["worlds"], "room": {**found["worlds"]["room"],
+                                                                                  "observer": -1}}}))
+    with pytest.raises(RunFileError, match=r"worlds\.room\.observer is -1") as e:
+        jobs.read_result(tmp_path, worlds, QUICK)
+    assert "\n" not in str(e.value)
+    # It renders: the summary counts seeds meeting the goal everywhere, the table world by world.
+    path.write_text(json.dumps(found))
+    order = [landmark, worlds]
+    outcomes = {j.id: Outcome(Task(j.id, j.needs, jobs.run_job), "done", r) for j, r in zip(order, [done, found])}
+    row = report.summary_row(plan.experiment("landmark-worlds"), order, outcomes)
+    assert row[1].endswith("the held-out worlds are not in the paper") and row[2] == "1/1"
+    assert re.fullmatch(r"seeds right in >85% with the interval's lower end >80% in every held-out world: "
+                        r"[01]/1 \(.*\)", row[4])
+    block = report.seed_table(plan.experiment("landmark-worlds"), order, outcomes)
+    assert block is not None and block.rows[0][1:5] == ("training: right (95% interval)",
+                                                        "follower (held out): right (95% interval)",
+                                                        "sonar (held out): right (95% interval)",
+                                                        "room (held out): right (95% interval)")
+    n = 2 * 10
+    assert block.rows[1][2].startswith(f"{found['worlds']['follower']['right']}/{n} (")
+    assert "10 trials per landmark per world, seed 47002" in block.rows[1][7]
 
 
 def test_a_result_is_not_trusted_when_its_runs_changed(tmp_path: Path) -> None:

@@ -47,7 +47,7 @@ def repo(tmp_path: Path, reproduction: Path) -> Path:
     (repo / "README.md").write_text(README, encoding="utf-8")
     r = _results("collect", source, repo / "docs" / "results", "--seeds", "0", "--commit", "abc1234")
     assert r.returncode == 0, r.stderr
-    assert "collected 4 results" in r.stdout
+    assert "collected 6 results" in r.stdout
     shutil.rmtree(source)  # the tables need no run folder
     return repo
 
@@ -55,12 +55,13 @@ def repo(tmp_path: Path, reproduction: Path) -> Path:
 def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) -> None:
     stored = repo / "docs" / "results"
     assert sorted(p.relative_to(stored).as_posix() for p in stored.rglob("*.json")) == [
-        "landmark-robot/seed-0.json", "landmark-robust-robot/seed-0.json", "landmark-robust/seed-0.json",
-        "landmark/seed-0.json", "provenance.json", "reproduce.json"]
+        "landmark-robot/seed-0.json", "landmark-robust-robot/seed-0.json", "landmark-robust-worlds/seed-0.json",
+        "landmark-robust/seed-0.json", "landmark-worlds/seed-0.json", "landmark/seed-0.json", "provenance.json",
+        "reproduce.json"]
     provenance = json.loads((stored / "provenance.json").read_text())
     assert provenance["commit"] == "abc1234" and provenance["seeds"] == [0]
     assert provenance["environment"]["SIMD kernel"] and provenance["environment"]["dnnevo"].endswith("(git abc1234)")
-    assert provenance["families"]["landmark"]["runs"] == provenance["families"]["landmark"]["planned"] == 4
+    assert provenance["families"]["landmark"]["runs"] == provenance["families"]["landmark"]["planned"] == 6
     assert provenance["families"]["landmark"]["command"] == (
         "dnnevo reproduce --seeds 0 --only landmark --quick --eval-trials 10 --no-dt-check")
 
@@ -79,16 +80,17 @@ def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) 
     hand = plan.experiment("reactive-navigation-hand")
     assert f"| {hand.name} | {hand.paper} | not yet run | - | - |" in readme
     planned = len(plan.jobs([0]))  # the paper's families, seed 0
-    assert "commit abc1234" in readme and f"4 of {planned} runs done" in readme and "Quick mode" in readme
+    assert "commit abc1234" in readme and f"6 of {planned} runs done" in readme and "Quick mode" in readme
     # Families beyond the paper's appear only once their runs are collected.
     assert not any(f"| {e.name} |" in readme for e in plan.EXPERIMENTS if e.family not in plan.PAPER_FAMILIES)
 
     page = (stored / "index.md").read_text()
     assert "<!-- results:landmark:begin -->\n\n### landmark\n\nPaper: §3" in page
     assert "| seed | right (95% interval) | confusion" in page
+    assert "| seed | training: right (95% interval) | follower (held out): right (95% interval) |" in page
     assert ("### nav1d-far\n\nPaper: §4.2: solved at generation 0. Preset `nav1d-far`.\n\n"
             "Not yet run over seeds 0.") in page
-    assert "| landmark | (whole family) | 4/4 |" in page and "| nav1d | (whole family) | not yet run |" in page
+    assert "| landmark | (whole family) | 6/6 |" in page and "| nav1d | (whole family) | not yet run |" in page
     assert "| commit | abc1234 |" in page
 
     assert _results("render", "--root", repo, "--check").returncode == 0
@@ -207,7 +209,7 @@ def test_a_family_collected_again_at_another_commit_names_both(tmp_path: Path, r
     # The earlier session had not finished the robot-like test.
     (dest / "landmark-robot" / "seed-0.json").unlink()
     provenance = json.loads((dest / "provenance.json").read_text())
-    provenance["families"]["landmark"].update(runs=3, elapsed_s=100, machines=["Earlier CPU, SIMD kernel avx2"])
+    provenance["families"]["landmark"].update(runs=5, elapsed_s=100, machines=["Earlier CPU, SIMD kernel avx2"])
     (dest / "provenance.json").write_text(json.dumps(provenance))
     for commit in ("def5678", "fed9999"):
         r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", commit)
@@ -215,7 +217,7 @@ def test_a_family_collected_again_at_another_commit_names_both(tmp_path: Path, r
     provenance = json.loads((dest / "provenance.json").read_text())
     family = provenance["families"]["landmark"]
     assert family["commit"] == provenance["commit"] == "abc1234, def5678"
-    assert family["runs"] == first["runs"] == 4
+    assert family["runs"] == first["runs"] == 6
     assert family["elapsed_s"] >= 100  # the earlier time, and the new run's (under a second here)
     assert family["machines"][0] == "Earlier CPU, SIMD kernel avx2" and len(family["machines"]) == 2
 

@@ -28,7 +28,7 @@ continues it."""
 
 DESCRIPTION = """\
 Run every experiment of the paper over seeds and write a report: landmark recognition (ideal
-training, then the robot-like test of the champions), predator avoidance and reactive navigation
+training, then the robot-like test of the champions and the held-out worlds), predator avoidance and reactive navigation
 (family robots: the paper's hand-designed network with and without its detectors on fresh
 starts, nothing evolved, then dnnevo's evolved comparison), one-dimensional navigation (the
 three subnetworks, the goal seekers evolved on chains, both integrated systems, the single
@@ -36,9 +36,10 @@ network) and sequence learning (1-bit, alternating, the incremental 2-bit route 
 runs, direct 2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). --only classic
 runs the field's benchmarks written as Python tasks instead (walker, categorical perception,
 double pole). Each evolution has its own run folder OUT/EXPERIMENT/seed-N and its result in
-OUT/EXPERIMENT/seed-N.json (the robot-like test, the integrated systems and the hand-designed
-navigator are tests and have only the result; the navigator's starts per world are
---eval-trials, else 200, or 20 with --quick). The report, OUT/report.md and OUT/report.html,
+OUT/EXPERIMENT/seed-N.json (the robot-like test, the held-out worlds, the integrated systems
+and the hand-designed navigator are tests and have only the result; the navigator's starts per
+world are --eval-trials, else 200, or 20 with --quick, and the held-out worlds' trials per
+landmark --eval-trials, else 100, or 10 with --quick). The report, OUT/report.md and OUT/report.html,
 covers the seeds and families of the command that wrote it."""
 
 EXAMPLE = """examples:

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo import tasks
-from dnnevo.tasks import nav1d, registry
+from dnnevo.tasks import landmark_transfer, nav1d, registry
 from dnnevo.experiments import plan
 from dnnevo import presets
 from dnnevo.evaluation import stats
@@ -38,8 +38,9 @@ from dnnevo.runs.files import read_json
 from dnnevo.evolution.seeding import Seeding
 from dnnevo.robots import navigation
 
-__all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "HAND_STARTS", "HAND_QUICK_STARTS", "HAND_CONDITIONS", "Settings",
-           "Stopped", "result_path", "read_result", "run_job", "hand_counts"]
+__all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "HAND_STARTS", "HAND_QUICK_STARTS", "HAND_CONDITIONS", "WORLD_TRIALS",
+           "WORLD_QUICK_TRIALS", "WORLD_PLACES", "Settings", "Stopped", "result_path", "read_result", "run_job",
+           "hand_counts", "world_counts"]
 
 ROBOT_SEED_BASE = 3_000_003
 """The robot-like test of seed s's landmark champion draws its trials from seed
@@ -60,6 +61,20 @@ HAND_STEPS = 1200
 
 HAND_CONDITIONS = ("with", "without")
 """The hand-designed navigator's conditions: with the static and cyclic detectors, without."""
+
+WORLD_TRIALS = 100
+"""Trials per landmark of a held-out-worlds job in each world, unless ``eval_trials`` says
+otherwise: as many as ``examples/landmark_transfer.py`` judges on, and as many again to fit the
+bounds on."""
+
+WORLD_QUICK_TRIALS = 10
+"""The same in a quick reproduction: it shows that the test runs, in about a second."""
+
+WORLD_PLACES = ("training", *landmark_transfer.HELD_OUT)
+"""The places a held-out-worlds job judges its champion in: the training world and the held-out
+worlds (the robot-like test is its own job)."""
+
+_BOUNDS = ("threshold", "observer", "observer, other worlds")
 
 
 class Stopped(Exception):
@@ -114,6 +129,14 @@ class Settings:
         if self.eval_trials is not None:
             return self.eval_trials
         return HAND_QUICK_STARTS if self.quick else HAND_STARTS
+
+    def world_trials(self) -> int:
+        """A held-out-worlds job's trials per landmark in each world (and the bounds' fitting
+        trials): ``eval_trials`` when given, else :data:`WORLD_QUICK_TRIALS` in a quick
+        reproduction and :data:`WORLD_TRIALS` in a full one."""
+        if self.eval_trials is not None:
+            return self.eval_trials
+        return WORLD_QUICK_TRIALS if self.quick else WORLD_TRIALS
 
     def to_dict(self) -> dict[str, Any]:
         """The settings and every evolution's config, as plain JSON types."""
@@ -232,6 +255,35 @@ def hand_counts(found: dict[str, Any]) -> dict[str, dict[str, tuple[int, int]]]:
     return out
 
 
+def world_counts(found: dict[str, Any]) -> dict[str, dict[str, int]]:
+    """A held-out-worlds result's counts, checked, by place (:data:`WORLD_PLACES`): ``right``
+    and ``one answer`` of the champion and the bounds' ``threshold``, ``observer`` and (in a
+    held-out world) ``observer, other worlds``, each of ``n``, twice the result's ``trials``. Its
+    ``test_seed`` and ``fit_seed`` must be :mod:`~dnnevo.tasks.landmark_transfer`'s (trials of
+    other seeds are not pooled with these) and ``fit_trials`` its ``trials``. Raises ValueError,
+    KeyError or TypeError otherwise."""
+    for key, want in (("test_seed", landmark_transfer.TEST_SEED), ("fit_seed", landmark_transfer.FIT_SEED)):
+        if _count(found[key], key) != want:
+            raise ValueError(f"{key} is {found[key]}; this dnnevo draws them from {want}")
+    trials = _count(found["trials"], "trials", 1)
+    _count(found["fit_trials"], "fit_trials", trials, trials)
+    worlds = found["worlds"]
+    if not isinstance(worlds, dict) or sorted(worlds) != sorted(WORLD_PLACES):
+        raise ValueError(f"worlds is {short(worlds)}; expected the places {', '.join(WORLD_PLACES)}")
+    out: dict[str, dict[str, int]] = {}
+    for name in WORLD_PLACES:
+        w = worlds[name]
+        keys = ["right", "one answer", "n", "rule", *_BOUNDS[:3 if name in landmark_transfer.HELD_OUT else 2]]
+        if not isinstance(w, dict) or sorted(w) != sorted(keys):
+            raise ValueError(f"worlds.{name} is {short(w)}; expected {', '.join(keys)}")
+        n = _count(w["n"], f"worlds.{name}.n", 2 * trials, 2 * trials)
+        out[name] = {k: _count(w[k], f"worlds.{name}.{k}", 0, n) for k in keys if k not in ("n", "rule")}
+        out[name]["n"] = n
+        if not isinstance(w["rule"], str):
+            raise ValueError(f"worlds.{name}.rule is {short(w['rule'])}; expected text")
+    return out
+
+
 def _check_body(job: plan.Job, found: dict[str, Any], settings: Settings) -> None:
     """Every field a report reads is there and of its type."""
     if not float(found["wall_s"]) >= 0.0:
@@ -247,6 +299,10 @@ def _check_body(job: plan.Job, found: dict[str, Any], settings: Settings) -> Non
         if len(matrix) != 2 or any(len(row) != 2 for row in matrix) or not all(
                 isinstance(x, int) and not isinstance(x, bool) and x >= 0 for row in matrix for x in row):
             raise ValueError("confusion is not a 2 x 2 matrix of counts")
+    elif kind == plan.HELD_OUT:
+        world_counts(found)
+        if found["trials"] != settings.world_trials():
+            raise ValueError(f"trials is {found['trials']}; these settings draw {settings.world_trials()}")
     elif kind == plan.HAND_DESIGNED:
         hand_counts(found)
         if found["starts"] != settings.starts():
@@ -279,7 +335,7 @@ def run_job(job: plan.Job, root: str | Path, settings: Settings, threads: int | 
     if done is not None:
         return done
     t0 = time.perf_counter()
-    body = {plan.EVOLVE: _evolve, plan.ROBOT_LIKE: _robot_like, plan.SYSTEM: _system,
+    body = {plan.EVOLVE: _evolve, plan.ROBOT_LIKE: _robot_like, plan.HELD_OUT: _held_out, plan.SYSTEM: _system,
             plan.HAND_DESIGNED: _hand_designed}[job.spec.kind](
         job, root, settings, threads, progress)
     result = {**_header(job, settings), **body, "wall_s": round(time.perf_counter() - t0, 2),
@@ -316,6 +372,25 @@ def _robot_like(job: plan.Job, root: Path, settings: Settings, threads: int | No
     a = tasks.assess(config, run.read_best(config, table), settings.trials(config.task),
                seed=ROBOT_SEED_BASE + job.seed, robot_like=True)
     return {"assessment": a.to_dict()}
+
+
+def _held_out(job: plan.Job, root: Path, settings: Settings, threads: int | None,
+              progress: bool) -> dict[str, Any]:
+    """The champion in the training world and each held-out world, and each world's bounds, on
+    the trials ``examples/landmark_transfer.py`` uses: every seed's champion is judged on the
+    same trials (:data:`~dnnevo.tasks.landmark_transfer.TEST_SEED`), so its figures are the
+    example's and seeds differ by their champions alone. The bounds do not depend on the
+    champion; they cost as much again as judging it."""
+    run = RunDir(_folder(root, job.spec.needs[0], job.seed))
+    config, table = run.read_config()
+    net = run.read_best(config, table)
+    trials = settings.world_trials()
+    places = [landmark_transfer.place(p) for p in WORLD_PLACES]
+    right = landmark_transfer.judge(config, net, trials, places)
+    bounds = landmark_transfer.bounds(config, net, trials, trials, places)
+    worlds = {p: {"right": right[p], "one answer": right[f"{p} one answer"], **bounds[p]} for p in WORLD_PLACES}
+    return {"test_seed": landmark_transfer.TEST_SEED, "fit_seed": landmark_transfer.FIT_SEED, "trials": trials,
+            "fit_trials": trials, "worlds": worlds}
 
 
 def _system(job: plan.Job, root: Path, settings: Settings, threads: int | None, progress: bool) -> dict[str, Any]:

@@ -3,7 +3,8 @@ embedded) in the reproduction's folder.
 
 It holds the paper-vs-dnnevo table (success rates over seeds with their Wilson intervals, final
 champions passing on fresh conditions, median first-success generations with bootstrap
-intervals, step artefacts, wall times), the robot-like test's confusion matrices, the integrated
+intervals, step artefacts, wall times), the robot-like test's confusion matrices, the landmark
+champions in the held-out worlds beside each world's bounds, the integrated
 navigation system's goal rates, the hand-designed reactive navigator's arrivals with and without
 its detectors, every run's figures for the first seed of each experiment, a
 fitness figure over all seeds, and the machine and settings the runs ran with.
@@ -29,10 +30,11 @@ from dnnevo.experiments import plan
 from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
 from dnnevo.evaluation.assessment import Assessment
-from dnnevo.experiments.jobs import HAND_CONDITIONS, ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings, hand_counts
+from dnnevo.experiments.jobs import (HAND_CONDITIONS, ROBOT_SEED_BASE, SYSTEM_TRIALS, WORLD_PLACES, Settings,
+                                     hand_counts, world_counts)
 from dnnevo.robots.navigation import WORLDS
 from dnnevo.runs import RunDir, save_figure, write_atomic
-from dnnevo.tasks import nav1d
+from dnnevo.tasks import landmark_transfer, nav1d
 from dnnevo.experiments.scheduler import Outcome
 
 __all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "SUMMARY_HEADER",
@@ -103,9 +105,20 @@ def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[st
     if e.kind == plan.HAND_DESIGNED:
         counts = [hand_counts(o.result) for o in done if o.result]
         return (*head, "-", _hand_pooled(counts) if counts else "-", "-", "-", _median_wall(walls))
+    if e.kind == plan.HELD_OUT:
+        worlds = [world_counts(o.result) for o in done if o.result]
+        every = sum(_meets_every(w) for w in worlds)
+        text = (f"seeds right in >85% with the interval's lower end >80% in every held-out world: "
+                f"{_k_of_n(every, len(worlds))}" if worlds else "-")
+        return (*head, "-", text, "-", "-", _median_wall(walls))
     rates = [o.result["goal_rate"] for o in done if o.result]
     text = f"goal in {', '.join(_pct(r) for r in rates)} of trials" if rates else "-"
     return (*head, "-", text, "-", "-", _median_wall(walls))
+
+
+def _meets_every(counts: dict[str, dict[str, int]]) -> bool:
+    """Whether a champion meets issue 47's goal in every held-out world."""
+    return all(landmark_transfer.meets(counts[w]["right"], counts[w]["n"]) for w in landmark_transfer.HELD_OUT)
 
 
 def _hand_pooled(counts: Sequence[dict[str, dict[str, tuple[int, int]]]]) -> str:
@@ -147,6 +160,17 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
                          f"{_pct(overall.interval[1])})", f"[[{p}, {q}], [{s}, {t}]]",
                          ", ".join(f"{r.name} {_pct(r.rate)}" for r in a.rates[:-1]), a.verdict,
                          f"{o.result['wall_s']:.0f} s"))
+        elif e.kind == plan.HELD_OUT:
+            res = o.result
+            held = world_counts(res)
+            bounds = "; ".join(f"{w} " + " / ".join(_pct(held[w][b] / held[w]["n"]) for b in
+                                                    ("threshold", "observer", "observer, other worlds") if b in held[w])
+                               for w in WORLD_PLACES)
+            rows.append((str(job.seed), *(_k_of_n(held[w]["right"], held[w]["n"]) for w in WORLD_PLACES),
+                         "yes" if _meets_every(held) else "no", bounds,
+                         f"{res['trials']} trials per landmark per world, seed {res['test_seed']}; bounds "
+                         f"fitted on {res['fit_trials']} per landmark, seed {res['fit_seed']}",
+                         f"{res['wall_s']:.0f} s"))
         elif e.kind == plan.HAND_DESIGNED:
             res = o.result
             counts = hand_counts(res)
@@ -168,6 +192,10 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
                       "verdict", "largest change at a finer step", "wall (the run's, every session)"),
         plan.ROBOT_LIKE: ("seed", "right (95% interval)", "confusion [[1 as 1, 1 as 2], [2 as 1, 2 as 2]]",
                           "per landmark", "verdict (95% rule)", "wall"),
+        plan.HELD_OUT: ("seed", *(f"{w}{'' if w == 'training' else ' (held out)'}: right (95% interval)"
+                                  for w in WORLD_PLACES), "goal in every held-out world (>85%, lower end >80%)",
+                        "bounds, % right: threshold rule / observer / observer fitted on the other held-out worlds",
+                        "conditions", "wall"),
         plan.SYSTEM: ("seed", "goal reached (95% interval, by environment)", "classifier right",
                       "goal rate in trials 2-5", "conditions", "wall"),
         plan.HAND_DESIGNED: ("seed", *(f"{w}: goal reached with / without detectors (95% intervals)" for w in WORLDS),
@@ -233,7 +261,8 @@ def build(root: Path, order: Sequence[plan.Job], outcomes: dict[str, Outcome], *
     seeds = sorted({j.seed for j in order})
     intro = (f"Made by `{command}` over seeds {', '.join(map(str, seeds))}. Each final champion is judged "
              f"on fresh conditions from seed {settings.eval_seed} + the run's seed, which no run uses; the "
-             f"robot-like test draws its trials from seed {ROBOT_SEED_BASE} + the run's seed. Intervals "
+             f"robot-like test draws its trials from seed {ROBOT_SEED_BASE} + the run's seed, the held-out "
+             f"worlds theirs from seed {landmark_transfer.TEST_SEED} for every seed. Intervals "
              "are 95%: Wilson for rates, percentile bootstrap for medians.")
     if settings.quick:
         intro += (" **Quick mode**: small populations and few generations. It shows that everything "

@@ -74,8 +74,6 @@ struct Slot {
     inputs: Vec<[f64; LANES]>,
     /// The states of the lanes left out of the step, lane by lane.
     kept: Vec<f64>,
-    /// The rates after the step, lane by lane.
-    rates: Vec<f64>,
 }
 
 impl Batch {
@@ -152,7 +150,6 @@ impl Batch {
             on: 0,
             inputs: vec![[0.0; LANES]; m],
             kept: vec![0.0; LANES * n],
-            rates: vec![0.0; LANES * n],
         };
         let mut batch = Batch {
             size: n,
@@ -251,28 +248,26 @@ impl Batch {
         running
     }
 
-    /// Fills each stepping block's inputs from `inputs` (`B x M`), 0 in lanes that do not step;
-    /// fails on an input of a stepping row that is not finite.
-    fn gather<T: Copy + Into<f64>>(&mut self, inputs: &[T]) -> Result<()> {
+    /// Fails on the first input of a stepped row that is not finite, in the order of the blocks'
+    /// lanes (one pass over `inputs` when every value is finite, as it nearly always is).
+    fn check_inputs<T: Copy + Into<f64>>(&self, inputs: &[T]) -> Result<()> {
+        if inputs.iter().all(|&x| x.into().is_finite()) {
+            return Ok(());
+        }
         let m = self.n_inputs;
-        for (slot, rows) in self.slots.iter_mut().zip(self.row_at.chunks(LANES)) {
-            if slot.on == 0 {
-                continue;
-            }
+        for (slot, rows) in self.slots.iter().zip(self.row_at.chunks(LANES)) {
             for (l, &r) in rows.iter().enumerate() {
-                let on = slot.on >> l & 1 == 1;
-                for (k, sensor) in slot.inputs.iter_mut().enumerate() {
-                    let x = if on { inputs[r * m + k].into() } else { 0.0 };
+                if slot.on >> l & 1 == 0 {
+                    continue;
+                }
+                for k in 0..m {
+                    let x: f64 = inputs[r * m + k].into();
                     if !x.is_finite() {
                         return Err(Error::InvalidArgument(format!(
                             "inputs[{r}, {k}] is {x}; every input of a stepped row must be finite"
                         )));
                     }
-                    sensor[l] = x;
                 }
-            }
-            for sensor in &mut slot.inputs {
-                sensor[rows.len()..].fill(0.0);
             }
         }
         Ok(())
@@ -288,8 +283,9 @@ impl Batch {
     /// row that are not finite. Fails with [`Error::Interrupted`] soon after `cancel` is set
     /// (between blocks, and every 1024 integration steps within one), and with
     /// [`Error::InvalidArgument`] when a stepped row's integration diverges. Rows left out then
-    /// still keep their state, but the stepped rows' states are part-way through the step and
-    /// `rates` is not written: reset or set them before stepping again.
+    /// still keep their state and their rates, but the stepped rows' states are part-way through
+    /// the step, and their rates may or may not have been written: reset or set them before
+    /// stepping again.
     pub fn step<T: Copy + Into<f64> + Sync>(
         &mut self,
         inputs: &[T],
@@ -309,9 +305,14 @@ impl Batch {
         if let Some(mask) = active {
             self.pack_active(mask, running)?;
         }
-        self.gather(inputs)?;
+        self.check_inputs(inputs)?;
         let integ = self.integ;
         let row_at = &self.row_at;
+        let out = RatesOut {
+            rates: rates.as_mut_ptr(),
+            n,
+        };
+        let out = &out;
         let work = |b: usize, block: &mut Block, slot: &mut Slot| {
             if slot.on == 0 {
                 return Ok(());
@@ -320,22 +321,38 @@ impl Batch {
                 return Err(Error::Interrupted);
             }
             let lanes = block.len();
-            let first = b * LANES;
+            let rows = &row_at[b * LANES..b * LANES + lanes];
             let off = |l: usize| slot.on >> l & 1 == 0;
+            // The inputs of the stepping lanes; 0 in the others.
+            for (k, sensor) in slot.inputs.iter_mut().enumerate() {
+                for (l, &r) in rows.iter().enumerate() {
+                    sensor[l] = if off(l) {
+                        0.0
+                    } else {
+                        inputs[r * m + k].into()
+                    };
+                }
+                sensor[lanes..].fill(0.0);
+            }
             for l in (0..lanes).filter(|&l| off(l)) {
                 block.lane_state(l, &mut slot.kept[l * n..(l + 1) * n]);
             }
             let stepped = step_held_in_chunks(block, &slot.inputs, &integ, cancel)
-                .and_then(|()| check_finite(block, |l| (!off(l)).then(|| row_at[first + l])));
+                .and_then(|()| check_finite(block, |l| (!off(l)).then(|| rows[l])));
             // Rows left out keep their state, whatever happened to the others.
             for l in (0..lanes).filter(|&l| off(l)) {
                 block.set_lane_state(l, &slot.kept[l * n..(l + 1) * n]);
             }
             stepped?;
-            let rates = block.outputs();
-            for l in 0..lanes {
-                for (i, rate) in rates.iter().enumerate() {
-                    slot.rates[l * n + i] = rate[l];
+            let lane_rates = block.outputs();
+            for (l, &r) in rows.iter().enumerate().filter(|&(l, _)| !off(l)) {
+                // SAFETY: `r < B` and `rates` holds `B x N` values; a row sits in one lane of
+                // one block, and each block is stepped by one thread, so no other reference to
+                // this row's rates is alive.
+                #[allow(unsafe_code)]
+                let row = unsafe { out.row(r) };
+                for (x, rate) in row.iter_mut().zip(lane_rates) {
+                    *x = rate[l];
                 }
             }
             Ok(())
@@ -362,15 +379,6 @@ impl Batch {
                 .zip(self.slots.iter_mut())
                 .enumerate()
                 .try_for_each(|(b, (block, slot))| work(b, block, slot))?;
-        }
-        for (slot, rows) in self.slots.iter().zip(row_at.chunks(LANES)) {
-            for (l, &r) in rows
-                .iter()
-                .enumerate()
-                .filter(|&(l, _)| slot.on >> l & 1 == 1)
-            {
-                rates[r * n..(r + 1) * n].copy_from_slice(&slot.rates[l * n..(l + 1) * n]);
-            }
         }
         Ok(())
     }
@@ -489,6 +497,30 @@ impl Batch {
             self.blocks[at / LANES].set_lane(at % LANES, &self.networks[p])?;
         }
         Ok(())
+    }
+}
+
+/// The caller's rates (row-major `B x N`), written by the blocks' threads at once, each row by
+/// the one block whose lane holds it.
+struct RatesOut {
+    rates: *mut f64,
+    n: usize,
+}
+
+// SAFETY: a row sits in exactly one lane of one block (`row_at` is a permutation of the rows), and
+// each block is stepped by one thread, so no two threads write the same row.
+#[allow(unsafe_code)]
+unsafe impl Sync for RatesOut {}
+
+impl RatesOut {
+    /// Row `r`'s `N` rates.
+    ///
+    /// # Safety
+    /// `r` is a row of the batch whose `B x N` rates this points at, and no other reference to
+    /// that row is alive.
+    #[allow(unsafe_code, clippy::mut_from_ref)]
+    unsafe fn row(&self, r: usize) -> &mut [f64] {
+        unsafe { std::slice::from_raw_parts_mut(self.rates.add(r * self.n), self.n) }
     }
 }
 

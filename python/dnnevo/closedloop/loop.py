@@ -116,7 +116,7 @@ def rollout(
         except Exception as e:
             raise TaskError(f"{_name(env)}.step raised {type(e).__name__}: {e}") from e
         obs, reward, done = _outputs(out, env, rows, m, rates)
-        np.add(returns, reward, out=returns, where=active)
+        returns += _running(reward, active)
         np.logical_and(active, done, out=ended)
         if ended.any():  # rare: most steps end no episode
             if not np.isfinite(returns).all():
@@ -165,7 +165,7 @@ def _queued(networks: Sequence[_core.Network], env: Any, *, episodes: int, max_s
             raise TaskError(f"{_name(env)}.step raised {type(e).__name__}: {e}") from e
         obs, reward, done = _outputs(out, env, rows, m, rates)
         t += 1
-        np.add(row_returns, reward, out=row_returns, where=active)
+        row_returns += _running(reward, active)
         np.logical_and(active, done, out=ended)
         if t >= limit:
             ended |= active & (t - start >= max_steps)
@@ -265,6 +265,13 @@ def _outputs(out: Any, env: Any, rows: int, m: int, rates: npt.NDArray[np.float6
                         f"{getattr(done, 'dtype', '?')} and shape {np.shape(done)}; expected a "
                         f"bool array of shape (B,) = ({rows},)")
     return obs, reward, done
+
+
+def _running(reward: npt.NDArray[Any], active: npt.NDArray[np.bool_]) -> npt.NDArray[Any]:
+    """The rewards of the running rows, 0 elsewhere (whatever an ended row's reward is, even
+    NaN). Adding them gives the bits of ``np.add(..., where=active)``, since a return is never
+    -0.0 and ``x + 0.0`` is ``x``, at a third of its cost."""
+    return np.where(active, reward, 0.0)
 
 
 def _name(env: Any) -> str:

@@ -23,6 +23,7 @@ import dnnevo
 from dnnevo.experiments import jobs
 from dnnevo.experiments import plan
 from dnnevo.experiments import report
+from dnnevo.experiments import results
 from dnnevo.experiments import runsview
 from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError
@@ -291,6 +292,87 @@ def test_without_only_the_paper_is_reproduced_and_the_classic_tasks_are_a_family
     classic = plan.jobs([0], only=["classic"])
     assert {j.experiment for j in classic} == {"legged-walker", "categorical-perception", "double-pole"}
     assert all(QUICK.config(j.spec).task.startswith("python:dnnevo.classic.") for j in classic)
+
+
+def _flat(d: dict[str, Any], head: str = "") -> dict[str, Any]:
+    """A config dict with its tables' keys written ``table.key``."""
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        out.update(_flat(v, f"{head}{k}.") if isinstance(v, dict) else {f"{head}{k}": v})
+    return out
+
+
+def test_the_ablation_removes_one_departure_of_the_working_2bit_route_at_a_time() -> None:
+    base = plan.experiment("sequence-2bit")
+    ablation = [e for e in plan.EXPERIMENTS if e.family == "ablation"]
+    assert "ablation" in plan.FAMILIES and "ablation" not in plan.PAPER_FAMILIES
+    want = _flat(jobs.Settings().config(base).to_dict())
+    seeding = ("seed_populations", "spare_neurons")
+    changes = {}
+    for e in ablation:
+        assert (e.kind, e.preset, e.needs) == (plan.EVOLVE, base.preset, base.needs)
+        assert e.note.startswith("the working route, sequence-2bit, without ") and e.paper == "not in the paper"
+        config = _flat(jobs.Settings().config(e).to_dict())
+        assert config.keys() == want.keys()
+        changes[e.name] = {**{k: v for k, v in config.items() if v != want[k]},
+                           **{k: getattr(e, k) for k in seeding if getattr(e, k) != getattr(base, k)}}
+    assert changes == {
+        "ablation-2bit-no-spare": {"size": 10, "spare_neurons": 0},
+        "ablation-2bit-clamp-trial": {"task_params.clamp": "trial"},
+        "ablation-2bit-proportional": {"selection": "proportional"},
+        "ablation-2bit-no-elites": {"elitism": 0},
+        "ablation-2bit-validation-32": {"task_params.validation_trials": 32},
+        "ablation-2bit-champions": {"seed_populations": False},
+    }
+    assert (base.seed_populations, base.spare_neurons, want["task_params.clamp"]) == (True, 6, "evaluation")
+
+
+def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collects_its_own(tmp_path: Path) -> None:
+    """``--only ablation`` plans the same seed's 1-bit and alternating jobs (of the sequence family)
+    before its own, runs them in a folder without them and uses them in one with them. Shortened
+    by --set: the quick variants' 128 validation trials per target take a minute or more."""
+    order = plan.jobs([0], only=["ablation"])
+    parents = order[:2]
+    assert [j.id for j in parents] == ["sequence-1bit/seed-0", "sequence-2bit-alternating/seed-0"]
+    assert all(j.spec.family == "ablation" and j.needs == tuple(p.id for p in parents) for j in order[2:])
+    assert len(order) == 2 + 6
+    out = tmp_path / "repro"
+    args = ["reproduce", "--only", "ablation", "--seeds", "0", "--quick", "--set", "generations=2",
+            "--set", "task_params.validation_trials=4", "--eval-trials", "10", "--no-dt-check", "--in-process",
+            "--out", out]
+    r = run_cli(*args)
+    assert r.returncode == 0, r.stderr
+    assert "8 runs in" in r.stdout and "(0 already done)" in r.stdout
+    for job in order[2:]:
+        run = (out / job.id / "config.toml").read_text()
+        assert "sequence-1bit/seed-0" in run and "sequence-2bit-alternating/seed-0" in run
+        e = job.spec
+        assert f'seeded_with = "{"populations" if e.seed_populations else "champions"}"' in run
+        assert ("spare_neurons = 6" in run) == (e.spare_neurons == 6)
+    md = (out / "report.md").read_text()
+    assert all(f"| {j.experiment} | " in md for j in order)
+    # Another command in this folder finds every job done, the parents too, whichever family's
+    # command made them: it uses them as they are, without work (one more command would draw
+    # every figure again, the larger part of this test's time).
+    settings = jobs.Settings(**json.loads((out / "reproduce.json").read_text())["settings"])
+    stamps = {j.id: jobs.result_path(out, j).stat().st_mtime_ns for j in parents}
+    assert all(jobs.read_result(out, j, settings) is not None for j in order)
+    for job in parents:
+        jobs.run_job(job, out, settings, 1)
+    assert {j.id: jobs.result_path(out, j).stat().st_mtime_ns for j in parents} == stamps
+    # Collected as a family, the ablation takes its own runs; the parents belong to the sequence
+    # family's collection. Its rows are rendered from them.
+    stored = tmp_path / "repo" / "docs" / "results"
+    copied = results.collect(out, stored, families=["ablation"], seeds=[0], commit="abc1234")
+    assert copied == [j.id for j in order[2:]]
+    family = json.loads((stored / results.PROVENANCE_FILE).read_text())["families"]
+    assert list(family) == ["ablation"] and family["ablation"]["runs"] == family["ablation"]["planned"] == 6
+    page = stored.parent / "sequence.md"
+    page.write_text("<!-- results:summary:ablation:begin -->\n<!-- results:summary:ablation:end -->\n")
+    assert results.render(stored.parent.parent) == [page]
+    text = page.read_text()
+    assert all(f"| {j.experiment} | not in the paper | 1/1 |" in text for j in order[2:])
+    assert "| sequence-1bit |" not in text and "6 of 6 runs done" in text
 
 
 def test_experiments_added_since_a_reproduction_began_join_it(tmp_path: Path) -> None:

@@ -79,10 +79,13 @@ def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) 
     assert "| sequence-3bit | §5.4: 1 success, at generation 700 | not yet run |" in readme
     hand = plan.experiment("reactive-navigation-hand")
     assert f"| {hand.name} | {hand.paper} | not yet run | - | - |" in readme
-    planned = len(plan.jobs([0]))  # the paper's families, seed 0
+    planned = len(plan.jobs([0], results.REFERENCE_FAMILIES))  # the paper's families and the ablation, seed 0
     assert "commit abc1234" in readme and f"6 of {planned} runs done" in readme and "Quick mode" in readme
-    # Families beyond the paper's appear only once their runs are collected.
-    assert not any(f"| {e.name} |" in readme for e in plan.EXPERIMENTS if e.family not in plan.PAPER_FAMILIES)
+    # The ablation of the 2-bit route is part of the reference reproduction: its rows say "not
+    # yet run". Other families beyond the paper's appear only once their runs are collected.
+    ablation = [e for e in plan.EXPERIMENTS if e.family == "ablation"]
+    assert ablation and all(f"| {e.name} | {e.paper} | not yet run |" in readme for e in ablation)
+    assert not any(f"| {e.name} |" in readme for e in plan.EXPERIMENTS if e.family not in results.REFERENCE_FAMILIES)
 
     page = (stored / "index.md").read_text()
     assert "<!-- results:landmark:begin -->\n\n### landmark\n\nPaper: §3" in page
@@ -91,6 +94,8 @@ def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) 
     assert ("### nav1d-far\n\nPaper: §4.2: solved at generation 0. Preset `nav1d-far`.\n\n"
             "Not yet run over seeds 0.") in page
     assert "| landmark | (whole family) | 6/6 |" in page and "| nav1d | (whole family) | not yet run |" in page
+    assert "| ablation | (whole family) | not yet run |" in page
+    assert "### ablation-2bit-no-spare\n\nPaper: not in the paper. Preset `sequence-2bit` with `size=10`." in page
     assert "| commit | abc1234 |" in page
 
     assert _results("render", "--root", repo, "--check").returncode == 0
@@ -125,8 +130,8 @@ def test_without_results_every_experiment_is_not_yet_run(tmp_path: Path) -> None
     assert results.render(tmp_path) == [tmp_path / "README.md"]
     text = (tmp_path / "README.md").read_text()
     assert "No results yet in docs/results/" in text
-    paper = [e for e in plan.EXPERIMENTS if e.family in plan.PAPER_FAMILIES]
-    assert sum(f"| {e.name} | {e.paper} | not yet run |" in text for e in paper) == len(paper)
+    reference = [e for e in plan.EXPERIMENTS if e.family in results.REFERENCE_FAMILIES]
+    assert sum(f"| {e.name} | {e.paper} | not yet run |" in text for e in reference) == len(reference)
 
 
 def test_bad_markers_and_mixed_reproductions_are_named(tmp_path: Path, repo: Path) -> None:

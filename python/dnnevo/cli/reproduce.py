@@ -33,9 +33,11 @@ training, then the robot-like test of the champions and the held-out worlds), pr
 starts, nothing evolved, then dnnevo's evolved comparison), one-dimensional navigation (the
 three subnetworks, the goal seekers evolved on chains, both integrated systems, the single
 network) and sequence learning (1-bit, alternating, the incremental 2-bit route from those two
-runs, direct 2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). --only classic
-runs the field's benchmarks written as Python tasks instead (walker, categorical perception,
-double pole). Each evolution has its own run folder OUT/EXPERIMENT/seed-N and its result in
+runs, direct 2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). --only ablation
+runs the working incremental 2-bit route with one of its departures from the paper removed at a
+time, with the 1-bit and alternating runs it composes (those the folder holds are used).
+--only classic runs the field's benchmarks written as Python tasks instead (walker, categorical
+perception, double pole). Each evolution has its own run folder OUT/EXPERIMENT/seed-N and its result in
 OUT/EXPERIMENT/seed-N.json (the robot-like test, the held-out worlds, the integrated systems
 and the hand-designed navigator are tests and have only the result; the navigator's starts per
 world are --eval-trials, else 200, or 20 with --quick, and the held-out worlds' trials per
@@ -47,6 +49,7 @@ EXAMPLE = """examples:
   dnnevo reproduce --only sequence --seeds 0-4 --out runs/repro-seq
   dnnevo reproduce --only classic --quick --seeds 0 --out runs/repro-classic
   dnnevo reproduce --out reproduce --workers 4 --threads-per-worker 2
+  dnnevo reproduce --only ablation --out reproduce      uses the sequence runs it holds
   dnnevo reproduce --out /shared/reproduce --scheduler tcp://HOST:8786
 
 By default the runs go to a Dask LocalCluster of one worker process per core, one run at a time

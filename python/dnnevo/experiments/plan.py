@@ -12,6 +12,13 @@ seed that its experiment needs, and nothing else, so seeds never wait for each o
 >>> job = next(j for j in jobs([3]) if j.experiment == "nav1d-system")
 >>> job.needs
 ('nav1d-classifier/seed-3', 'nav1d-far/seed-3', 'nav1d-near/seed-3')
+
+A family's experiments may need another family's: the ablation of the 2-bit route composes the
+sequence family's 1-bit and alternating runs. Those jobs are then planned with it, so that a
+reproduction runs them, or finds them done in its folder and uses them:
+
+>>> [job.id for job in jobs([0], only=["ablation"])][:3]
+['sequence-1bit/seed-0', 'sequence-2bit-alternating/seed-0', 'ablation-2bit-no-spare/seed-0']
 """
 
 from __future__ import annotations
@@ -28,9 +35,11 @@ PAPER_FAMILIES = ("landmark", "robots", "nav1d", "sequence")
 """The paper's experiment families, in the paper's order (``robots`` is §3.2's other robot
 tasks): what ``dnnevo reproduce`` runs unless ``--only`` says otherwise."""
 
-FAMILIES = (*PAPER_FAMILIES, "classic")
-"""Every family; ``--only`` picks among them. ``classic`` is the field's benchmarks written as
-Python tasks (:mod:`dnnevo.classic`), which the paper does not have."""
+FAMILIES = (*PAPER_FAMILIES, "ablation", "classic")
+"""Every family; ``--only`` picks among them. ``ablation`` is the working incremental 2-bit route
+(``sequence-2bit``) with one of its departures from the paper removed at a time (issue 47);
+``classic`` is the field's benchmarks written as Python tasks (:mod:`dnnevo.classic`), which the
+paper does not have."""
 
 EVOLVE, ROBOT_LIKE, HELD_OUT, SYSTEM, HAND_DESIGNED = ("evolve", "robot-like", "held-out-worlds", "nav1d-system",
                                                       "hand-designed")
@@ -78,6 +87,26 @@ class Experiment:
 
 
 _CHAINED = ("task_params.chained=true", "task_params.reinforcement_input=true", "n_inputs=2")
+
+# The working incremental 2-bit route (sequence-2bit: member-by-member composites of the two
+# runs' last populations and 6 spare neurons, 16 neurons, the score clamped once per evaluation,
+# rank selection, 20 elites, 128 validation trials per target) with one departure from the paper
+# removed: (name, overrides of the preset, --seed-populations, --spare-neurons, what is removed).
+_ABLATION: tuple[tuple[str, tuple[str, ...], bool, int, str], ...] = (
+    ("no-spare", ("size=10",), True, 0,
+     "its 6 spare neurons: the composites alone, 10 neurons as in the paper"),
+    ("clamp-trial", ("task_params.clamp=trial",), True, 6,
+     "the score clamped once per evaluation: it is clamped per trial, the paper's formula"),
+    ("proportional", ("selection=proportional",), True, 6,
+     "rank selection: selection is proportional to fitness, the paper's"),
+    ("no-elites", ("elitism=0",), True, 6,
+     "its 20 elites: no network is kept unchanged, as in the paper"),
+    ("validation-32", ("task_params.validation_trials=32",), True, 6,
+     "its 128 validation trials per target: champions are chosen on the task's default 32"),
+    ("champions", (), False, 6,
+     "composing the two runs' last populations member by member: their champions are composed (with "
+     "6 spare neurons) and the first population is that composite and its mutants, as in the paper"),
+)
 
 EXPERIMENTS: tuple[Experiment, ...] = (
     Experiment("landmark", "landmark", EVOLVE, "§3: solved by generation 15 in simulation",
@@ -166,6 +195,11 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                     "and at dt/10"),
     Experiment("sequence-3bit", "sequence", EVOLVE, "§5.4: 1 success, at generation 700",
                preset="sequence-3bit"),
+    *(Experiment(f"ablation-2bit-{name}", "ablation", EVOLVE, "not in the paper", preset="sequence-2bit",
+                 overrides=overrides, needs=("sequence-1bit", "sequence-2bit-alternating"),
+                 seed_populations=populations, spare_neurons=spare,
+                 note=f"the working route, sequence-2bit, without {removed}")
+      for name, overrides, populations, spare, removed in _ABLATION),
     Experiment("legged-walker", "classic", EVOLVE, "not in the paper", preset="legged-walker",
                note="Beer and Gallagher's one-legged walker, a task written in Python "
                     "(dnnevo.classic.walker)"),
@@ -229,10 +263,14 @@ def families(only: Iterable[str] | None) -> tuple[str, ...]:
 
 def jobs(seeds: Sequence[int], only: Iterable[str] | None = None) -> list[Job]:
     """The jobs of the families ``only`` (default the paper's) over ``seeds``, each after the jobs
-    it needs."""
+    it needs, with the jobs of other families that they need."""
     chosen = families(only)
     if not seeds or any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
         raise ConfigError(f"seeds must be distinct and >= 0, at least one; got {list(seeds)[:10]}"
                           + (" ..." if len(seeds) > 10 else ""))
+    wanted = {e.name for e in EXPERIMENTS if e.family in chosen}
+    for e in reversed(EXPERIMENTS):  # needs come first, so this takes needs of needs too
+        if e.name in wanted:
+            wanted.update(e.needs)
     return [Job(e.name, s, tuple(job_id(n, s) for n in e.needs))
-            for e in EXPERIMENTS if e.family in chosen for s in seeds]
+            for e in EXPERIMENTS if e.name in wanted for s in seeds]

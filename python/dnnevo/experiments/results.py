@@ -53,8 +53,8 @@ from dnnevo.experiments.scheduler import Outcome, Task
 from dnnevo.runs import RunFileError, first_difference, short, write_atomic
 from dnnevo.runs.files import checked, read_json
 
-__all__ = ["RESULTS_DIR", "SETTINGS_FILE", "PROVENANCE_FILE", "Results", "load", "collect", "blocks", "render",
-           "main"]
+__all__ = ["RESULTS_DIR", "SETTINGS_FILE", "PROVENANCE_FILE", "REFERENCE_FAMILIES", "Results", "load", "collect",
+           "blocks", "render", "main"]
 
 RESULTS_DIR = Path("docs") / "results"
 """Where the reference reproduction's results live, under the repository's root."""
@@ -67,6 +67,11 @@ PROVENANCE_FILE = "provenance.json"
 
 DEFAULT_SEEDS = tuple(range(10))
 """The reference reproduction's seeds, ``--seeds 0-9``."""
+
+REFERENCE_FAMILIES = (*plan.PAPER_FAMILIES, "ablation")
+"""The families the reference reproduction covers: the paper's and the ablation of its 2-bit
+route (issue 47). Their experiments have rows in the tables, "not yet run" until collected;
+another family's (``classic``) appear once its runs are collected."""
 
 NOT_RUN = "not yet run"
 """The status of a job with no stored result."""
@@ -98,9 +103,10 @@ class Results:
 
     @property
     def families(self) -> tuple[str, ...]:
-        """The families the tables cover: the paper's, and any other whose runs were collected."""
+        """The families the tables cover: :data:`REFERENCE_FAMILIES`, and any other whose runs were
+        collected."""
         collected = self.provenance.get("families", {})
-        return tuple(f for f in plan.FAMILIES if f in plan.PAPER_FAMILIES or f in collected)
+        return tuple(f for f in plan.FAMILIES if f in REFERENCE_FAMILIES or f in collected)
 
     @property
     def order(self) -> list[plan.Job]:
@@ -291,6 +297,12 @@ def _commits(before: Any, commit: str) -> str:
     return ", ".join(dict.fromkeys([*filter(None, names), commit]))
 
 
+def _own(seeds: Sequence[int], family: str) -> list[plan.Job]:
+    """The jobs of ``family``'s own experiments over ``seeds``: not those of another family that
+    it needs, which are collected, counted and timed with their own family."""
+    return [j for j in plan.jobs(list(seeds), [family]) if j.spec.family == family]
+
+
 def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             seeds: Sequence[int] = DEFAULT_SEEDS, commit: str | None = None) -> list[str]:
     """Copies the finished results of ``families`` (default the paper's) over ``seeds`` from the
@@ -326,7 +338,7 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
     with checked(settings_file):
         settings = jobs.Settings(**manifest["settings"])
     # Every result is checked before any is written, so a refusal leaves dest as it was.
-    chosen = {family: [job for job in plan.jobs(list(seeds), [family])
+    chosen = {family: [job for job in _own(seeds, family)
                        if jobs.read_result(source, job, settings) is not None]  # checked against its run
               for family in plan.families(families)}
     # A result collected before (another session's reproduction, maybe another machine) must be
@@ -361,9 +373,8 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             earlier = [] if before is None else before.get("machines", [old_machine])
             times[family] = {"command": _command(seeds, family, settings),
                              "commit": _commits(before, named.group(1)),
-                             "runs": sum(jobs.result_path(dest, j).exists()
-                                         for j in plan.jobs(list(seeds), [family])),
-                             "planned": len(plan.jobs(list(seeds), [family])),
+                             "runs": sum(jobs.result_path(dest, j).exists() for j in _own(seeds, family)),
+                             "planned": len(_own(seeds, family)),
                              "elapsed_s": round(max(ends) - min(starts))
                              + (0 if before is None else before["elapsed_s"]),
                              "machines": list(dict.fromkeys([*earlier, _machine_name(env)]))}

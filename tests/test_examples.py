@@ -202,7 +202,8 @@ def test_legged_walker(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
 
 
 def test_pendulum(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """The torque-0 baseline, a row per seed with its interval and upright count, the figure."""
+    """The torque-0 baseline, a row per seed with its interval and upright count, how many seeds
+    solve it, the figure."""
     from cli_helpers import assert_png
 
     argv = ["--seeds", "1", "--population", "6", "--generations", "1", "--episodes", "1",
@@ -212,14 +213,31 @@ def test_pendulum(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert re.fullmatch(r"torque 0 throughout: fresh mean return -\d+\.\d", lines[0])
     row = re.fullmatch(r"\s+0\s+(-?\d+\.\d) \(\s*-?\d+\.\d to\s+-?\d+\.\d\)\s+(\d+)/100 "
                        r"\(\d+%-\d+%\)\s+\d+", lines[2])
-    assert row is not None and len(lines) == 6
+    assert row is not None and len(lines) == 7
     assert lines[3] == f"median of the seeds' fresh mean returns: {row[1]}"
     idle = lines[0].split()[-1]
     assert lines[4] == (f"{int(float(row[1]) > float(idle))} of 1 champions have a higher fresh mean return "
                         f"than torque 0 throughout ({idle})")
     assert lines[5] == f"fresh episodes that end within 10 degrees of upright: {row[2]} to {row[2]} of 100, by seed"
+    solved = float(row[1]) > -200 and int(row[2]) >= 95
+    assert lines[6] == (f"{int(solved)} of 1 champions solve it (fresh mean return above -200 and at least "
+                        "95 of 100 episodes ending upright)")
     assert_png(tmp_path / "p.png")
     assert_rendered(tmp_path, "p", "examples/pendulum.py", argv, lines[3:])
+
+
+def test_pendulum_equations_are_gymnasiums() -> None:
+    """Evolution runs Pendulum-v1's equations in NumPy; on the same seeds they give every return
+    of Gymnasium's own environment bit for bit."""
+    import numpy as np
+
+    from dnnevo.closedloop import rollout
+
+    nets = [dnnevo.Network.random(5, 3, seed=s) for s in range(6)]
+    gym_run, numpy_run = (rollout(nets, env, episodes=4, max_steps=pendulum.STEPS, substeps=2, seed=5)
+                          for env in (pendulum.Pendulum(), pendulum.PendulumEquations()))
+    assert np.array_equal(gym_run.returns, numpy_run.returns)
+    assert np.array_equal(gym_run.lengths, numpy_run.lengths)
 
 
 def test_legged_walker_without_its_sensor(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

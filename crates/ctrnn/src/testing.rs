@@ -7,24 +7,27 @@
 
 /// The lane vectors ([`crate::vector`]) and their register backends.
 pub mod vector {
-    pub use crate::vector::{pow2, Arith, Portable, Vector};
+    pub use crate::vector::{pow2, pow2_f32, Arith, Elem, Portable, Vector};
 
-    /// Four lanes in an AVX2 register.
+    /// Four `f64` (or eight `f32`) lanes in an AVX2 register.
     #[cfg(target_arch = "x86_64")]
     pub mod avx2 {
         pub use crate::vector::avx2::{enabled, Avx2};
+        pub use crate::vector::avx2_f32::Avx2F32;
     }
 
-    /// Eight lanes in an AVX-512 register.
+    /// Eight `f64` (or sixteen `f32`) lanes in an AVX-512 register.
     #[cfg(target_arch = "x86_64")]
     pub mod avx512 {
         pub use crate::vector::avx512::{enabled, Avx512};
+        pub use crate::vector::avx512_f32::Avx512F32;
     }
 
-    /// Two lanes in a NEON register.
+    /// Two `f64` (or four `f32`) lanes in a NEON register.
     #[cfg(target_arch = "aarch64")]
     pub mod neon {
         pub use crate::vector::neon::Neon;
+        pub use crate::vector::neon_f32::NeonF32;
     }
 }
 
@@ -36,6 +39,10 @@ pub mod math {
     pub const EXP_MIN: f64 = crate::math::EXP_MIN;
     /// The upper end of [`crate::math::exp`]'s argument range.
     pub const EXP_MAX: f64 = crate::math::EXP_MAX;
+    /// The lower end of [`crate::math::exp_f32`]'s argument range.
+    pub const EXP_F32_MIN: f64 = crate::math::EXP_F32_MIN;
+    /// The upper end of [`crate::math::exp_f32`]'s argument range.
+    pub const EXP_F32_MAX: f64 = crate::math::EXP_F32_MAX;
 
     /// [`crate::math::exp`] in every lane.
     #[inline(always)]

@@ -1,21 +1,16 @@
 //! [`Lanes`]: `L` networks of the same shape packed parameter by parameter, side by side, and
-//! stepped together by the kernel.
+//! stepped together by the kernel, in `f64` (the default) or in `f32`.
 
 use std::any::Any;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::error::{Error, Result};
-use crate::math::sigmoid;
 use crate::network::Network;
 use crate::rows::Rows;
 use crate::simd::{self, Kernel};
-#[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
-use crate::vector::Group;
-#[cfg(target_arch = "aarch64")]
-use crate::vector::Neon;
 #[cfg(target_arch = "x86_64")]
-use crate::vector::{avx2, avx512, Avx2, Avx512};
-use crate::vector::{Portable, Vector};
+use crate::vector::{avx2, avx512};
+use crate::vector::{Elem, Portable, Vector};
 
 use super::kernel::{rates, weight_order, Work};
 use super::Integrator;
@@ -32,11 +27,11 @@ const _: () = assert!(
 /// is seen within milliseconds however many substeps a row has.
 pub(crate) const CANCEL_CHECK_STEPS: usize = 1024;
 
-/// Calls `self.method::<V>(args)` with `V` the lane vector type of `kernel` for `L` lanes:
-/// registers of the kernel for a block of [`LANES`], plain lanes for any other width (a single
-/// network, the tests' odd widths). Either way the code is compiled for the kernel's CPU features
-/// (so plain lanes get hardware fused multiply-adds too). The widths are `const` conditions, so
-/// the arms a width does not take are never compiled.
+/// Calls `self.method::<V>(args)` with `V` the lane vector type of `kernel` for `L` lanes of
+/// `E`: registers of the kernel for a block of [`LANES`] ([`Elem`] names them), plain lanes for
+/// any other width (a single network, the tests' odd widths). Either way the code is compiled
+/// for the kernel's CPU features (so plain lanes get hardware fused multiply-adds too). The
+/// widths are `const` conditions, so the arms a width does not take are never compiled.
 macro_rules! with_backend {
     ($kernel:expr, $self:ident . $method:ident ( $($arg:expr),* )) => {{
         match $kernel {
@@ -48,9 +43,9 @@ macro_rules! with_backend {
             Kernel::Avx512 => unsafe {
                 avx512::enabled(#[inline(always)] || {
                     if const { L == LANES } {
-                        $self.$method::<Group<Avx512, 2>>($($arg),*)
+                        $self.$method::<E::Avx512Block>($($arg),*)
                     } else {
-                        $self.$method::<Portable<L>>($($arg),*)
+                        $self.$method::<Portable<L, E>>($($arg),*)
                     }
                 })
             },
@@ -59,9 +54,9 @@ macro_rules! with_backend {
             Kernel::Avx2 => unsafe {
                 avx2::enabled(#[inline(always)] || {
                     if const { L == LANES } {
-                        $self.$method::<Group<Avx2, 4>>($($arg),*)
+                        $self.$method::<E::Avx2Block>($($arg),*)
                     } else {
-                        $self.$method::<Portable<L>>($($arg),*)
+                        $self.$method::<Portable<L, E>>($($arg),*)
                     }
                 })
             },
@@ -69,54 +64,56 @@ macro_rules! with_backend {
             #[cfg(target_arch = "aarch64")]
             Kernel::Neon => {
                 if const { L == LANES } {
-                    $self.$method::<Group<Neon, 8>>($($arg),*)
+                    $self.$method::<E::NeonBlock>($($arg),*)
                 } else {
-                    $self.$method::<Portable<L>>($($arg),*)
+                    $self.$method::<Portable<L, E>>($($arg),*)
                 }
             }
-            _ => $self.$method::<Portable<L>>($($arg),*),
+            _ => $self.$method::<Portable<L, E>>($($arg),*),
         }
     }};
 }
 
-/// `L` networks of the same shape, laid out for stepping together.
+/// `L` networks of the same shape, laid out for stepping together, computing in `E`: `f64`
+/// (the default and the reference), or `f32`, single precision, where the parameters are rounded
+/// to `f32` once, when packed, and every state, rate and step is `f32`.
 #[derive(Clone, Debug)]
-pub struct Lanes<const L: usize> {
+pub struct Lanes<const L: usize, E: Elem = f64> {
     size: usize,
     n_inputs: usize,
     len: usize,
-    tau: Rows<L>,
-    theta: Rows<L>,
-    weights: Rows<L>,
-    sensor_weights: Rows<L>,
-    state: Rows<L>,
-    scratch: Scratch<L>,
+    tau: Rows<L, E>,
+    theta: Rows<L, E>,
+    weights: Rows<L, E>,
+    sensor_weights: Rows<L, E>,
+    state: Rows<L, E>,
+    scratch: Scratch<L, E>,
 }
 
 /// Work arrays, reused from step to step so that stepping allocates nothing.
 #[derive(Clone, Debug)]
-struct Scratch<const L: usize> {
+struct Scratch<const L: usize, E: Elem> {
     dt: f64,
     /// dt / tau, and its half and sixth for RK4.
-    h: Rows<L>,
-    h2: Rows<L>,
-    h6: Rows<L>,
+    h: Rows<L, E>,
+    h2: Rows<L, E>,
+    h6: Rows<L, E>,
     /// Sensor drive S I of the current row.
-    ext: Rows<L>,
+    ext: Rows<L, E>,
     /// Whether `ext` is the sensor drive of the last [`Lanes::step_row`], for
     /// [`Lanes::step_held`].
     held: bool,
     /// Firing rates.
-    out: Rows<L>,
+    out: Rows<L, E>,
     /// Whether `out` holds the firing rates of the current state, computed by
     /// [`Lanes::outputs`]; the next step then starts from them instead of computing them again.
     fresh: bool,
     /// RK4's first three slopes (the fourth is used as soon as it is known).
-    k: [Rows<L>; 3],
-    probe: Rows<L>,
+    k: [Rows<L, E>; 3],
+    probe: Rows<L, E>,
 }
 
-impl<const L: usize> Lanes<L> {
+impl<const L: usize, E: Elem> Lanes<L, E> {
     /// Packs up to `L` networks of the same shape. Unused lanes repeat the first network, so they
     /// stay finite; their results are ignored.
     pub fn new(nets: &[&Network]) -> Result<Self> {
@@ -141,11 +138,11 @@ impl<const L: usize> Lanes<L> {
         }
         // Row r of an array holds value order[r] of every network; padding lanes repeat the first.
         let gather = |get: fn(&Network) -> &[f64], order: &[usize]| {
-            let mut rows = Rows::<L>::zeros(order.len());
+            let mut rows = Rows::<L, E>::zeros(order.len());
             for l in 0..L {
                 let source = get(nets.get(l).unwrap_or(first));
                 for (row, &q) in rows.iter_mut().zip(order) {
-                    row[l] = source[q];
+                    row[l] = E::from_f64(source[q]);
                 }
             }
             rows
@@ -196,12 +193,12 @@ impl<const L: usize> Lanes<L> {
     }
 
     /// State of neuron `i` in every lane.
-    pub fn state(&self, i: usize) -> &[f64; L] {
+    pub fn state(&self, i: usize) -> &[E; L] {
         &self.state[i]
     }
     /// Firing rate `f(v_i - theta_i)` of neuron `i` in every lane.
-    pub fn output(&self, i: usize) -> [f64; L] {
-        std::array::from_fn(|l| sigmoid(self.state[i][l] - self.theta[i][l]))
+    pub fn output(&self, i: usize) -> [E; L] {
+        std::array::from_fn(|l| E::sigmoid(self.state[i][l] - self.theta[i][l]))
     }
     /// Every neuron's firing rate in every lane, `outputs()[i][l] = f(v_i - theta_i)`, with the
     /// same bits as [`output`](Self::output). Computed once per state, in the lane vectors of a
@@ -217,7 +214,7 @@ impl<const L: usize> Lanes<L> {
     /// let one = lanes.output(0);
     /// assert_eq!(lanes.outputs()[0], one);
     /// ```
-    pub fn outputs(&mut self) -> &[[f64; L]] {
+    pub fn outputs(&mut self) -> &[[E; L]] {
         if !self.scratch.fresh {
             self.compute_outputs();
             self.scratch.fresh = true;
@@ -226,13 +223,7 @@ impl<const L: usize> Lanes<L> {
     }
 
     fn compute_outputs(&mut self) {
-        if const { L == LANES } {
-            as_width::<L, LANES>(self).compute_outputs_once();
-        } else if const { L == 1 } {
-            as_width::<L, 1>(self).compute_outputs_once();
-        } else {
-            self.compute_outputs_on(simd::kernel());
-        }
+        E::compute_outputs(self);
     }
 
     #[inline(always)]
@@ -241,7 +232,7 @@ impl<const L: usize> Lanes<L> {
     }
 
     #[inline(always)]
-    fn compute_outputs_with<V: Vector>(&mut self) {
+    fn compute_outputs_with<V: Vector<Elem = E>>(&mut self) {
         rates::<V>(
             V::rows(self.theta.as_flattened()),
             V::rows(self.state.as_flattened()),
@@ -252,10 +243,10 @@ impl<const L: usize> Lanes<L> {
     /// Sets every lane's state to zero.
     pub fn reset(&mut self) {
         self.scratch.fresh = false;
-        self.state.fill([0.0; L]);
+        self.state.fill([E::default(); L]);
     }
     /// Sets the state of lane `l` (length N).
-    pub fn set_lane_state(&mut self, l: usize, state: &[f64]) {
+    pub fn set_lane_state(&mut self, l: usize, state: &[E]) {
         self.scratch.fresh = false;
         for (row, &v) in self.state.iter_mut().zip(state) {
             row[l] = v;
@@ -274,11 +265,12 @@ impl<const L: usize> Lanes<L> {
                 self.n_inputs
             )));
         }
-        let put = |rows: &mut Rows<L>, source: &[f64], order: &mut dyn Iterator<Item = usize>| {
-            for (row, q) in rows.iter_mut().zip(order) {
-                row[l] = source[q];
-            }
-        };
+        let put =
+            |rows: &mut Rows<L, E>, source: &[f64], order: &mut dyn Iterator<Item = usize>| {
+                for (row, q) in rows.iter_mut().zip(order) {
+                    row[l] = E::from_f64(source[q]);
+                }
+            };
         let n = self.size;
         put(&mut self.tau, net.tau(), &mut (0..n));
         put(&mut self.theta, net.theta(), &mut (0..n));
@@ -296,7 +288,7 @@ impl<const L: usize> Lanes<L> {
         Ok(())
     }
     /// Copies the state of lane `l` into `into` (length N).
-    pub fn lane_state(&self, l: usize, into: &mut [f64]) {
+    pub fn lane_state(&self, l: usize, into: &mut [E]) {
         copy_lane(&self.state, l, into);
     }
 
@@ -308,62 +300,58 @@ impl<const L: usize> Lanes<L> {
         }
     }
 
+    /// In `f32`, `dt` is rounded to `f32` first and the step sizes are computed in `f32`.
     #[cold]
     fn set_step_sizes(&mut self, dt: f64) {
         let s = &mut self.scratch;
         s.dt = dt;
+        let (dt, half, six) = (E::from_f64(dt), E::from_f64(0.5), E::from_f64(6.0));
         for i in 0..self.size {
             for l in 0..L {
                 let h = dt / self.tau[i][l];
                 s.h[i][l] = h;
-                s.h2[i][l] = 0.5 * h;
-                s.h6[i][l] = h / 6.0;
+                s.h2[i][l] = half * h;
+                s.h6[i][l] = h / six;
             }
         }
     }
 
-    /// Holds `inputs` (one `[f64; L]` per sensor) for `integ.substeps` steps of `integ.dt`.
+    /// Holds `inputs` (one `[E; L]` per sensor) for `integ.substeps` steps of `integ.dt`.
     /// `integ` must be valid.
     #[inline(always)]
-    pub fn step_row(&mut self, inputs: &[[f64; L]], integ: &Integrator) {
+    pub fn step_row(&mut self, inputs: &[[E; L]], integ: &Integrator) {
         debug_assert_eq!(inputs.len(), self.n_inputs);
         self.advance(Some(inputs), integ);
     }
 
     /// [`step_row`](Self::step_row) on a given kernel, which the CPU must support.
-    pub(crate) fn step_row_on(&mut self, kernel: Kernel, inputs: &[[f64; L]], integ: &Integrator) {
+    pub(crate) fn step_row_on(&mut self, kernel: Kernel, inputs: &[[E; L]], integ: &Integrator) {
         self.advance_by(kernel, Some(inputs), integ);
     }
 
     /// One row of `integ.substeps` steps: with `inputs`, from their sensor drive; without, from
     /// the sensor drive held since the last row.
     #[inline(always)]
-    fn advance(&mut self, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
+    fn advance(&mut self, inputs: Option<&[[E; L]]>, integ: &Integrator) {
         self.advance_by(simd::kernel(), inputs, integ);
     }
 
     /// [`advance`](Self::advance) on a given kernel, through the shared copy of its width if
     /// there is one.
     #[inline(always)]
-    fn advance_by(&mut self, kernel: Kernel, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
-        if const { L == LANES } {
-            as_width::<L, LANES>(self).advance_once(kernel, inputs.map(as_rows), integ);
-        } else if const { L == 1 } {
-            as_width::<L, 1>(self).advance_once(kernel, inputs.map(as_rows), integ);
-        } else {
-            self.advance_on(kernel, inputs, integ);
-        }
+    fn advance_by(&mut self, kernel: Kernel, inputs: Option<&[[E; L]]>, integ: &Integrator) {
+        E::advance(self, kernel, inputs, integ);
     }
 
     /// [`advance`](Self::advance) on a given kernel, which the CPU must support.
     #[inline(always)]
-    fn advance_on(&mut self, kernel: Kernel, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
+    fn advance_on(&mut self, kernel: Kernel, inputs: Option<&[[E; L]]>, integ: &Integrator) {
         self.prepare(integ.dt);
         with_backend!(kernel, self.advance_with(inputs, integ))
     }
 
     #[inline(always)]
-    fn advance_with<V: Vector>(&mut self, inputs: Option<&[[f64; L]]>, integ: &Integrator) {
+    fn advance_with<V: Vector<Elem = E>>(&mut self, inputs: Option<&[[E; L]]>, integ: &Integrator) {
         let fresh = std::mem::take(&mut self.scratch.fresh);
         self.scratch.held |= inputs.is_some();
         let (mut work, state) = self.work::<V>();
@@ -405,7 +393,7 @@ impl<const L: usize> Lanes<L> {
     }
 
     /// Runs `steps` input rows. `row(t, inputs)` fills the sensors of row `t`; after each row
-    /// `record(t, state)` may read the state (one `[f64; L]` per neuron). Stops with
+    /// `record(t, state)` may read the state (one `[E; L]` per neuron). Stops with
     /// [`Error::Interrupted`] when `cancel` is set. The states are not checked: call
     /// [`Lanes::check_finite`] after.
     pub fn run_rows(
@@ -413,8 +401,8 @@ impl<const L: usize> Lanes<L> {
         steps: usize,
         integ: &Integrator,
         cancel: Option<&AtomicBool>,
-        row: impl FnMut(usize, &mut [[f64; L]]),
-        record: impl FnMut(usize, &[[f64; L]]),
+        row: impl FnMut(usize, &mut [[E; L]]),
+        record: impl FnMut(usize, &[[E; L]]),
     ) -> Result<()> {
         self.prepare(integ.dt);
         with_backend!(
@@ -424,17 +412,17 @@ impl<const L: usize> Lanes<L> {
     }
 
     #[inline(always)]
-    fn run_rows_with<V: Vector>(
+    fn run_rows_with<V: Vector<Elem = E>>(
         &mut self,
         steps: usize,
         integ: &Integrator,
         cancel: Option<&AtomicBool>,
-        mut row: impl FnMut(usize, &mut [[f64; L]]),
-        mut record: impl FnMut(usize, &[[f64; L]]),
+        mut row: impl FnMut(usize, &mut [[E; L]]),
+        mut record: impl FnMut(usize, &[[E; L]]),
     ) -> Result<()> {
-        let mut inputs = Rows::<L>::zeros(self.n_inputs);
+        let mut inputs = Rows::<L, E>::zeros(self.n_inputs);
         // The row views are taken once: taken row by row, they cost 10% at N = 5.
-        let inputs: &mut [[f64; L]] = &mut inputs;
+        let inputs: &mut [[E; L]] = &mut inputs;
         let mut fresh = std::mem::take(&mut self.scratch.fresh);
         self.scratch.held = false;
         let (mut work, state) = self.work::<V>();
@@ -459,11 +447,11 @@ impl<const L: usize> Lanes<L> {
 
     /// Every array a step uses but the state, viewed as rows of `V`; and the state.
     #[inline(always)]
-    fn work<V: Vector>(&mut self) -> (Work<'_, V>, &mut [[f64; L]]) {
-        fn rows<V: Vector, const L: usize>(x: &[[f64; L]]) -> &[V::Row] {
+    fn work<V: Vector<Elem = E>>(&mut self) -> (Work<'_, V>, &mut [[E; L]]) {
+        fn rows<V: Vector, const L: usize>(x: &[[V::Elem; L]]) -> &[V::Row] {
             V::rows(x.as_flattened())
         }
-        fn rows_mut<V: Vector, const L: usize>(x: &mut [[f64; L]]) -> &mut [V::Row] {
+        fn rows_mut<V: Vector, const L: usize>(x: &mut [[V::Elem; L]]) -> &mut [V::Row] {
             V::rows_mut(x.as_flattened_mut())
         }
         let s = &mut self.scratch;
@@ -492,7 +480,7 @@ impl<const L: usize> Lanes<L> {
     /// oscillates with growing amplitude; say so rather than return infinities.
     pub fn check_finite(&self, name: impl Fn(usize) -> String) -> Result<()> {
         for (i, row) in self.state.iter().enumerate() {
-            if let Some(l) = (0..self.len).find(|&l| !row[l].is_finite()) {
+            if let Some(l) = (0..self.len).find(|&l| !row[l].finite()) {
                 return Err(Error::InvalidArgument(format!(
                     "integration diverged: state[{i}] of {} became {}; use a smaller dt \
                      (dt / tau = {} here; Euler needs it well below 2)",
@@ -503,6 +491,67 @@ impl<const L: usize> Lanes<L> {
             }
         }
         Ok(())
+    }
+}
+
+/// How [`Lanes`] of each element type reach their stepping code: `f64` through copies compiled
+/// once (see [`compile_once!`]), `f32` directly.
+pub trait Dispatch: Sized {
+    /// [`Lanes::advance_by`].
+    fn advance<const L: usize>(
+        lanes: &mut Lanes<L, Self>,
+        kernel: Kernel,
+        inputs: Option<&[[Self; L]]>,
+        integ: &Integrator,
+    ) where
+        Self: Elem;
+    /// [`Lanes::compute_outputs`].
+    fn compute_outputs<const L: usize>(lanes: &mut Lanes<L, Self>)
+    where
+        Self: Elem;
+}
+
+impl Dispatch for f64 {
+    #[inline(always)]
+    fn advance<const L: usize>(
+        lanes: &mut Lanes<L>,
+        kernel: Kernel,
+        inputs: Option<&[[f64; L]]>,
+        integ: &Integrator,
+    ) {
+        if const { L == LANES } {
+            as_width::<L, LANES>(lanes).advance_once(kernel, inputs.map(as_rows), integ);
+        } else if const { L == 1 } {
+            as_width::<L, 1>(lanes).advance_once(kernel, inputs.map(as_rows), integ);
+        } else {
+            lanes.advance_on(kernel, inputs, integ);
+        }
+    }
+    fn compute_outputs<const L: usize>(lanes: &mut Lanes<L>) {
+        if const { L == LANES } {
+            as_width::<L, LANES>(lanes).compute_outputs_once();
+        } else if const { L == 1 } {
+            as_width::<L, 1>(lanes).compute_outputs_once();
+        } else {
+            lanes.compute_outputs_on(simd::kernel());
+        }
+    }
+}
+
+/// Single precision is only stepped from this crate (the population run), so it needs no
+/// shared copies.
+impl Dispatch for f32 {
+    #[inline(always)]
+    fn advance<const L: usize>(
+        lanes: &mut Lanes<L, f32>,
+        kernel: Kernel,
+        inputs: Option<&[[f32; L]]>,
+        integ: &Integrator,
+    ) {
+        lanes.advance_on(kernel, inputs, integ);
+    }
+    fn compute_outputs<const L: usize>(lanes: &mut Lanes<L, f32>) {
+        lanes.compute_outputs_on(simd::kernel());
     }
 }
 
@@ -547,7 +596,7 @@ fn as_rows<const L: usize, const W: usize>(rows: &[[f64; L]]) -> &[[f64; W]] {
 }
 
 /// Copies lane `l` of `rows` (one value per row) into `into`.
-pub fn copy_lane<const L: usize>(rows: &[[f64; L]], l: usize, into: &mut [f64]) {
+pub fn copy_lane<const L: usize, E: Copy>(rows: &[[E; L]], l: usize, into: &mut [E]) {
     for (dst, row) in into.iter_mut().zip(rows) {
         *dst = row[l];
     }

@@ -90,6 +90,7 @@ impl Vector for Avx2 {
 }
 
 impl Arith for Avx2 {
+    type Elem = f64;
     #[inline(always)]
     fn splat(x: f64) -> Self {
         // SAFETY: reached only through `enabled` (module doc).

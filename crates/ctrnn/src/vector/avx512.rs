@@ -91,6 +91,7 @@ impl Vector for Avx512 {
 }
 
 impl Arith for Avx512 {
+    type Elem = f64;
     #[inline(always)]
     fn splat(x: f64) -> Self {
         // SAFETY: reached only through `enabled` (module doc).

@@ -75,6 +75,7 @@ impl Vector for Neon {
 }
 
 impl Arith for Neon {
+    type Elem = f64;
     #[inline(always)]
     fn splat(x: f64) -> Self {
         // SAFETY: NEON is part of every AArch64 CPU (module doc).

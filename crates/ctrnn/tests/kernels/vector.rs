@@ -112,3 +112,98 @@ fn register_backends_match_f64_bit_for_bit() {
 fn neon_backend_matches_f64_bit_for_bit() {
     backend_matches_f64::<Neon, 2>();
 }
+
+#[test]
+fn pow2_f32_is_exact_over_the_normal_range() {
+    use ctrnn::testing::vector::pow2_f32;
+    for k in -126..=127 {
+        assert_eq!(pow2_f32(k as f32), 2f32.powi(k), "k = {k}");
+    }
+}
+
+/// Runs `f` on the `f32` backend `V` and on plain `f32`s, `W` inputs at a time, and demands the
+/// same bits.
+fn same_bits_f32<V: Vector<Row = [f32; W]>, const W: usize>(
+    inputs: &[f32],
+    f_vec: fn(V) -> V,
+    f_ref: fn(f32) -> f32,
+) {
+    for chunk in inputs.chunks(W) {
+        let mut x = [0.0; W];
+        x[..chunk.len()].copy_from_slice(chunk);
+        let mut got = [0.0; W];
+        f_vec(V::load(&x)).store(&mut got);
+        for l in 0..W {
+            let want = f_ref(x[l]);
+            assert!(
+                got[l].to_bits() == want.to_bits() || got[l].is_nan() && want.is_nan(),
+                "x = {:e}: {:e} (vector) vs {:e} (f32)",
+                x[l],
+                got[l],
+                want
+            );
+        }
+    }
+}
+
+/// [`inputs`] for `f32`: a dense sweep where networks live, a coarse one far out, every `f32`
+/// near the ends of `exp_f32`'s range, and the edge cases.
+fn inputs_f32() -> Vec<f32> {
+    use ctrnn::testing::math::{EXP_F32_MAX, EXP_F32_MIN};
+    let mut x: Vec<f32> = inputs().into_iter().map(|x| x as f32).collect();
+    for end in [EXP_F32_MIN, -EXP_F32_MIN, EXP_F32_MAX, -EXP_F32_MAX] {
+        let b = (end as f32).to_bits();
+        x.extend((b - 3000..b + 3000).map(f32::from_bits));
+    }
+    x.extend([
+        f32::MAX,
+        f32::MIN,
+        f32::MIN_POSITIVE,
+        -f32::MIN_POSITIVE,
+        f32::from_bits(1),
+        100.0,
+        -100.0,
+    ]);
+    x
+}
+
+/// `exp`, `sigmoid` and negation on the `f32` backend `V` against plain `f32`s.
+fn backend_matches_f32<V: Vector<Row = [f32; W]>, const W: usize>() {
+    use ctrnn::testing::math::{exp_lanes, sigmoid_lanes};
+    let x = inputs_f32();
+    same_bits_f32::<V, W>(&x, exp_lanes, exp_lanes);
+    same_bits_f32::<V, W>(&x, sigmoid_lanes, sigmoid_lanes);
+    same_bits_f32::<V, W>(&x, |v| -v, |v| -v);
+}
+
+#[test]
+fn portable_f32_lanes_match_f32_bit_for_bit() {
+    backend_matches_f32::<Portable<4, f32>, 4>();
+}
+
+#[test]
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+fn register_f32_backends_match_f32_bit_for_bit() {
+    use ctrnn::simd::Kernel;
+    use ctrnn::testing::vector::{avx2::Avx2F32, avx512::Avx512F32};
+    if Kernel::Avx2.is_supported() {
+        // SAFETY: the CPU has AVX2 and FMA (checked above).
+        unsafe { avx2::enabled(backend_matches_f32::<Avx2F32, 8>) };
+    } else {
+        eprintln!("this CPU has no AVX2 + FMA: the f32 avx2 backend was not checked");
+    }
+    if Kernel::Avx512.is_supported() {
+        // SAFETY: the CPU has AVX-512F (checked above).
+        unsafe { avx512::enabled(backend_matches_f32::<Avx512F32, 16>) };
+    } else {
+        eprintln!("this CPU has no AVX-512F: the f32 avx512 backend was not checked");
+    }
+}
+
+#[test]
+#[cfg(target_arch = "aarch64")]
+fn neon_f32_backend_matches_f32_bit_for_bit() {
+    use ctrnn::testing::vector::neon::NeonF32;
+    backend_matches_f32::<NeonF32, 4>();
+}

@@ -1,5 +1,5 @@
 use ctrnn::math::*;
-use ctrnn::testing::math::{EXP_MAX, EXP_MIN};
+use ctrnn::testing::math::{EXP_F32_MAX, EXP_F32_MIN, EXP_MAX, EXP_MIN};
 
 /// Distance in units in the last place between two positive finite floats.
 fn ulps(a: f64, b: f64) -> u64 {
@@ -41,4 +41,71 @@ fn sigmoid_is_within_a_few_ulp_and_saturates() {
     assert_eq!(sigmoid(1e9), 1.0);
     assert!(sigmoid(-1e9) < 1e-300);
     assert!((sigmoid(2.0) + sigmoid(-2.0) - 1.0).abs() <= f64::EPSILON);
+}
+
+/// The `f32` arguments of the tests below: a sweep of the whole clamped range, a dense one where
+/// networks live, every `f32` near 0 and near the ends, and every `f32` of [1, 2) (one binade,
+/// where the reduced argument takes every position).
+fn f32_arguments() -> impl Iterator<Item = f32> {
+    let (lo, hi) = (EXP_F32_MIN, EXP_F32_MAX);
+    let sweep = (0..=4_000_000).map(move |i| (lo + (hi - lo) * i as f64 / 4e6) as f32);
+    let dense = (0..=2_000_000).map(|i| (-20.0 + 40.0 * i as f64 / 2e6) as f32);
+    let binade = (1f32.to_bits()..2f32.to_bits()).map(f32::from_bits);
+    let near = |x: f32| {
+        let b = x.to_bits();
+        (b.saturating_sub(5000)..b + 5000).map(f32::from_bits)
+    };
+    sweep
+        .chain(dense)
+        .chain(binade.clone())
+        .chain(binade.map(|x| -x))
+        .chain(near(lo as f32))
+        .chain(near(hi as f32))
+        .chain(near(1e-30))
+        .chain(near(-1e-30))
+        .filter(move |x| (lo..=hi).contains(&(*x as f64)))
+}
+
+/// The bound stated in `exp_f32`'s documentation, against f64's `exp` (accurate to about 1e-16)
+/// of the same argument.
+#[test]
+fn exp_f32_is_within_its_stated_bound_of_f64_exp() {
+    let (mut worst, mut at) = (0.0f64, 0.0f32);
+    for x in f32_arguments() {
+        let want = (x as f64).exp();
+        let rel = (exp_f32(x) as f64 - want).abs() / want;
+        if rel > worst {
+            (worst, at) = (rel, x);
+        }
+    }
+    eprintln!("exp_f32: worst relative error {worst:.3e} at x = {at:e}");
+    assert!(
+        worst <= 1e-7,
+        "worst relative error {worst:e} at x = {at:e}"
+    );
+}
+
+#[test]
+fn exp_f32_exact_points_and_edges() {
+    assert_eq!(exp_f32(0.0), 1.0);
+    assert!(exp_f32(f32::NAN).is_nan());
+    assert_eq!(exp_f32(-1e6), exp_f32(EXP_F32_MIN as f32));
+    assert!(exp_f32(-1e6) >= f32::MIN_POSITIVE);
+    assert_eq!(exp_f32(f32::INFINITY), exp_f32(EXP_F32_MAX as f32));
+    assert!(exp_f32(f32::INFINITY).is_finite());
+}
+
+/// `sigmoid_f32` against f64's sigmoid of the same argument, relative to the rate.
+#[test]
+fn sigmoid_f32_is_close_to_f64_and_saturates() {
+    let mut worst = 0.0f64;
+    for x in f32_arguments() {
+        let want = 1.0 / (1.0 + (-(x as f64)).exp());
+        worst = worst.max((sigmoid_f32(x) as f64 - want).abs() / want);
+    }
+    eprintln!("sigmoid_f32: worst relative error {worst:.3e}");
+    assert!(worst <= 2e-7, "worst relative error {worst:e}");
+    assert_eq!(sigmoid_f32(1e9), 1.0);
+    assert!(sigmoid_f32(-1e9) > 0.0 && sigmoid_f32(-1e9) < 1e-37);
+    assert!((sigmoid_f32(2.0) + sigmoid_f32(-2.0) - 1.0).abs() <= f32::EPSILON);
 }

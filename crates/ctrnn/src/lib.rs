@@ -41,7 +41,7 @@ pub use error::{Error, Result};
 pub use evolve::{Evolution, Fill, Stats, Task};
 pub use ga::{GaConfig, Selection};
 pub use genome::{Layout, Ranges};
-pub use integrate::{Integrator, Lanes, Method, LANES};
+pub use integrate::{Integrator, Lanes, Method, Precision, LANES};
 pub use network::{compose, compose_with, Network};
 pub use population::{Block, Inputs, Population};
 /// The random streams, from the `streams` crate (kept here under their old path).

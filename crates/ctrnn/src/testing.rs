@@ -107,10 +107,10 @@ pub mod integrate {
     }
 
     /// [`Lanes::step_row`] on a given kernel, which the CPU must support.
-    pub fn step_row_on<const L: usize>(
-        lanes: &mut Lanes<L>,
+    pub fn step_row_on<const L: usize, E: crate::vector::Elem>(
+        lanes: &mut Lanes<L, E>,
         kernel: Kernel,
-        inputs: &[[f64; L]],
+        inputs: &[[E; L]],
         integ: &Integrator,
     ) {
         lanes.step_row_on(kernel, inputs, integ);

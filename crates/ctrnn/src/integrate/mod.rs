@@ -26,7 +26,7 @@ mod settings;
 
 pub(crate) use lanes::CANCEL_CHECK_STEPS;
 pub use lanes::{copy_lane, Dispatch, Lanes, LANES};
-pub use settings::{Integrator, Method};
+pub use settings::{Integrator, Method, Precision};
 
 impl Network {
     /// Integrates the network through `steps` rows of `inputs` (row-major `steps x n_inputs`),

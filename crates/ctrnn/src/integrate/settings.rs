@@ -32,6 +32,42 @@ impl Method {
     }
 }
 
+/// The floating-point type an integration computes in.
+///
+/// `f64` is the default and the reference: every published result, preset and stored
+/// fingerprint is `f64`. `f32` is opt-in: the parameters (time constants, thresholds, weights),
+/// the step size and each input row are rounded to `f32` once, and every state, firing rate and
+/// step is computed in `f32` with its own exponential ([`crate::math::exp_f32`]). Like `f64`, it
+/// performs one sequence of IEEE operations, so every kernel gives the same `f32` bits; they are
+/// not `f64`'s bits, and trajectories drift apart from `f64`'s over time (faster in chaotic
+/// networks).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// IEEE binary64 (default).
+    #[default]
+    F64,
+    /// IEEE binary32, opt-in.
+    F32,
+}
+
+impl std::str::FromStr for Precision {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        crate::names::parse_name("precision", s).map_err(Error::InvalidArgument)
+    }
+}
+
+impl Precision {
+    /// The lower-case name used in files and on the command line: `"f64"` or `"f32"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        }
+    }
+}
+
 /// Integration settings: each input row is held for `substeps` steps of `dt`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -124,3 +124,66 @@ fn a_diverging_population_names_its_first_diverging_network() {
         );
     }
 }
+
+/// Single precision is what it says: the population run in f32 gives the bits of a plain f32
+/// Euler loop (parameters, step size and inputs rounded to f32 once; each sum taken in order
+/// with fused multiply-adds; `sigmoid_f32`), widened to f64.
+#[test]
+fn an_f32_population_is_a_plain_f32_euler_loop() {
+    use ctrnn::integrate::Precision;
+    use ctrnn::math::sigmoid_f32;
+    let (n, m, steps) = (5, 2, 60);
+    let nets = ctrnn::testing::integrate::random_networks(19, n, m, 4);
+    let inputs: Vec<f64> = (0..steps * m).map(|k| (k % 7) as f64 * 0.3 - 0.9).collect();
+    let integ = Integrator {
+        method: Method::Euler,
+        dt: 0.1,
+        substeps: 1,
+    };
+    let mut pop = Population::with_precision(&nets, Precision::F32).unwrap();
+    assert_eq!(pop.precision(), Precision::F32);
+    let got = pop
+        .run(Inputs::Shared(&inputs), steps, &integ, true, None)
+        .unwrap();
+    let f = |x: &[f64]| x.iter().map(|&v| v as f32).collect::<Vec<_>>();
+    for (p, net) in nets.iter().enumerate() {
+        let (tau, theta, w, s) = (
+            f(net.tau()),
+            f(net.theta()),
+            f(net.weights()),
+            f(net.sensor_weights()),
+        );
+        let mut v = f(net.state());
+        let h: Vec<f32> = tau.iter().map(|t| 0.1f32 / t).collect();
+        for t in 0..steps {
+            let x = f(&inputs[t * m..(t + 1) * m]);
+            let out: Vec<f32> = (0..n).map(|j| sigmoid_f32(v[j] - theta[j])).collect();
+            let next: Vec<f32> = (0..n)
+                .map(|i| {
+                    let ext = (0..m).fold(0.0f32, |acc, k| s[i * m + k].mul_add(x[k], acc));
+                    let acc = (0..n).fold(ext, |acc, j| w[i * n + j].mul_add(out[j], acc));
+                    h[i].mul_add(acc - v[i], v[i])
+                })
+                .collect();
+            v = next;
+            let row = &got[(p * steps + t) * n..][..n];
+            for i in 0..n {
+                assert_eq!(
+                    row[i].to_bits(),
+                    (v[i] as f64).to_bits(),
+                    "network {p}, step {t}, neuron {i}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn precision_names_parse() {
+    use ctrnn::integrate::Precision;
+    assert_eq!("f32".parse::<Precision>().unwrap(), Precision::F32);
+    assert_eq!("f64".parse::<Precision>().unwrap(), Precision::F64);
+    assert_eq!(Precision::default(), Precision::F64);
+    let e = "f16".parse::<Precision>().unwrap_err().to_string();
+    assert!(e.contains(r#""f64" or "f32""#), "{e}");
+}

@@ -8,7 +8,7 @@
 
 use ctrnn::genome::{self, Layout};
 use ctrnn::simd::{self, Kernel};
-use ctrnn::{Evolution, Fill, Inputs, Integrator, Method, Network, Population};
+use ctrnn::{Evolution, Fill, Inputs, Integrator, Method, Network, Population, Precision};
 use tasks::RunConfig;
 
 /// FNV-1a over the bits of `values`: any change of any bit changes it.
@@ -72,6 +72,40 @@ fn a_population_run_keeps_its_stored_bits() {
                 pop.run(Inputs::Shared(&inputs), steps, &integ, true, None)
                     .unwrap(),
             );
+        }
+        fingerprint(all)
+    });
+}
+
+/// The same run in single precision: its own fingerprint, the same on every kernel. (The
+/// states come back widened to f64, exactly, so the fingerprint is of the f32 bits.)
+#[test]
+fn a_population_run_in_f32_keeps_its_stored_bits() {
+    let nets = random_networks(
+        Layout {
+            size: 7,
+            n_inputs: 2,
+        },
+        37,
+    );
+    let steps = 120;
+    let inputs: Vec<f64> = (0..steps * 2)
+        .map(|k| ((k * 7) % 11) as f64 / 5.0 - 1.0)
+        .collect();
+    same_on_every_kernel("a population run in f32", 0x5913_88b2_8198_2425, || {
+        let mut all = Vec::new();
+        for (method, substeps) in [(Method::Euler, 1), (Method::Rk4, 3)] {
+            let integ = Integrator {
+                method,
+                dt: 0.1,
+                substeps,
+            };
+            let mut pop = Population::with_precision(&nets, Precision::F32).unwrap();
+            let states = pop
+                .run(Inputs::Shared(&inputs), steps, &integ, true, None)
+                .unwrap();
+            assert!(states.iter().all(|&v| v as f32 as f64 == v));
+            all.extend(states);
         }
         fingerprint(all)
     });

@@ -4,10 +4,16 @@
 use ctrnn::integrate::*;
 use ctrnn::simd::{self, Kernel};
 use ctrnn::testing::integrate::{random_networks, step_row_on};
+use ctrnn::testing::vector::Elem;
 use ctrnn::Network;
 
 /// Steps one block of `L` networks on `kernel` and on the portable kernel: same bits.
 fn kernels_agree<const L: usize>(kernel: Kernel) {
+    kernels_agree_in::<L, f64>(kernel);
+}
+
+/// [`kernels_agree`] computing in `E` (`f64` or `f32`).
+fn kernels_agree_in<const L: usize, E: Elem>(kernel: Kernel) {
     for (n, m) in [
         (1, 0),
         (3, 1),
@@ -26,11 +32,13 @@ fn kernels_agree<const L: usize>(kernel: Kernel) {
                 dt: 0.05,
                 substeps: 3,
             };
-            let mut fast = Lanes::<L>::new(&refs).unwrap();
+            let mut fast = Lanes::<L, E>::new(&refs).unwrap();
             let mut portable = fast.clone();
             for t in 0..20 {
-                let inputs: Vec<[f64; L]> = (0..m)
-                    .map(|k| std::array::from_fn(|l| ((t * 7 + k * 3 + l) % 5) as f64 - 2.0))
+                let inputs: Vec<[E; L]> = (0..m)
+                    .map(|k| {
+                        std::array::from_fn(|l| E::from_f64(((t * 7 + k * 3 + l) % 5) as f64 - 2.0))
+                    })
                     .collect();
                 step_row_on(&mut fast, kernel, &inputs, &integ);
                 step_row_on(&mut portable, Kernel::Portable, &inputs, &integ);
@@ -38,7 +46,9 @@ fn kernels_agree<const L: usize>(kernel: Kernel) {
             for i in 0..n {
                 let (a, b) = (fast.state(i), portable.state(i));
                 assert!(
-                    a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    a.iter()
+                        .zip(b)
+                        .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits()),
                     "{kernel}, L = {L}, N = {n}, M = {m}, {method:?}, neuron {i}: {a:?} vs {b:?}"
                 );
             }
@@ -56,6 +66,15 @@ fn every_kernel_matches_the_portable_kernel_bit_for_bit() {
     }
     for kernel in Kernel::ALL.into_iter().filter(|k| !k.is_supported()) {
         eprintln!("this CPU cannot run the {kernel} kernel: not checked");
+    }
+}
+
+#[test]
+fn every_kernel_matches_the_portable_kernel_bit_for_bit_in_f32() {
+    for kernel in simd::supported() {
+        kernels_agree_in::<1, f32>(kernel);
+        kernels_agree_in::<3, f32>(kernel);
+        kernels_agree_in::<LANES, f32>(kernel);
     }
 }
 

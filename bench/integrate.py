@@ -13,6 +13,10 @@ Contenders, each in network-steps per second (P x steps / seconds):
     slightly more work than dnnevo's. dnnevo and C take turns (each turn a warm-up, then a few
     timed calls; see _common.interleaved_medians), and the medians of --repeats calls are
     compared: the goal is dnnevo >= 1.25x C (issue #14);
+  - dnnevo in single precision: run_population(..., precision="f32"), timed in the same turns as
+    the f64 run; the goal is f32 >= 1.8x f64 at every N (issue #49). Its accuracy: the largest
+    |f32 - f64| state difference over the whole T-step trajectory of the first ACCURACY_NETWORKS
+    networks (all of them, each network's largest, and the median of those);
   - NumPy with the same equations, batched over the population with einsum, on one core
     (NumPy's einsum does not thread), median of at most 3 runs. NumPy may be timed over fewer
     steps (--numpy-steps): the figure is a per-step throughput.
@@ -43,6 +47,8 @@ SIZES = (5, 10, 30)
 POPULATION, STEPS = 1000, 1000  # networks and Euler steps of the full workload
 TARGETS = {5: 20.0, 10: 16.0, 30: 10.0}  # minimum dnnevo / numpy speed-up
 ANCHOR_TARGET = 1.25  # minimum dnnevo / C anchor speed-up, every N
+F32_TARGET = 1.8  # minimum dnnevo f32 / dnnevo f64 speed-up, every N
+ACCURACY_NETWORKS = 100  # networks whose f32 and f64 trajectories are compared
 DT = 0.1
 N_INPUTS = 2
 
@@ -133,11 +139,11 @@ def bench_size(n: int, args, anchor) -> dict:
     inputs = pulse_inputs(args.steps)
     p = len(nets)
 
-    def run_dnnevo():
+    def run_dnnevo(precision="f64"):
         return dnnevo.run_population(nets, inputs, dt=DT, substeps=1, method="euler",
-                                     record=False)
+                                     record=False, precision=precision)
 
-    contenders = {"dnnevo": run_dnnevo}
+    contenders = {"dnnevo": run_dnnevo, "f32": lambda: run_dnnevo("f32")}
     if anchor is not None:
         c_params = _anchor.params(*params)
         contenders["c"] = lambda: anchor.run_simd_omp(c_params, args.steps)
@@ -153,10 +159,19 @@ def bench_size(n: int, args, anchor) -> dict:
     if np_steps < args.steps:
         theirs = numpy_final_states(params, inputs)
     n_close, sensitive, unexplained = compare(ours, theirs, params, inputs)
+    few = nets[:ACCURACY_NETWORKS]
+    traj = {prec: dnnevo.run_population(few, inputs, dt=DT, substeps=1, method="euler",
+                                        record=True, precision=prec)
+            for prec in ("f64", "f32")}
+    per_net = np.abs(traj["f32"] - traj["f64"]).max(axis=(1, 2))
     return dict(
         n=n,
         p=p,
         dnnevo=p * args.steps / times["dnnevo"],
+        f32=p * args.steps / times["f32"],
+        f32_max=float(per_net.max()),
+        f32_median=float(np.median(per_net)),
+        f32_nets=len(few),
         c=p * args.steps / times["c"] if "c" in times else None,
         numpy=p * np_steps / t_numpy,
         n_close=n_close,
@@ -232,6 +247,20 @@ def main(argv=None) -> int:
             line += f"; DISAGREE: networks {r['unexplained'].tolist()}"
         print(line)
     print("agreement: OK" if ok else "agreement: FAILED")
+    print()
+    kernel = dnnevo.build_info()["kernel"]
+    header = (f"{'N':>3}  {'kernel':>8}  {'f64':>9}  {'f32':>9}  {'f32/f64':>7}  {'met':>3}  "
+              f"{'max|f32-f64|':>12}  {'median':>8}   (network-steps/s, same turns; target "
+              f"{F32_TARGET:g}x; state distance over {args.steps} steps)")
+    print(header)
+    print("-" * len(header))
+    for r in results:
+        ratio = r["f32"] / r["dnnevo"]
+        print(f"{r['n']:>3}  {kernel:>8}  {r['dnnevo']:>9.3g}  {r['f32']:>9.3g}  {ratio:>6.2f}x  "
+              f"{'yes' if ratio >= F32_TARGET else 'NO':>3}  {r['f32_max']:>12.2e}  "
+              f"{r['f32_median']:>8.1e}")
+    print(f"(max|f32-f64|: the largest state difference over every step and neuron of the first "
+          f"{results[0]['f32_nets']} networks; median: of each network's largest)")
     print(f"total benchmark time: {time.perf_counter() - start:.1f} s")
     return 0 if ok else 1
 

@@ -82,6 +82,44 @@ def test_every_kernel_gives_the_same_states(
             assert np.array_equal(a, b), f"{name} differs from {KERNELS[0]}"
 
 
+@settings(max_examples=20, deadline=None)
+@given(
+    p=st.integers(1, 40),
+    n=st.integers(1, 12),
+    m=st.integers(0, 3),
+    steps=st.integers(1, 30),
+    method=st.sampled_from(["euler", "rk4"]),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_every_kernel_gives_the_same_states_in_f32(
+    p: int, n: int, m: int, steps: int, method: str, seed: int
+) -> None:
+    inputs = np.random.default_rng(seed).uniform(-3, 3, size=(steps, m))
+    nets = [dnnevo.Network.random(n, m, seed=seed + k) for k in range(p)]
+    runs = {}
+    for name in KERNELS:
+        dnnevo.use_kernel(name)
+        runs[name] = dnnevo.run_population(nets, inputs, dt=0.05, substeps=2, method=method,
+                                           precision="f32")
+    first = runs[KERNELS[0]]
+    assert first.dtype == np.float64
+    assert np.array_equal(first.astype(np.float32).astype(np.float64), first)  # f32 values
+    for name, run in runs.items():
+        assert np.array_equal(bits(run), bits(first)), f"{name} differs from {KERNELS[0]}"
+
+
+def test_f32_is_close_to_f64_and_a_bad_precision_is_refused() -> None:
+    nets = [dnnevo.Network.random(5, 2, seed=k) for k in range(20)]
+    inputs = np.random.default_rng(1).uniform(-1, 1, size=(50, 2))
+    f64 = dnnevo.run_population(nets, inputs)
+    assert np.array_equal(bits(dnnevo.run_population(nets, inputs, precision="f64")), bits(f64))
+    f32 = dnnevo.run_population(nets, inputs, precision="f32")
+    assert f32.shape == f64.shape and not np.array_equal(f32, f64)
+    assert np.abs(f32 - f64).max() < 1e-3  # 50 steps: rounding, not divergence
+    with pytest.raises(ValueError, match='precision is "f16"; expected "f64" or "f32"'):
+        dnnevo.run_population(nets, inputs, precision="f16")
+
+
 TIMINGS = {"evals_per_s", "elapsed_s"}  # the log's columns that are wall times
 
 

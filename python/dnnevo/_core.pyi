@@ -71,6 +71,7 @@ LANDMARK_SUCCESS_RATE: float
 
 _Array = npt.NDArray[np.float64]
 _Method = Literal["euler", "rk4"]
+_Precision = Literal["f64", "f32"]
 
 @final
 class Trace:
@@ -174,7 +175,13 @@ def run_population(
     substeps: int = 1,
     method: _Method = "euler",
     record: bool = True,
-) -> _Array: ...
+    precision: _Precision = "f64",
+) -> _Array:
+    """Integrates P networks of the same N and M together: the states after every input row
+    (P, T, N) with ``record``, else the final states (P, N). ``precision="f32"`` computes in
+    single precision (parameters and inputs rounded to float32 once, states float32
+    throughout, returned widened to float64); "f64", the default, is the reference. Any other
+    precision is an InvalidArgumentError (a ValueError)."""
 
 @final
 class Batch:

@@ -1,7 +1,7 @@
 //! Populations from Python (a sequence of Networks, or stacked parameter arrays) and
 //! `dnnevo.run_population`.
 
-use ctrnn::{Inputs, Population};
+use ctrnn::{Inputs, Population, Precision};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict};
@@ -24,14 +24,14 @@ pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
 }
 
 /// Packs a population for the integrator straight from its Python form (as [`networks_from`]),
-/// without copying each `Network` first.
-fn population_from(obj: &Bound<'_, PyAny>) -> PyResult<Population> {
+/// without copying each `Network` first, to compute in `precision`.
+fn population_from(obj: &Bound<'_, PyAny>, precision: Precision) -> PyResult<Population> {
     if let Ok(d) = obj.cast::<PyDict>() {
-        return Population::new(&stacked(d)?).py_err();
+        return Population::with_precision(&stacked(d)?, precision).py_err();
     }
     let objects = network_objects(obj)?;
     let refs: Vec<&ctrnn::Network> = objects.iter().map(|net| &net.inner).collect();
-    Population::new(&refs).py_err()
+    Population::with_precision(&refs, precision).py_err()
 }
 
 /// Borrows every item of a non-empty sequence of Networks.
@@ -136,7 +136,8 @@ fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
 
 /// Integrates P networks of the same shape together; see `dnnevo.run_population`.
 #[pyfunction]
-#[pyo3(signature = (networks, inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", record=true), text_signature = "(networks, inputs, *, dt=0.1, substeps=1, method='euler', record=True)")]
+#[allow(clippy::too_many_arguments)] // Python's keyword arguments
+#[pyo3(signature = (networks, inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", record=true, precision="f64"), text_signature = "(networks, inputs, *, dt=0.1, substeps=1, method='euler', record=True, precision='f64')")]
 pub fn run_population<'py>(
     py: Python<'py>,
     networks: &Bound<'py, PyAny>,
@@ -145,9 +146,11 @@ pub fn run_population<'py>(
     substeps: AnyInt,
     method: &str,
     record: bool,
+    precision: &str,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let integ = integrator(dt, &substeps, method)?;
-    let mut pop = population_from(networks)?;
+    let precision = precision.parse::<Precision>().py_err()?;
+    let mut pop = population_from(networks, precision)?;
     let (p_len, n, m) = (pop.len(), pop.size(), pop.n_inputs());
     let x = dense(inputs, "inputs", arg_err)?;
     let (steps, shared) = match x.shape.as_slice() {

@@ -127,12 +127,13 @@ impl Population {
     /// The blocks, for tasks that compute each row's inputs from the networks' outputs.
     /// Block `b`, lane `l` is network `b * LANES + l`.
     ///
-    /// # Panics
-    /// If the population computes in `f32` (tasks run in `f64` only, for now).
-    pub fn blocks_mut(&mut self) -> &mut [Block] {
+    /// Fails if the population computes in `f32`: tasks run in `f64` only, for now.
+    pub fn blocks_mut(&mut self) -> Result<&mut [Block]> {
         match &mut self.blocks {
-            Blocks::F64(blocks) => blocks,
-            Blocks::F32(_) => panic!("blocks_mut: this population computes in f32"),
+            Blocks::F64(blocks) => Ok(blocks),
+            Blocks::F32(_) => Err(Error::InvalidArgument(
+                "this population computes in f32; tasks step f64 blocks only".into(),
+            )),
         }
     }
 

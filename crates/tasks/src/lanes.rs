@@ -72,7 +72,7 @@ fn blocks<N: Borrow<Network> + Sync, A, T: Send>(
     }
     let mut population = Population::new(networks)?;
     let per_block = population
-        .blocks_mut()
+        .blocks_mut()?
         .par_iter_mut()
         .enumerate()
         .map(|(b, block)| {

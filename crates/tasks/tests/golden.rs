@@ -47,33 +47,8 @@ fn random_networks(layout: Layout, count: usize) -> Vec<Network> {
 
 #[test]
 fn a_population_run_keeps_its_stored_bits() {
-    // 37 networks: two full blocks of 16 and a ragged one, N = 7 (not a multiple of 4).
-    let nets = random_networks(
-        Layout {
-            size: 7,
-            n_inputs: 2,
-        },
-        37,
-    );
-    let steps = 120;
-    let inputs: Vec<f64> = (0..steps * 2)
-        .map(|k| ((k * 7) % 11) as f64 / 5.0 - 1.0)
-        .collect();
     same_on_every_kernel("a population run", 0x26b4_c19b_421f_2efe, || {
-        let mut all = Vec::new();
-        for (method, substeps) in [(Method::Euler, 1), (Method::Rk4, 3)] {
-            let integ = Integrator {
-                method,
-                dt: 0.1,
-                substeps,
-            };
-            let mut pop = Population::new(&nets).unwrap();
-            all.extend(
-                pop.run(Inputs::Shared(&inputs), steps, &integ, true, None)
-                    .unwrap(),
-            );
-        }
-        fingerprint(all)
+        population_fingerprint(Precision::F64)
     });
 }
 
@@ -81,6 +56,14 @@ fn a_population_run_keeps_its_stored_bits() {
 /// states come back widened to f64, exactly, so the fingerprint is of the f32 bits.)
 #[test]
 fn a_population_run_in_f32_keeps_its_stored_bits() {
+    same_on_every_kernel("a population run in f32", 0x5913_88b2_8198_2425, || {
+        population_fingerprint(Precision::F32)
+    });
+}
+
+/// 37 networks (two full blocks of 16 and a ragged one, N = 7, not a multiple of 4) run for 120
+/// steps with Euler and with RK4 in `precision`: every state of both runs.
+fn population_fingerprint(precision: Precision) -> u64 {
     let nets = random_networks(
         Layout {
             size: 7,
@@ -92,23 +75,23 @@ fn a_population_run_in_f32_keeps_its_stored_bits() {
     let inputs: Vec<f64> = (0..steps * 2)
         .map(|k| ((k * 7) % 11) as f64 / 5.0 - 1.0)
         .collect();
-    same_on_every_kernel("a population run in f32", 0x5913_88b2_8198_2425, || {
-        let mut all = Vec::new();
-        for (method, substeps) in [(Method::Euler, 1), (Method::Rk4, 3)] {
-            let integ = Integrator {
-                method,
-                dt: 0.1,
-                substeps,
-            };
-            let mut pop = Population::with_precision(&nets, Precision::F32).unwrap();
-            let states = pop
-                .run(Inputs::Shared(&inputs), steps, &integ, true, None)
-                .unwrap();
+    let mut all = Vec::new();
+    for (method, substeps) in [(Method::Euler, 1), (Method::Rk4, 3)] {
+        let integ = Integrator {
+            method,
+            dt: 0.1,
+            substeps,
+        };
+        let mut pop = Population::with_precision(&nets, precision).unwrap();
+        let states = pop
+            .run(Inputs::Shared(&inputs), steps, &integ, true, None)
+            .unwrap();
+        if precision == Precision::F32 {
             assert!(states.iter().all(|&v| v as f32 as f64 == v));
-            all.extend(states);
         }
-        fingerprint(all)
-    });
+        all.extend(states);
+    }
+    fingerprint(all)
 }
 
 #[test]

@@ -91,6 +91,7 @@ def _stop(*processes: subprocess.Popen[bytes]) -> None:
         p.wait()
 
 
+@pytest.mark.slow
 def test_a_sweep_whose_scheduler_dies_ends_in_one_line_and_continues_to_the_same_results(tmp_path: Path) -> None:
     here = run_cli(*SWEEP, "--seeds", "0-2", "--out", tmp_path / "here")
     assert here.returncode == 0, here.stderr

@@ -105,6 +105,7 @@ PAGES_THAT_RUN = [p for p in PAGES if marked(p)]
 
 
 @pytest.mark.parametrize("page", PAGES_THAT_RUN, ids=lambda p: p.name)
+@pytest.mark.slow
 def test_marked_shell_blocks_run_and_print_what_the_page_quotes(page: Path,
                                                                 tmp_path: Path) -> None:
     shutil.copytree(ROOT / "tests" / "data", tmp_path / "tests" / "data")

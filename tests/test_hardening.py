@@ -128,6 +128,7 @@ def check_outcome(r: subprocess.CompletedProcess[str], run: Path, command: str) 
 
 
 @pytest.mark.parametrize("name", ["checkpoint.json", "log.csv", "config.toml", "best.json"])
+@pytest.mark.slow
 def test_damaged_files_are_one_line_or_repaired(pristine: Path, tmp_path: Path, name: str) -> None:
     damages = text_damage((pristine / name).read_text())
     if not FULL:
@@ -172,6 +173,7 @@ def test_edited_config_toml_is_refused_naming_the_field(pristine: Path, tmp_path
         assert_one_line_error(r, "config.toml was edited after the run", f"{field} is")
 
 
+@pytest.mark.slow
 def test_log_damage_in_show_and_plot(pristine: Path, tmp_path: Path) -> None:
     text = (pristine / "log.csv").read_text()
     header, *rows = text.splitlines()
@@ -353,6 +355,7 @@ FREQUENT = ("import sys, dnnevo; e = sys.modules['dnnevo.evolution.evolve']; e.C
             "e.LOG_SECONDS = 0.0; from dnnevo.cli.command import main; sys.exit(main(sys.argv[1:]))")
 
 
+@pytest.mark.slow
 def test_kill_at_random_moments_then_resume_is_bit_identical(tmp_path: Path) -> None:
     """SIGKILL at random moments (from start-up on, so also before the first checkpoint and
     inside writes), then resume, again and again: the end equals an uninterrupted run."""

@@ -236,6 +236,7 @@ def test_a_stopped_run_resumes_to_the_bits_of_an_unstopped_one(tmp_path: Path) -
     same_run(tmp_path / "whole" / job.id, out)
 
 
+@pytest.mark.slow
 def test_a_composed_run_uses_the_runs_it_needs(tmp_path: Path) -> None:
     order = plan.jobs([0], only=["sequence"])[:3]
     for job in order:
@@ -268,6 +269,7 @@ def test_the_report_says_the_same_in_markdown_and_html(tmp_path: Path) -> None:
     assert env["SIMD kernel"].split()[0] == dnnevo.build_info()["kernel"]
 
 
+@pytest.mark.slow
 def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path) -> None:
     out = tmp_path / "repro"
     args = ["reproduce", "--only", "sequence", "--seeds", "0", "--quick", "--eval-trials", "10",
@@ -327,6 +329,7 @@ def test_the_ablation_removes_one_departure_of_the_working_2bit_route_at_a_time(
     assert (base.seed_populations, base.spare_neurons, want["task_params.clamp"]) == (True, 6, "evaluation")
 
 
+@pytest.mark.slow
 def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collects_its_own(tmp_path: Path) -> None:
     """``--only ablation`` plans the same seed's 1-bit and alternating jobs (of the sequence family)
     before its own, runs them in a folder without them and uses them in one with them. Shortened
@@ -375,6 +378,7 @@ def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collec
     assert "| sequence-1bit |" not in text and "6 of 6 runs done" in text
 
 
+@pytest.mark.slow
 def test_experiments_added_since_a_reproduction_began_join_it(tmp_path: Path) -> None:
     out = tmp_path / "repro"
     args = ["reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
@@ -417,6 +421,7 @@ FREQUENT = ("import signal, sys, dnnevo; signal.signal(signal.SIGINT, signal.def
             "from dnnevo.cli.command import main; sys.exit(main(sys.argv[1:]))")
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_a_reproduction_that_then_continues_to_the_same_results(tmp_path: Path) -> None:
     args = ["reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--set", "generations=60",
             "--eval-trials", "10", "--no-dt-check", "--in-process", "--threads-per-worker", "1"]
@@ -435,8 +440,10 @@ def test_ctrl_c_stops_a_reproduction_that_then_continues_to_the_same_results(tmp
         quick=True, eval_trials=10, dt_check=False, overrides=("generations=60",))) is None
     again = run_cli(*args, "--out", stopped)
     assert again.returncode == 0 and "(0 already done)" in again.stdout, again.stderr
-    whole = tmp_path / "whole"
-    assert run_cli(*args, "--out", whole).returncode == 0
+    whole = tmp_path / "whole"  # run by run, without the command's report
+    settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False, overrides=("generations=60",))
+    for job in plan.jobs([0], only=["landmark"]):
+        jobs.run_job(job, whole, settings, 1)
     for job in plan.jobs([0], only=["landmark"]):
         a = json.loads(jobs.result_path(stopped, job).read_text())
         b = json.loads(jobs.result_path(whole, job).read_text())
@@ -463,6 +470,7 @@ def dask() -> Any:
     return pytest.importorskip("distributed")
 
 
+@pytest.mark.slow
 def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_path: Path) -> None:
     dask()
     # Every family, the classic benchmarks (tasks written in Python) too, but the ablation: its six
@@ -471,7 +479,9 @@ def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_
     families = [f for f in plan.FAMILIES if f != "ablation"]
     args = ["reproduce", "--seeds", "0", "--quick", "--eval-trials", "10", "--no-dt-check",
             "--only", ",".join(families)]
-    assert run_cli(*args, "--in-process", "--out", tmp_path / "here").returncode == 0
+    # In this process, run by run: the command would also draw every figure, half its time.
+    for job in plan.jobs([0], only=families):
+        jobs.run_job(job, tmp_path / "here", QUICK, 1)
     r = run_cli(*args, "--workers", "2", "--out", tmp_path / "dask")
     assert r.returncode == 0, r.stderr
     assert "a local Dask cluster of 2 workers" in r.stdout
@@ -490,6 +500,7 @@ def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_
         assert figure in md, figure
 
 
+@pytest.mark.slow
 def test_a_running_scheduler_takes_the_runs(tmp_path: Path) -> None:
     with dask().LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
         r = run_cli("reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--eval-trials", "10",
@@ -504,6 +515,7 @@ def test_a_running_scheduler_takes_the_runs(tmp_path: Path) -> None:
     assert on_cluster is not None and without_wall(on_cluster) == without_wall(here)
 
 
+@pytest.mark.slow
 def test_a_killed_worker_s_run_resumes_to_the_same_bits(tmp_path: Path) -> None:
     dask()
     settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False,
@@ -559,6 +571,7 @@ def _whole_report(name: str, text: bytes) -> bool:
         text.startswith(b"<!DOCTYPE html>") and text.endswith(b"</html>\n")
 
 
+@pytest.mark.slow
 def test_a_kill_inside_the_report_s_write_leaves_the_old_report_and_the_next_run_tidies(tmp_path: Path) -> None:
     name = report.REPORT_FILES[-1]  # killed in the last write: the files before it are new
     args = ["reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",

@@ -248,6 +248,7 @@ def test_a_result_that_differs_from_the_one_collected_is_refused(tmp_path: Path,
     assert {p: p.read_bytes() for p in dest.rglob("*.json")} == before
 
 
+@pytest.mark.slow
 def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, repo: Path) -> None:
     """The classic benchmarks, collected beside the paper's families, get their rows."""
     source = tmp_path / "classic"
@@ -264,6 +265,7 @@ def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, re
     assert "| landmark | " in readme
 
 
+@pytest.mark.slow
 def test_the_papers_reactive_navigation_is_rendered_from_its_results_or_said_not_yet_run(tmp_path: Path,
                                                                                         repo: Path) -> None:
     """The hand-designed reactive navigator's results, collected with the robots family, make

@@ -136,6 +136,7 @@ def test_a_seed_that_fails_on_dask_is_named_and_the_exit_status_says_so(tmp_path
     assert [run["seed"] for run in results(out)] == [0]
 
 
+@pytest.mark.slow
 def test_a_sweep_stopped_by_ctrl_c_leaves_the_stopped_seed_out_and_exits_130(tmp_path: Path) -> None:
     import signal
     import subprocess

@@ -15,9 +15,9 @@ from dnnevo.runs import RunDir, save_figure
 __all__ = ["draw_run"]
 
 
-def draw_run(path: str | Path, *, seed: int = 0, animate: bool = False) -> list[str]:
-    """Writes the figures of the run in ``path`` and returns their file names: ``fitness.png``,
-    then the task's (sequence: Figs. 4-5; nav1d: Figs. 2-3; landmark: top-down views, with
+def draw_run(path: str | Path, *, seed: int = 0, animate: bool = False, fitness: bool = True) -> list[str]:
+    """Writes the figures of the run in ``path`` and returns their file names: ``fitness.png``
+    (unless ``fitness`` is False), then the task's (sequence: Figs. 4-5; nav1d: Figs. 2-3; landmark: top-down views, with
     ``animate`` a GIF too; a Python task class: its champion's episodes, importing the class's
     module), of trials drawn from ``seed``. Every file of the run is checked before
     any figure is written."""
@@ -29,11 +29,13 @@ def draw_run(path: str | Path, *, seed: int = 0, animate: bool = False) -> list[
         task = UserTask(config.task)
     if task is not None:
         run.read_best(config, table)
-    arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
-    ax = plot.plot_fitness(arrays, title=f"{config.task}: {run.path.name}")
-    save_figure(ax.figure, run.path / "fitness.png")
-    plot.close(ax.figure)
-    written = ["fitness.png"]
+    written = []
+    if fitness:
+        arrays = {k: np.array([r[k] for r in history]) for k in history[0]}
+        ax = plot.plot_fitness(arrays, title=f"{config.task}: {run.path.name}")
+        save_figure(ax.figure, run.path / "fitness.png")
+        plot.close(ax.figure)
+        written.append("fitness.png")
     if task is not None:
         written += task.draw(run, config, seed, animate=animate)
     return written

@@ -225,9 +225,9 @@ def _figures(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, 
         plot.close(ax.figure)
         blocks.append(Block("img", f"{e.name}: best (solid) and mean (dotted) fitness per seed", path=name))
         first = done[0]
-        for file in figures.draw_run(root / first.id, seed=0):
-            if file != "fitness.png":
-                blocks.append(Block("img", f"{e.name}, seed {first.seed}: {file}", path=f"{first.id}/{file}"))
+        # The seeds' fitness is drawn above, together: the run's own fitness.png is not drawn.
+        for file in figures.draw_run(root / first.id, seed=0, fitness=False):
+            blocks.append(Block("img", f"{e.name}, seed {first.seed}: {file}", path=f"{first.id}/{file}"))
     elif e.kind == plan.SYSTEM:
         first = done[0]
         parts = [nav1d.load_part(root / plan.job_id(n, first.seed)) for n in e.needs]

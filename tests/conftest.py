@@ -6,10 +6,13 @@ tests that press Ctrl-C, in this process or in a ``dnnevo`` subprocess, would wa
 run and fail. Python's own handler is put back here; a subprocess then starts with SIGINT at its
 default, as from a terminal.
 
-Tests marked ``slow`` (about 8 s or more on 2 cores) are collected first. pytest-xdist hands out
-the first tests in turn to its workers, so the long ones start at once and run beside each other;
-at the end of the collection order they ran last, each alone, with the other core idle: a minute
-of CI's wall time.
+Tests marked ``slow`` (about 8 s or more on 2 cores) are collected first. pytest-xdist runs with
+``--dist worksteal`` (pyproject.toml): each worker starts with an equal run of the collected
+tests, and an idle worker takes half of a busy one's waiting tests, so the workers end within one
+test of each other, and with the slow tests first that last test is a short one. xdist's default
+(``load``) gave one worker its whole first batch: with the slow tests first, all of them, and it
+ran 140 s after the other had finished; with them last, in file order, CI's pytest ended with a
+core idle for 2.5 minutes.
 """
 
 import signal

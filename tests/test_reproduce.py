@@ -283,8 +283,13 @@ def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path)
     md = (out / "report.md").read_text()
     assert "| sequence-2bit-paper | §5.3: success in 2 of 2 runs | 1/1 |" in md
     assert "sequence-3bit" in md and "landmark" not in md.split("## Environment")[0]
-    again = run_cli(*args)
+    assert "![" in md
+    # Every run done: the report is made again, here without its figures.
+    again = run_cli(*args, "--no-figures")
     assert again.returncode == 0 and f"({n} already done)" in again.stdout, again.stderr
+    md = (out / "report.md").read_text()
+    assert "![" not in md and "--no-dt-check --no-figures" in md
+    assert "| sequence-2bit-paper | §5.3: success in 2 of 2 runs | 1/1 |" in md
     other = run_cli(*[a if a != "10" else "11" for a in args])
     assert_one_line_error(other, "eval_trials", "= 10, not 11")
 
@@ -342,7 +347,7 @@ def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collec
     out = tmp_path / "repro"
     args = ["reproduce", "--only", "ablation", "--seeds", "0", "--quick", "--set", "generations=2",
             "--set", "task_params.validation_trials=4", "--eval-trials", "10", "--no-dt-check", "--in-process",
-            "--out", out]
+            "--no-figures", "--out", out]
     r = run_cli(*args)
     assert r.returncode == 0, r.stderr
     assert "8 runs in" in r.stdout and "(0 already done)" in r.stdout
@@ -355,8 +360,8 @@ def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collec
     md = (out / "report.md").read_text()
     assert all(f"| {j.experiment} | " in md for j in order)
     # Another command in this folder finds every job done, the parents too, whichever family's
-    # command made them: it uses them as they are, without work (one more command would draw
-    # every figure again, the larger part of this test's time).
+    # command made them: it uses them as they are, without work (one more command would make
+    # the report again, for no more than this).
     settings = jobs.Settings(**json.loads((out / "reproduce.json").read_text())["settings"])
     stamps = {j.id: jobs.result_path(out, j).stat().st_mtime_ns for j in parents}
     assert all(jobs.read_result(out, j, settings) is not None for j in order)
@@ -382,7 +387,7 @@ def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collec
 def test_experiments_added_since_a_reproduction_began_join_it(tmp_path: Path) -> None:
     out = tmp_path / "repro"
     args = ["reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
-            "--no-dt-check", "--in-process", "--out", out]
+            "--no-dt-check", "--in-process", "--no-figures", "--out", out]
     assert run_cli(*args).returncode == 0
     manifest = out / "reproduce.json"
     full = json.loads(manifest.read_text())
@@ -424,7 +429,7 @@ FREQUENT = ("import signal, sys, dnnevo; signal.signal(signal.SIGINT, signal.def
 @pytest.mark.slow
 def test_ctrl_c_stops_a_reproduction_that_then_continues_to_the_same_results(tmp_path: Path) -> None:
     args = ["reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--set", "generations=60",
-            "--eval-trials", "10", "--no-dt-check", "--in-process", "--threads-per-worker", "1"]
+            "--eval-trials", "10", "--no-dt-check", "--in-process", "--threads-per-worker", "1", "--no-figures"]
     stopped = tmp_path / "stopped"
     proc = subprocess.Popen([sys.executable, "-c", FREQUENT, *args, "--out", str(stopped)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -504,7 +509,7 @@ def test_the_whole_quick_reproduction_on_a_local_cluster_matches_in_process(tmp_
 def test_a_running_scheduler_takes_the_runs(tmp_path: Path) -> None:
     with dask().LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
         r = run_cli("reproduce", "--only", "landmark", "--seeds", "0", "--quick", "--eval-trials", "10",
-                    "--no-dt-check", "--scheduler", cluster.scheduler_address, "--out", tmp_path)
+                    "--no-dt-check", "--no-figures", "--scheduler", cluster.scheduler_address, "--out", tmp_path)
     assert r.returncode == 0, r.stderr
     assert f"on {cluster.scheduler_address}" in r.stdout
     robot = plan.Job("landmark-robot", 0, ("landmark/seed-0",))
@@ -575,7 +580,7 @@ def _whole_report(name: str, text: bytes) -> bool:
 def test_a_kill_inside_the_report_s_write_leaves_the_old_report_and_the_next_run_tidies(tmp_path: Path) -> None:
     name = report.REPORT_FILES[-1]  # killed in the last write: the files before it are new
     args = ["reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
-            "--no-dt-check", "--in-process", "--out", str(tmp_path)]
+            "--no-dt-check", "--in-process", "--no-figures", "--out", str(tmp_path)]
     assert run_cli(*args).returncode == 0
     old = {n: f"an older {n}\n".encode() for n in report.REPORT_FILES}
     for n, text in old.items():
@@ -623,7 +628,7 @@ def test_the_hand_designed_job_counts_what_the_navigation_function_does(tmp_path
 
 def test_the_quick_robots_reproduction_has_the_papers_reactive_navigation_row(tmp_path: Path) -> None:
     r = run_cli("reproduce", "--only", "robots", "--seeds", "0", "--quick", "--no-dt-check", "--in-process",
-                "--out", tmp_path)
+                "--no-figures", "--out", tmp_path)
     assert r.returncode == 0, r.stderr
     md = (tmp_path / "report.md").read_text()
     e = plan.experiment("reactive-navigation-hand")

@@ -84,6 +84,8 @@ def add_parser(sub: Any, parse_seeds: Any, positive: Any) -> None:
                    help="threads of each run (default: 1 on Dask, all cores in process)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://HOST:8786")
     p.add_argument("--in-process", action="store_true", help="run here, one run after another, without Dask")
+    p.add_argument("--no-figures", dest="figures", action="store_false",
+                   help="a report of tables only: drawing the figures takes about a second per experiment")
 
 
 def _families(text: str) -> tuple[str, ...]:
@@ -149,7 +151,8 @@ def reproduce(args: argparse.Namespace) -> int:
         outcomes = {j.id: done[j.id] if j.id in done else ran[j.id] for j in order}
         env = report.environment(workers=workers, threads=threads, wall_s=time.perf_counter() - t0)
         command = _command(args)
-        blocks = report.build(root, order, outcomes, settings=settings, environment=env, command=command)
+        blocks = report.build(root, order, outcomes, settings=settings, environment=env, command=command,
+                              draw=args.figures)
         paths = report.write(root, blocks)
     print(report.markdown([b for b in blocks if b.kind == "table"][:1]), end="")
     print(f"wrote {', '.join(str(args.out / p.name) for p in paths)}")
@@ -166,6 +169,7 @@ def _command(args: argparse.Namespace) -> str:
     words += ["--only", ",".join(args.only)] if tuple(args.only) != plan.PAPER_FAMILIES else []
     words += ["--eval-trials", str(args.eval_trials)] if args.eval_trials is not None else []
     words += [] if args.dt_check else ["--no-dt-check"]
+    words += [] if args.figures else ["--no-figures"]
     words += [w for kv in args.set for w in ("--set", kv)]
     return " ".join(shlex.quote(w) for w in words)
 

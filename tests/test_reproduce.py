@@ -441,12 +441,11 @@ def test_ctrl_c_stops_a_reproduction_that_then_continues_to_the_same_results(tmp
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, (out, err)
     assert "run the same command again to continue" in err and "Traceback" not in err
-    assert jobs.read_result(stopped, plan.Job("landmark", 0, ()), jobs.Settings(
-        quick=True, eval_trials=10, dt_check=False, overrides=("generations=60",))) is None
+    settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False, overrides=("generations=60",))
+    assert jobs.read_result(stopped, plan.Job("landmark", 0, ()), settings) is None
     again = run_cli(*args, "--out", stopped)
     assert again.returncode == 0 and "(0 already done)" in again.stdout, again.stderr
     whole = tmp_path / "whole"  # run by run, without the command's report
-    settings = jobs.Settings(quick=True, eval_trials=10, dt_check=False, overrides=("generations=60",))
     for job in plan.jobs([0], only=["landmark"]):
         jobs.run_job(job, whole, settings, 1)
     for job in plan.jobs([0], only=["landmark"]):

@@ -17,10 +17,10 @@ __all__ = ["draw_run"]
 
 def draw_run(path: str | Path, *, seed: int = 0, animate: bool = False, fitness: bool = True) -> list[str]:
     """Writes the figures of the run in ``path`` and returns their file names: ``fitness.png``
-    (unless ``fitness`` is False), then the task's (sequence: Figs. 4-5; nav1d: Figs. 2-3; landmark: top-down views, with
-    ``animate`` a GIF too; a Python task class: its champion's episodes, importing the class's
-    module), of trials drawn from ``seed``. Every file of the run is checked before
-    any figure is written."""
+    (unless ``fitness`` is False), then the task's (sequence: Figs. 4-5; nav1d: Figs. 2-3;
+    landmark: top-down views, with ``animate`` a GIF too; a Python task class: its champion's
+    episodes, importing the class's module), of trials drawn from ``seed``. Every file of the run
+    is checked before any figure is written."""
     run = RunDir(path)
     config, table = run.read_run_config()
     history = run.read_log(config)

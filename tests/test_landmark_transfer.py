@@ -4,12 +4,12 @@ example's code path writes a record that renders."""
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_helpers import run_cli
 
 import dnnevo
 from dnnevo import presets
@@ -148,9 +148,8 @@ def test_the_library_answers_as_the_example_did() -> None:
 
 def test_a_tiny_run_makes_a_record_that_renders(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     runs = tmp_path / "tiny"
-    r = subprocess.run([sys.executable, "-m", "dnnevo", "run", "landmark", "--quick", "--out", str(runs / "seed-0"),
-                        "--seed", "0", "--set", "generations=1", "--set", "population=10", "--threads", "1"],
-                       capture_output=True, text=True, timeout=120)
+    r = run_cli("run", "landmark", "--quick", "--out", runs / "seed-0", "--seed", "0", "--set", "generations=1",
+                "--set", "population=10", "--threads", "1")
     assert r.returncode == 0, r.stderr
     record = tmp_path / "results" / "examples" / "landmark-transfer.json"
     argv = [str(runs), "--trials", "3", "--fit-trials", "4", "--record", str(record)]

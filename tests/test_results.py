@@ -7,12 +7,11 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from cli_helpers import run_cli
+from cli_helpers import run_cli, run_main
 from dnnevo.errors import DnnevoError
 from dnnevo.experiments import plan, results
 
@@ -21,8 +20,7 @@ README = "# dnnevo\n\nBefore.\n\n<!-- results-table:begin -->\nold\n<!-- results
 
 
 def _results(*args: object) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "dnnevo.experiments.results", *map(str, args)],
-                          capture_output=True, text=True, timeout=120)
+    return run_main(results.main, "python -m dnnevo.experiments.results", *args)
 
 
 @pytest.fixture(scope="module")

@@ -51,3 +51,46 @@ def params(tau, theta, weights, sensor_weights, state) -> dict:
     (P, N)."""
     return dict(W=weights, theta=theta, tau=tau, S=sensor_weights, v0=state,
                 N=tau.shape[1], P=tau.shape[0])
+
+
+F32_SOURCE = Path(__file__).resolve().parent / "anchor_f32"
+"""The anchor in float: ctrnn_simd_f32.c, adapted from the double anchor (its header says how)."""
+
+
+class FloatAnchor:
+    """The float C anchor (bench/anchor_f32), built into `folder`: `run_simd_omp(params, T)`
+    integrates the population of `params` (the double anchor's dict) in float32 on 2 threads,
+    with the double anchor's dt and inputs, and returns the final states (P, N) as float32."""
+
+    def __init__(self, folder: Path, dt: float):
+        import ctypes
+
+        lib = ctypes.CDLL(str(folder / "libctrnn_simd_f32.so"))
+        fp = ctypes.POINTER(ctypes.c_float)
+        lib.run_popsimd_omp_f32.argtypes = [ctypes.c_int64] * 3 + [fp] * 6 + [ctypes.c_int64]
+        lib.block_size_f32.restype = ctypes.c_int64
+        self.BLOCK = lib.block_size_f32()
+        self._lib, self._fp, self._dt = lib, fp, dt
+
+    def run_simd_omp(self, params: dict, steps: int):
+        import numpy as np
+
+        arrays = [np.ascontiguousarray(a, dtype=np.float32) for a in
+                  (params["W"], params["theta"], self._dt / params["tau"], params["S"], params["v0"])]
+        out = np.empty(arrays[-1].shape, dtype=np.float32)
+        pointers = [a.ctypes.data_as(self._fp) for a in (*arrays, out)]
+        self._lib.run_popsimd_omp_f32(params["P"], params["N"], steps, *pointers, 2)
+        return out
+
+
+def load_f32(dt: float, env: dict | None = None) -> FloatAnchor:
+    """Builds the float anchor (`bash anchor_f32/build.sh`, a second; `env` as for `load`) into a
+    temporary folder and loads it."""
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="dnnevo-anchor-f32-"))
+    built = subprocess.run(["bash", str(F32_SOURCE / "build.sh"), str(folder)], capture_output=True,
+                           text=True, env=env)
+    if built.returncode != 0:
+        raise SystemExit(f"error: building the float C anchor failed:\n{built.stderr.strip()}")
+    return FloatAnchor(folder, dt)

@@ -108,6 +108,28 @@ def test_every_kernel_gives_the_same_states_in_f32(
         assert np.array_equal(bits(run), bits(first)), f"{name} differs from {KERNELS[0]}"
 
 
+@settings(max_examples=10, deadline=None)
+@given(n=st.integers(1, 8), m=st.integers(0, 3), steps=st.integers(1, 30),
+       method=st.sampled_from(["euler", "rk4"]), seed=st.integers(0, 2**32 - 1))
+def test_a_network_run_alone_in_f32_has_its_population_s_bits(n: int, m: int, steps: int, method: str,
+                                                               seed: int) -> None:
+    inputs = np.random.default_rng(seed).uniform(-3, 3, size=(steps, m))
+    nets = [dnnevo.Network.random(n, m, seed=seed + k) for k in range(3)]
+    for name in KERNELS:
+        dnnevo.use_kernel(name)
+        population = dnnevo.run_population(nets, inputs, dt=0.05, substeps=2, method=method,
+                                           precision="f32")
+        for net, states in zip(nets, population, strict=True):
+            alone = dnnevo.Network.from_json(net.to_json())
+            trace = alone.run(inputs, dt=0.05, substeps=2, method=method, precision="f32")
+            assert np.array_equal(bits(trace.states), bits(states)), name
+            assert np.array_equal(bits(alone.state), bits(states[-1]))  # the state kept
+            # The outputs are f32's own sigmoid of the f32 states, widened.
+            assert np.array_equal(trace.outputs.astype(np.float32).astype(np.float64), trace.outputs)
+            exact = 1.0 / (1.0 + np.exp(net.theta - trace.states))
+            assert np.allclose(trace.outputs, exact, rtol=1e-6, atol=1e-7)
+
+
 def test_f32_is_close_to_f64_and_a_bad_precision_is_refused() -> None:
     nets = [dnnevo.Network.random(5, 2, seed=k) for k in range(20)]
     inputs = np.random.default_rng(1).uniform(-1, 1, size=(50, 2))
@@ -118,6 +140,8 @@ def test_f32_is_close_to_f64_and_a_bad_precision_is_refused() -> None:
     assert np.abs(f32 - f64).max() < 1e-3  # 50 steps: rounding, not divergence
     with pytest.raises(ValueError, match='precision is "f16"; expected "f64" or "f32"'):
         dnnevo.run_population(nets, inputs, precision="f16")
+    with pytest.raises(ValueError, match='precision is "f16"; expected "f64" or "f32"'):
+        nets[0].run(inputs, precision="f16")
 
 
 TIMINGS = {"evals_per_s", "elapsed_s"}  # the log's columns that are wall times

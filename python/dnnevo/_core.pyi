@@ -132,7 +132,13 @@ class Network:
         dt: float = 0.1,
         substeps: int = 1,
         method: _Method = "euler",
-    ) -> Trace: ...
+        precision: _Precision = "f64",
+    ) -> Trace:
+        """Integrates through the rows of ``inputs`` (T, M), each held for ``substeps`` steps of
+        ``dt``, and keeps the final state. ``precision="f32"`` computes in single precision, with
+        the bits of ``run_population(..., precision="f32")`` for this network: parameters,
+        state and inputs rounded to float32 once, the trace's states and outputs (and the state
+        kept) float32 values widened to float64."""
     def to_json(self) -> str: ...
     @staticmethod
     def from_json(text: str) -> Network: ...

@@ -3,7 +3,7 @@
 use ctrnn::genome::{self, Layout, Ranges};
 use ctrnn::io::NetworkFile;
 use ctrnn::limits::zeros;
-use ctrnn::{Integrator, Method, Purpose, Stream};
+use ctrnn::{Integrator, Method, Precision, Purpose, Stream};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict, PyTuple};
@@ -248,8 +248,9 @@ impl PyNetwork {
             .py_err()
     }
 
-    /// Integrates through the rows of `inputs` (T, M), each held for `substeps` steps of `dt`.
-    #[pyo3(signature = (inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler"), text_signature = "($self, inputs, *, dt=0.1, substeps=1, method='euler')")]
+    /// Integrates through the rows of `inputs` (T, M), each held for `substeps` steps of `dt`,
+    /// in `precision` ("f64" or "f32": see `run_population`).
+    #[pyo3(signature = (inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", precision="f64"), text_signature = "($self, inputs, *, dt=0.1, substeps=1, method='euler', precision='f64')")]
     fn run(
         &mut self,
         py: Python<'_>,
@@ -257,8 +258,10 @@ impl PyNetwork {
         dt: f64,
         substeps: AnyInt,
         method: &str,
+        precision: &str,
     ) -> PyResult<PyTrace> {
         let integ = integrator(dt, &substeps, method)?;
+        let precision = precision.parse::<Precision>().py_err()?;
         let (n, m) = (self.inner.size(), self.inner.n_inputs());
         let x = dense(inputs, "inputs", arg_err)?;
         let steps = match x.shape.as_slice() {
@@ -273,13 +276,17 @@ impl PyNetwork {
         let cost = steps as f64 * (n * n.max(1)) as f64 * integ.substeps as f64;
         let net = &mut self.inner;
         let states = detached(py, cost, |cancel| {
-            net.run_cancellable(&x.data, steps, &integ, Some(cancel))
+            net.run_in(&x.data, steps, &integ, precision, Some(cancel))
         })?;
         let theta = self.inner.theta();
         // Reserved, not assumed: a long run's arrays fail with an error, not an abort.
         let mut outputs = zeros(states.len(), "recorded outputs").py_err()?;
-        for (k, (out, v)) in outputs.iter_mut().zip(&states).enumerate() {
-            *out = ctrnn::math::sigmoid(v - theta[k % n]);
+        for (k, (out, &v)) in outputs.iter_mut().zip(&states).enumerate() {
+            let theta = theta[k % n];
+            *out = match precision {
+                Precision::F64 => ctrnn::math::sigmoid(v - theta),
+                Precision::F32 => ctrnn::math::sigmoid_f32(v as f32 - theta as f32) as f64,
+            };
         }
         let row_time = dt * integ.substeps as f64;
         let mut time = zeros(steps, "recorded times").py_err()?;

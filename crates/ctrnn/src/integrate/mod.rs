@@ -19,6 +19,7 @@ use std::sync::atomic::AtomicBool;
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::network::Network;
+use crate::vector::Elem;
 
 pub(crate) mod kernel;
 mod lanes;
@@ -53,15 +54,55 @@ impl Network {
         integ: &Integrator,
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<f64>> {
+        self.run_in(inputs, steps, integ, Precision::F64, cancel)
+    }
+
+    /// [`Network::run_cancellable`] computing in `precision`. In [`Precision::F32`] the
+    /// parameters, the state and each input are rounded to `f32` once, the network steps in
+    /// `f32` with the bits of a population run in `f32`, and the states returned, and kept, are
+    /// the `f32` states widened (exactly) to `f64`.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Integrator, Network, Precision};
+    /// let mut net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None)?;
+    /// let states = net.run_in(&[1.0, 1.0], 2, &Integrator::default(), Precision::F32, None)?;
+    /// // v += 0.1 * (-v + 1) in f32: 0.1, then 0.19, widened to f64.
+    /// assert_eq!(states, [0.1f32 as f64, (0.1f32 + 0.1f32 * (1.0 - 0.1f32)) as f64]);
+    /// assert_eq!(net.state(), &states[1..]);
+    /// # Ok::<(), ctrnn::Error>(())
+    /// ```
+    pub fn run_in(
+        &mut self,
+        inputs: &[f64],
+        steps: usize,
+        integ: &Integrator,
+        precision: Precision,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
         integ.validate()?;
-        let (n, m) = (self.size(), self.n_inputs());
         limits::check_work(1, steps, integ.substeps)?;
         check_inputs(
             inputs,
-            limits::product(&[steps, m], "inputs")?,
+            limits::product(&[steps, self.n_inputs()], "inputs")?,
             "steps x n_inputs",
         )?;
-        let mut lanes = Lanes::<1>::new(&[self])?;
+        match precision {
+            Precision::F64 => self.run_lanes::<f64>(inputs, steps, integ, cancel),
+            Precision::F32 => self.run_lanes::<f32>(inputs, steps, integ, cancel),
+        }
+    }
+
+    /// [`Network::run_in`] on one lane of element type `E`, its inputs checked.
+    fn run_lanes<E: Elem>(
+        &mut self,
+        inputs: &[f64],
+        steps: usize,
+        integ: &Integrator,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        let (n, m) = (self.size(), self.n_inputs());
+        let mut lanes = Lanes::<1, E>::new(&[self])?;
         let mut states = limits::zeros(limits::product(&[steps, n], "states")?, "recorded states")?;
         lanes.run_rows(
             steps,
@@ -69,13 +110,19 @@ impl Network {
             cancel,
             |t, row| {
                 for k in 0..m {
-                    row[k][0] = inputs[t * m + k];
+                    row[k][0] = E::from_f64(inputs[t * m + k]);
                 }
             },
-            |t, state| copy_lane(state, 0, &mut states[t * n..(t + 1) * n]),
+            |t, state| {
+                for (into, v) in states[t * n..(t + 1) * n].iter_mut().zip(state) {
+                    *into = v[0].to_f64();
+                }
+            },
         )?;
         lanes.check_finite(|_| "the network".into())?;
-        lanes.lane_state(0, self.state_mut());
+        for (into, i) in self.state_mut().iter_mut().zip(0..n) {
+            *into = lanes.state(i)[0].to_f64();
+        }
         Ok(states)
     }
 }

@@ -1,4 +1,4 @@
-use ctrnn::integrate::{Integrator, Method};
+use ctrnn::integrate::{Integrator, Method, Precision};
 use ctrnn::population::*;
 use ctrnn::Network;
 use proptest::prelude::*;
@@ -30,19 +30,21 @@ fn arb_population() -> impl Strategy<Value = (Vec<Network>, Vec<f64>, usize, boo
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     #[test]
-    fn population_equals_single_bit_for_bit((nets, inputs, steps, rk4) in arb_population()) {
+    fn population_equals_single_bit_for_bit((nets, inputs, steps, rk4) in arb_population(), f32 in any::<bool>()) {
+        // In either precision: a network run alone keeps its population's bits.
+        let precision = if f32 { Precision::F32 } else { Precision::F64 };
         let integ = Integrator {
             method: if rk4 { Method::Rk4 } else { Method::Euler },
             dt: 0.1,
             substeps: 3,
         };
         let (n, m, p_len) = (nets[0].size(), nets[0].n_inputs(), nets.len());
-        let mut pop = Population::new(&nets).unwrap();
+        let mut pop = Population::with_precision(&nets, precision).unwrap();
         let all = pop.run(Inputs::PerNetwork(&inputs), steps, &integ, true, None).unwrap();
         for (p, net) in nets.iter().enumerate() {
             let mut single = net.clone();
             let own = &inputs[p * steps * m..(p + 1) * steps * m];
-            let s = single.run(own, steps, &integ).unwrap();
+            let s = single.run_in(own, steps, &integ, precision, None).unwrap();
             let mine = &all[p * steps * n..(p + 1) * steps * n];
             prop_assert!(s.iter().zip(mine).all(|(a, b)| a.to_bits() == b.to_bits()));
         }
@@ -50,11 +52,11 @@ proptest! {
         prop_assert_eq!(finals.len(), p_len * n);
         // Shared inputs: the first network's series for everyone.
         let shared = &inputs[..steps * m];
-        let mut pop = Population::new(&nets).unwrap();
+        let mut pop = Population::with_precision(&nets, precision).unwrap();
         let last = pop.run(Inputs::Shared(shared), steps, &integ, false, None).unwrap();
         for (p, net) in nets.iter().enumerate() {
             let mut single = net.clone();
-            single.run(shared, steps, &integ).unwrap();
+            single.run_in(shared, steps, &integ, precision, None).unwrap();
             let mine = &last[p * n..(p + 1) * n];
             prop_assert!(single.state().iter().zip(mine).all(|(a, b)| a.to_bits() == b.to_bits()));
         }
@@ -130,7 +132,6 @@ fn a_diverging_population_names_its_first_diverging_network() {
 /// with fused multiply-adds; `sigmoid_f32`), widened to f64.
 #[test]
 fn an_f32_population_is_a_plain_f32_euler_loop() {
-    use ctrnn::integrate::Precision;
     use ctrnn::math::sigmoid_f32;
     let (n, m, steps) = (5, 2, 60);
     let nets = ctrnn::testing::integrate::random_networks(19, n, m, 4);
@@ -180,7 +181,6 @@ fn an_f32_population_is_a_plain_f32_euler_loop() {
 
 #[test]
 fn precision_names_parse() {
-    use ctrnn::integrate::Precision;
     assert_eq!("f32".parse::<Precision>().unwrap(), Precision::F32);
     assert_eq!("f64".parse::<Precision>().unwrap(), Precision::F64);
     assert_eq!(Precision::default(), Precision::F64);

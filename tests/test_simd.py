@@ -130,6 +130,24 @@ def test_a_network_run_alone_in_f32_has_its_population_s_bits(n: int, m: int, st
             assert np.allclose(trace.outputs, exact, rtol=1e-6, atol=1e-7)
 
 
+def test_a_batch_in_f32_steps_each_row_as_network_run_in_f32() -> None:
+    nets = [dnnevo.Network.random(4, 2, seed=k) for k in range(9)]
+    inputs = np.random.default_rng(3).uniform(-2, 2, size=(12, len(nets) * 2, 2))
+    for name in KERNELS:
+        dnnevo.use_kernel(name)
+        batch = dnnevo.Batch(nets, replicas=2, substeps=3, method="rk4", precision="f32")
+        assert batch.precision == "f32" and "precision='f32'" in repr(batch)
+        rates = np.empty((batch.rows, batch.size))
+        for row in inputs:
+            batch.step(row, out=rates)
+        for r in range(batch.rows):
+            alone = dnnevo.Network.from_json(nets[r // 2].to_json())
+            trace = alone.run(inputs[:, r], substeps=3, method="rk4", precision="f32")
+            assert np.array_equal(bits(batch.states[r]), bits(trace.states[-1])), (name, r)
+            assert np.array_equal(bits(rates[r]), bits(trace.outputs[-1])), (name, r)
+    assert dnnevo.Batch(nets).precision == "f64"
+
+
 def test_f32_is_close_to_f64_and_a_bad_precision_is_refused() -> None:
     nets = [dnnevo.Network.random(5, 2, seed=k) for k in range(20)]
     inputs = np.random.default_rng(1).uniform(-1, 1, size=(50, 2))
@@ -142,6 +160,8 @@ def test_f32_is_close_to_f64_and_a_bad_precision_is_refused() -> None:
         dnnevo.run_population(nets, inputs, precision="f16")
     with pytest.raises(ValueError, match='precision is "f16"; expected "f64" or "f32"'):
         nets[0].run(inputs, precision="f16")
+    with pytest.raises(ValueError, match='precision is "f16"; expected "f64" or "f32"'):
+        dnnevo.Batch(nets, precision="f16")
 
 
 TIMINGS = {"evals_per_s", "elapsed_s"}  # the log's columns that are wall times

@@ -12,7 +12,8 @@
 //! row busy with the episodes still waiting, instead of stepping ended rows' environments.
 //!
 //! One row fed the same inputs gives the same bits as [`Network::run`]: both step through the
-//! same kernel in the same order of operations.
+//! same kernel in the same order of operations. A batch may compute in single precision
+//! ([`Batch::with_rows_in`], [`Precision::F32`]), with the bits of [`Network::run_in`] in `f32`.
 
 use std::borrow::Borrow;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -20,11 +21,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrate::{Integrator, CANCEL_CHECK_STEPS, LANES};
+use crate::integrate::{Integrator, Lanes, Precision, CANCEL_CHECK_STEPS, LANES};
 use crate::limits::{check_work, MAX_BATCH_ROWS};
 use crate::network::Network;
-use crate::population::Block;
 use crate::spin;
+use crate::vector::Elem;
 
 /// Block-steps (blocks x N x N x substeps) from which a step runs its blocks on all cores; below
 /// it, handing the blocks to the thread pool costs more than it saves.
@@ -57,23 +58,56 @@ pub struct Batch {
     networks: Vec<Network>,
     /// The network each row runs, an index into `networks`.
     network_of: Vec<usize>,
-    blocks: Vec<Block>,
-    /// Each block's work arrays, reused from step to step so that a step allocates nothing.
-    slots: Vec<Slot>,
+    /// The blocks, in the precision the batch computes in.
+    store: Store,
+    /// The lanes of each block that take part in the current step, one bit per lane.
+    on: Vec<u32>,
     /// The row in each lane, `row_at[b * LANES + l]`, and each row's lane, `lane_of[row]`.
     row_at: Vec<usize>,
     lane_of: Vec<usize>,
 }
 
+/// A batch's blocks in the precision it computes in.
+#[derive(Clone, Debug)]
+enum Store {
+    F64(Blocks<f64>),
+    F32(Blocks<f32>),
+}
+
+/// Runs `$body` with `$b` bound to the [`Blocks`] of `$store`, whatever their precision.
+macro_rules! with_blocks {
+    ($store:expr, $b:ident => $body:expr) => {
+        match $store {
+            Store::F64($b) => $body,
+            Store::F32($b) => $body,
+        }
+    };
+}
+
+/// Blocks of [`LANES`] rows and their work arrays, reused from step to step so that a step
+/// allocates nothing.
+#[derive(Clone, Debug)]
+struct Blocks<E: Elem> {
+    blocks: Vec<Lanes<LANES, E>>,
+    slots: Vec<Slot<E>>,
+}
+
+impl<E: Elem> Blocks<E> {
+    fn empty() -> Self {
+        Blocks {
+            blocks: Vec::new(),
+            slots: Vec::new(),
+        }
+    }
+}
+
 /// One block's work arrays.
 #[derive(Clone, Debug)]
-struct Slot {
-    /// The lanes that take part in the current step, one bit per lane.
-    on: u32,
+struct Slot<E> {
     /// The inputs of the step, `[sensor][lane]`.
-    inputs: Vec<[f64; LANES]>,
+    inputs: Vec<[E; LANES]>,
     /// The states of the lanes left out of the step, lane by lane.
-    kept: Vec<f64>,
+    kept: Vec<E>,
 }
 
 impl Batch {
@@ -102,6 +136,33 @@ impl Batch {
         replicas: usize,
         rows: usize,
         integ: Integrator,
+    ) -> Result<Self> {
+        Self::with_rows_in(networks, replicas, rows, integ, Precision::F64)
+    }
+
+    /// [`Batch::with_rows`] computing in `precision`. In [`Precision::F32`] each row's
+    /// parameters and state are rounded to `f32` when it is packed, each input and each state
+    /// set when it is read; states and rates are the `f32` values widened (exactly) to `f64`.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Batch, Integrator, Network, Precision};
+    /// let net = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None)?;
+    /// let mut batch = Batch::with_rows_in(&[net], 1, 1, Integrator::default(), Precision::F32)?;
+    /// let mut rates = vec![0.0];
+    /// batch.step(&[1.0], None, &mut rates, None)?;
+    /// batch.step(&[1.0], None, &mut rates, None)?;
+    /// // v += 0.1 * (-v + 1) in f32: 0.1, then 0.19, widened to f64.
+    /// assert_eq!(batch.states(), [(0.1f32 + 0.1f32 * (1.0 - 0.1f32)) as f64]);
+    /// assert_eq!(batch.precision(), Precision::F32);
+    /// # Ok::<(), ctrnn::Error>(())
+    /// ```
+    pub fn with_rows_in<N: Borrow<Network>>(
+        networks: &[N],
+        replicas: usize,
+        rows: usize,
+        integ: Integrator,
+        precision: Precision,
     ) -> Result<Self> {
         integ.validate()?;
         if replicas == 0 {
@@ -146,11 +207,6 @@ impl Batch {
                 networks[p].n_inputs()
             )));
         }
-        let slot = Slot {
-            on: 0,
-            inputs: vec![[0.0; LANES]; m],
-            kept: vec![0.0; LANES * n],
-        };
         let mut batch = Batch {
             size: n,
             n_inputs: m,
@@ -158,13 +214,25 @@ impl Batch {
             integ,
             networks,
             network_of: (0..rows).map(|r| r / replicas).collect(),
-            blocks: Vec::new(),
-            slots: vec![slot; rows.div_ceil(LANES)],
+            // Empty until packed below, in the precision asked for.
+            store: match precision {
+                Precision::F64 => Store::F64(Blocks::empty()),
+                Precision::F32 => Store::F32(Blocks::empty()),
+            },
+            on: vec![0; rows.div_ceil(LANES)],
             row_at: (0..rows).collect(),
             lane_of: (0..rows).collect(),
         };
-        batch.blocks = batch.pack(&batch.row_at, None)?;
+        batch.store = batch.pack(&batch.row_at, None)?;
         Ok(batch)
+    }
+
+    /// The precision it computes in.
+    pub fn precision(&self) -> Precision {
+        match self.store {
+            Store::F64(_) => Precision::F64,
+            Store::F32(_) => Precision::F32,
+        }
     }
 
     /// Rows B: networks x replicas, or as many as [`Batch::with_rows`] was given.
@@ -192,32 +260,48 @@ impl Batch {
         &self.integ
     }
 
-    /// Blocks with the rows of `order` lane by lane, each row's state taken from `states`
-    /// (row-major `B x N`), or from its network when `None`.
-    fn pack(&self, order: &[usize], states: Option<&[f64]>) -> Result<Vec<Block>> {
-        let n = self.size;
-        order
+    /// Blocks, in the batch's precision, with the rows of `order` lane by lane, each row's
+    /// state taken from `states` (row-major `B x N`), or from its network when `None`.
+    fn pack(&self, order: &[usize], states: Option<&[f64]>) -> Result<Store> {
+        Ok(match self.store {
+            Store::F64(_) => Store::F64(self.pack_as(order, states)?),
+            Store::F32(_) => Store::F32(self.pack_as(order, states)?),
+        })
+    }
+
+    /// [`Batch::pack`] in element type `E`.
+    fn pack_as<E: Elem>(&self, order: &[usize], states: Option<&[f64]>) -> Result<Blocks<E>> {
+        let (n, m) = (self.size, self.n_inputs);
+        let blocks = order
             .par_chunks(LANES)
             .map(|rows| {
                 let refs: Vec<&Network> = rows
                     .iter()
                     .map(|&r| &self.networks[self.network_of[r]])
                     .collect();
-                let mut block = Block::new(&refs)?;
+                let mut block = Lanes::new(&refs)?;
                 if let Some(states) = states {
                     for (l, &r) in rows.iter().enumerate() {
-                        block.set_lane_state(l, &states[r * n..(r + 1) * n]);
+                        set_lane_state(&mut block, l, &states[r * n..(r + 1) * n]);
                     }
                 }
                 Ok(block)
             })
-            .collect()
+            .collect::<Result<Vec<_>>>()?;
+        let slot = Slot {
+            inputs: vec![[E::default(); LANES]; m],
+            kept: vec![E::default(); LANES * n],
+        };
+        Ok(Blocks {
+            slots: vec![slot; blocks.len()],
+            blocks,
+        })
     }
 
     /// Moves the rows of `active` (`running` of them) to the first lanes, in row order, when
     /// they are spread over clearly more blocks than they fill.
     fn pack_active(&mut self, active: &[bool], running: usize) -> Result<()> {
-        let touched = self.slots.iter().filter(|s| s.on != 0).count();
+        let touched = self.on.iter().filter(|&&on| on != 0).count();
         let needed = running.div_ceil(LANES);
         if touched <= needed + needed / 4 + 1 {
             return Ok(());
@@ -226,7 +310,7 @@ impl Batch {
         let (on, off): (Vec<usize>, Vec<usize>) = (0..self.rows()).partition(|&r| active[r]);
         let order: Vec<usize> = on.into_iter().chain(off).collect();
         // The blocks first: if packing failed, the batch would be as it was.
-        self.blocks = self.pack(&order, Some(&states))?;
+        self.store = self.pack(&order, Some(&states))?;
         self.row_at = order;
         for (at, &r) in self.row_at.iter().enumerate() {
             self.lane_of[r] = at;
@@ -238,12 +322,12 @@ impl Batch {
     /// Marks the lanes whose row is in `active` (every lane without a mask); returns how many.
     fn mark(&mut self, active: Option<&[bool]>) -> usize {
         let mut running = 0;
-        for (slot, rows) in self.slots.iter_mut().zip(self.row_at.chunks(LANES)) {
-            slot.on = 0;
+        for (on, rows) in self.on.iter_mut().zip(self.row_at.chunks(LANES)) {
+            *on = 0;
             for (l, &r) in rows.iter().enumerate() {
-                slot.on |= u32::from(active.is_none_or(|mask| mask[r])) << l;
+                *on |= u32::from(active.is_none_or(|mask| mask[r])) << l;
             }
-            running += slot.on.count_ones() as usize;
+            running += on.count_ones() as usize;
         }
         running
     }
@@ -255,9 +339,9 @@ impl Batch {
             return Ok(());
         }
         let m = self.n_inputs;
-        for (slot, rows) in self.slots.iter().zip(self.row_at.chunks(LANES)) {
+        for (&on, rows) in self.on.iter().zip(self.row_at.chunks(LANES)) {
             for (l, &r) in rows.iter().enumerate() {
-                if slot.on >> l & 1 == 0 {
+                if on >> l & 1 == 0 {
                     continue;
                 }
                 for k in 0..m {
@@ -306,81 +390,12 @@ impl Batch {
             self.pack_active(mask, running)?;
         }
         self.check_inputs(inputs)?;
-        let integ = self.integ;
-        let row_at = &self.row_at;
-        let out = RatesOut {
-            rates: rates.as_mut_ptr(),
+        let shape = StepShape {
             n,
+            m,
+            integ: self.integ,
         };
-        let out = &out;
-        let work = |b: usize, block: &mut Block, slot: &mut Slot| {
-            if slot.on == 0 {
-                return Ok(());
-            }
-            if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
-                return Err(Error::Interrupted);
-            }
-            let lanes = block.len();
-            let rows = &row_at[b * LANES..b * LANES + lanes];
-            let off = |l: usize| slot.on >> l & 1 == 0;
-            // The inputs of the stepping lanes; 0 in the others.
-            for (k, sensor) in slot.inputs.iter_mut().enumerate() {
-                for (l, &r) in rows.iter().enumerate() {
-                    sensor[l] = if off(l) {
-                        0.0
-                    } else {
-                        inputs[r * m + k].into()
-                    };
-                }
-                sensor[lanes..].fill(0.0);
-            }
-            for l in (0..lanes).filter(|&l| off(l)) {
-                block.lane_state(l, &mut slot.kept[l * n..(l + 1) * n]);
-            }
-            let stepped = step_held_in_chunks(block, &slot.inputs, &integ, cancel)
-                .and_then(|()| check_finite(block, |l| (!off(l)).then(|| rows[l])));
-            // Rows left out keep their state, whatever happened to the others.
-            for l in (0..lanes).filter(|&l| off(l)) {
-                block.set_lane_state(l, &slot.kept[l * n..(l + 1) * n]);
-            }
-            stepped?;
-            let lane_rates = block.outputs();
-            for (l, &r) in rows.iter().enumerate().filter(|&(l, _)| !off(l)) {
-                // SAFETY: `r < B` and `rates` holds `B x N` values; a row sits in one lane of
-                // one block, and each block is stepped by one thread, so no other reference to
-                // this row's rates is alive.
-                #[allow(unsafe_code)]
-                let row = unsafe { out.row(r) };
-                for (x, rate) in row.iter_mut().zip(lane_rates) {
-                    *x = rate[l];
-                }
-            }
-            Ok(())
-        };
-        let busy = self.slots.iter().filter(|s| s.on != 0).count();
-        let amount = busy * n * n * integ.substeps;
-        if amount >= PARALLEL_WORK && busy > 1 {
-            // The lowest failing block's error, as in order: not whichever thread failed first.
-            let failed = self
-                .blocks
-                .par_iter_mut()
-                .zip(self.slots.par_iter_mut())
-                .enumerate()
-                .filter_map(|(b, (block, slot))| work(b, block, slot).err().map(|e| (b, e)))
-                .min_by_key(|&(b, _)| b);
-            if let Some((_, e)) = failed {
-                return Err(e);
-            }
-        } else if amount >= SPIN_WORK && busy > 1 {
-            spin::try_for_each_zip(&mut self.blocks, &mut self.slots, work)?;
-        } else {
-            self.blocks
-                .iter_mut()
-                .zip(self.slots.iter_mut())
-                .enumerate()
-                .try_for_each(|(b, (block, slot))| work(b, block, slot))?;
-        }
-        Ok(())
+        with_blocks!(&mut self.store, b => step_blocks(b, &self.on, &self.row_at, shape, inputs, rates, cancel))
     }
 
     fn check_len(&self, name: &str, len: usize, want: usize, shape: &str) -> Result<()> {
@@ -396,30 +411,37 @@ impl Batch {
         }
     }
 
-    /// Every row's state, row-major `B x N`.
+    /// Every row's state, row-major `B x N` (widened to `f64` in `f32`).
     pub fn states(&self) -> Vec<f64> {
         let n = self.size;
         let mut out = vec![0.0; self.rows() * n];
-        for (r, &at) in self.lane_of.iter().enumerate() {
-            self.blocks[at / LANES].lane_state(at % LANES, &mut out[r * n..(r + 1) * n]);
-        }
+        with_blocks!(&self.store, b => {
+            for (r, &at) in self.lane_of.iter().enumerate() {
+                let block = &b.blocks[at / LANES];
+                for (i, into) in out[r * n..(r + 1) * n].iter_mut().enumerate() {
+                    *into = block.state(i)[at % LANES].to_f64();
+                }
+            }
+        });
         out
     }
 
-    /// Every row's firing rates `f(v - theta)`, row-major `B x N`.
+    /// Every row's firing rates `f(v - theta)`, row-major `B x N` (widened to `f64` in `f32`).
     pub fn rates(&mut self) -> Vec<f64> {
         let n = self.size;
         let mut out = vec![0.0; self.rows() * n];
-        for (b, block) in self.blocks.iter_mut().enumerate() {
-            let lanes = block.len();
-            let rates = block.outputs();
-            for l in 0..lanes {
-                let r = self.row_at[b * LANES + l];
-                for (i, rate) in rates.iter().enumerate() {
-                    out[r * n + i] = rate[l];
+        with_blocks!(&mut self.store, b => {
+            for (k, block) in b.blocks.iter_mut().enumerate() {
+                let lanes = block.len();
+                let rates = block.outputs();
+                for l in 0..lanes {
+                    let r = self.row_at[k * LANES + l];
+                    for (i, rate) in rates.iter().enumerate() {
+                        out[r * n + i] = rate[l].to_f64();
+                    }
                 }
             }
-        }
+        });
         out
     }
 
@@ -440,11 +462,13 @@ impl Batch {
                 states[k]
             )));
         }
-        for (r, &at) in self.lane_of.iter().enumerate() {
-            if chosen(r) {
-                self.blocks[at / LANES].set_lane_state(at % LANES, &states[r * n..(r + 1) * n]);
+        with_blocks!(&mut self.store, b => {
+            for (r, &at) in self.lane_of.iter().enumerate() {
+                if chosen(r) {
+                    set_lane_state(&mut b.blocks[at / LANES], at % LANES, &states[r * n..(r + 1) * n]);
+                }
             }
-        }
+        });
         Ok(())
     }
 
@@ -494,7 +518,8 @@ impl Batch {
         for (&r, &p) in rows.iter().zip(networks) {
             self.network_of[r] = p;
             let at = self.lane_of[r];
-            self.blocks[at / LANES].set_lane(at % LANES, &self.networks[p])?;
+            let net = &self.networks[p];
+            with_blocks!(&mut self.store, b => b.blocks[at / LANES].set_lane(at % LANES, net))?;
         }
         Ok(())
     }
@@ -524,11 +549,113 @@ impl RatesOut {
     }
 }
 
+/// Sets lane `l`'s state from `state` (N values), rounded to `E`.
+fn set_lane_state<E: Elem>(block: &mut Lanes<LANES, E>, l: usize, state: &[f64]) {
+    let state: Vec<E> = state.iter().map(|&v| E::from_f64(v)).collect();
+    block.set_lane_state(l, &state);
+}
+
+/// The sizes and settings of a step.
+#[derive(Clone, Copy)]
+struct StepShape {
+    n: usize,
+    m: usize,
+    integ: Integrator,
+}
+
+/// [`Batch::step`] on blocks of element type `E`, its arrays checked and its lanes marked in
+/// `on`: each block with a lane on is stepped, in parallel when the step is big enough.
+fn step_blocks<E: Elem, T: Copy + Into<f64> + Sync>(
+    store: &mut Blocks<E>,
+    on: &[u32],
+    row_at: &[usize],
+    shape: StepShape,
+    inputs: &[T],
+    rates: &mut [f64],
+    cancel: Option<&AtomicBool>,
+) -> Result<()> {
+    let StepShape { n, m, integ } = shape;
+    let out = RatesOut {
+        rates: rates.as_mut_ptr(),
+        n,
+    };
+    let out = &out;
+    let work = |b: usize, block: &mut Lanes<LANES, E>, slot: &mut Slot<E>| {
+        let on = on[b];
+        if on == 0 {
+            return Ok(());
+        }
+        if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            return Err(Error::Interrupted);
+        }
+        let lanes = block.len();
+        let rows = &row_at[b * LANES..b * LANES + lanes];
+        let off = |l: usize| on >> l & 1 == 0;
+        // The inputs of the stepping lanes; 0 in the others.
+        for (k, sensor) in slot.inputs.iter_mut().enumerate() {
+            for (l, &r) in rows.iter().enumerate() {
+                sensor[l] = if off(l) {
+                    E::default()
+                } else {
+                    E::from_f64(inputs[r * m + k].into())
+                };
+            }
+            sensor[lanes..].fill(E::default());
+        }
+        for l in (0..lanes).filter(|&l| off(l)) {
+            block.lane_state(l, &mut slot.kept[l * n..(l + 1) * n]);
+        }
+        let stepped = step_held_in_chunks(block, &slot.inputs, &integ, cancel)
+            .and_then(|()| check_finite(block, |l| (!off(l)).then(|| rows[l])));
+        // Rows left out keep their state, whatever happened to the others.
+        for l in (0..lanes).filter(|&l| off(l)) {
+            block.set_lane_state(l, &slot.kept[l * n..(l + 1) * n]);
+        }
+        stepped?;
+        let lane_rates = block.outputs();
+        for (l, &r) in rows.iter().enumerate().filter(|&(l, _)| !off(l)) {
+            // SAFETY: `r < B` and `rates` holds `B x N` values; a row sits in one lane of
+            // one block, and each block is stepped by one thread, so no other reference to
+            // this row's rates is alive.
+            #[allow(unsafe_code)]
+            let row = unsafe { out.row(r) };
+            for (x, rate) in row.iter_mut().zip(lane_rates) {
+                *x = rate[l].to_f64();
+            }
+        }
+        Ok(())
+    };
+    let busy = on.iter().filter(|&&on| on != 0).count();
+    let amount = busy * n * n * integ.substeps;
+    let Blocks { blocks, slots } = store;
+    if amount >= PARALLEL_WORK && busy > 1 {
+        // The lowest failing block's error, as in order: not whichever thread failed first.
+        let failed = blocks
+            .par_iter_mut()
+            .zip(slots.par_iter_mut())
+            .enumerate()
+            .filter_map(|(b, (block, slot))| work(b, block, slot).err().map(|e| (b, e)))
+            .min_by_key(|&(b, _)| b);
+        if let Some((_, e)) = failed {
+            return Err(e);
+        }
+    } else if amount >= SPIN_WORK && busy > 1 {
+        spin::try_for_each_zip(blocks, slots, work)?;
+    } else {
+        blocks
+            .iter_mut()
+            .zip(slots.iter_mut())
+            .enumerate()
+            .try_for_each(|(b, (block, slot))| work(b, block, slot))?;
+    }
+    Ok(())
+}
+
 /// One input row held for `integ.substeps` steps, taken [`CANCEL_CHECK_STEPS`] at a time with a
 /// look at `cancel` in between (holding the inputs gives the same bits as one long row).
-fn step_held_in_chunks(
-    block: &mut Block,
-    inputs: &[[f64; LANES]],
+fn step_held_in_chunks<E: Elem>(
+    block: &mut Lanes<LANES, E>,
+    inputs: &[[E; LANES]],
     integ: &Integrator,
     cancel: Option<&AtomicBool>,
 ) -> Result<()> {
@@ -551,14 +678,17 @@ fn step_held_in_chunks(
 
 /// Fails when a stepped lane's state is no longer finite (an Euler step with `dt / tau > 2`);
 /// `row(l)` is the row in lane `l` if it was stepped.
-fn check_finite(block: &Block, row: impl Fn(usize) -> Option<usize>) -> Result<()> {
+fn check_finite<E: Elem>(
+    block: &Lanes<LANES, E>,
+    row: impl Fn(usize) -> Option<usize>,
+) -> Result<()> {
     for i in 0..block.size() {
         let state = block.state(i);
-        if state.iter().all(|v| v.is_finite()) {
+        if state.iter().all(|v| v.finite()) {
             continue;
         }
         for l in 0..block.len() {
-            if let Some(r) = row(l).filter(|_| !state[l].is_finite()) {
+            if let Some(r) = row(l).filter(|_| !state[l].finite()) {
                 return Err(Error::InvalidArgument(format!(
                     "integration diverged: state[{i}] of row {r} became {}; use a smaller dt \
                      (Euler needs dt / tau well below 2)",

@@ -3,6 +3,7 @@
 //! A step reads the caller's float64 or float32 inputs and writes into the caller's output
 //! array in place when given, so that a loop of steps copies and allocates nothing.
 
+use ctrnn::Precision;
 use numpy::{
     PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
     PyUntypedArrayMethods,
@@ -19,7 +20,8 @@ use crate::population::networks_from;
 /// P networks times E replicas, stepped together one time step per call: the core of a
 /// closed-loop task, where each step's inputs come from the last step's outputs.
 ///
-/// ``Batch(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method="euler")`` holds B = P
+/// ``Batch(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method="euler",
+/// precision="f64")`` holds B = P
 /// * E rows; row ``p * replicas + e`` is replica ``e`` of ``networks[p]`` (a sequence of Networks
 /// of one shape, or a dict of stacked arrays as for ``run_population``). Each row starts from its
 /// network's state. With ``rows`` (1 to P * E) it holds only the first ``rows`` of those rows,
@@ -40,6 +42,9 @@ use crate::population::networks_from;
 /// - ``states`` and ``rates`` are (B, N) copies.
 ///
 /// A row gives the same bits as ``Network.run`` fed the same rows of inputs, on every kernel.
+/// ``precision="f32"`` computes in single precision, as ``Network.run(..., precision="f32")``
+/// does: parameters, states and inputs rounded to float32 when read, states and rates float32
+/// values widened to float64.
 ///
 /// >>> import numpy as np, dnnevo
 /// >>> nets = [dnnevo.Network.random(3, 1, seed=s) for s in range(4)]
@@ -193,7 +198,7 @@ fn indices(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<usize>> {
 #[pymethods]
 impl PyBatch {
     #[new]
-    #[pyo3(signature = (networks, *, replicas=AnyInt::from(1), rows=None, dt=0.1, substeps=AnyInt::from(1), method="euler"), text_signature = "(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method='euler')")]
+    #[pyo3(signature = (networks, *, replicas=AnyInt::from(1), rows=None, dt=0.1, substeps=AnyInt::from(1), method="euler", precision="f64"), text_signature = "(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method='euler', precision='f64')")]
     fn new(
         networks: &Bound<'_, PyAny>,
         replicas: AnyInt,
@@ -201,16 +206,18 @@ impl PyBatch {
         dt: f64,
         substeps: AnyInt,
         method: &str,
+        precision: &str,
     ) -> PyResult<Self> {
         let integ = integrator(dt, &substeps, method)?;
+        let precision = precision.parse::<Precision>().py_err()?;
         let replicas: usize = replicas.to("replicas", "[1, 2**64)")?;
         let nets = networks_from(networks)?;
-        let inner = match rows {
-            None => ctrnn::Batch::new(&nets, replicas, integ),
-            Some(rows) => {
-                ctrnn::Batch::with_rows(&nets, replicas, rows.to("rows", "[1, 2**64)")?, integ)
-            }
+        let all = (nets.len() as u128).saturating_mul(replicas as u128);
+        let rows = match rows {
+            None => usize::try_from(all).unwrap_or(usize::MAX),
+            Some(rows) => rows.to("rows", "[1, 2**64)")?,
         };
+        let inner = ctrnn::Batch::with_rows_in(&nets, replicas, rows, integ, precision);
         Ok(PyBatch {
             inner: inner.py_err()?,
         })
@@ -240,6 +247,11 @@ impl PyBatch {
     #[getter]
     fn n_inputs(&self) -> usize {
         self.inner.n_inputs()
+    }
+    /// The precision it computes in, "f64" or "f32".
+    #[getter]
+    fn precision(&self) -> &'static str {
+        self.inner.precision().name()
     }
     /// The integration settings, {"method": ..., "dt": ..., "substeps": ...}.
     #[getter]
@@ -388,14 +400,15 @@ impl PyBatch {
     fn __repr__(&self) -> String {
         let i = self.inner.integrator();
         format!(
-            "Batch(networks={}, replicas={}, size={}, n_inputs={}, method='{}', dt={}, substeps={})",
+            "Batch(networks={}, replicas={}, size={}, n_inputs={}, method='{}', dt={}, substeps={}, precision='{}')",
             self.inner.networks(),
             self.inner.replicas(),
             self.inner.size(),
             self.inner.n_inputs(),
             i.method.name(),
             i.dt,
-            i.substeps
+            i.substeps,
+            self.inner.precision().name()
         )
     }
 }

@@ -1,7 +1,7 @@
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::integrate::{Integrator, Method};
-use ctrnn::math::sigmoid;
+use ctrnn::integrate::{Integrator, Method, Precision};
+use ctrnn::math::{sigmoid, sigmoid_f32};
 use ctrnn::testing::integrate::random_networks;
 use ctrnn::{Batch, Error, Network};
 use proptest::prelude::*;
@@ -12,6 +12,19 @@ fn integrator(rk4: bool, substeps: usize) -> Integrator {
         dt: 0.1,
         substeps,
     }
+}
+
+fn precision(f32: bool) -> Precision {
+    if f32 {
+        Precision::F32
+    } else {
+        Precision::F64
+    }
+}
+
+/// A batch of every replica of `nets`, in `precision`.
+fn batch_in(nets: &[Network], e: usize, integ: Integrator, precision: Precision) -> Batch {
+    Batch::with_rows_in(nets, e, nets.len() * e, integ, precision).unwrap()
 }
 
 fn bits(x: &[f64]) -> Vec<u64> {
@@ -26,15 +39,18 @@ fn input(row: usize, t: usize, k: usize) -> f64 {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
     /// Every row, stepped only on its active steps, ends where `Network::run` on those steps'
-    /// inputs ends, bit for bit, and the rates of a row stepped last are `f(v - theta)` of its state.
+    /// inputs ends, bit for bit, and the rates of a row stepped last are `f(v - theta)` of its
+    /// state: in either precision.
     #[test]
     fn rows_equal_network_run_bit_for_bit(
         n in 1usize..7, m in 0usize..3, p in 1usize..20, e in 1usize..4,
         steps in 1usize..8, rk4 in any::<bool>(), seed in 0u64..1000, sub in 1usize..4,
+        f32 in any::<bool>(),
     ) {
         let nets = random_networks(p, n, m, seed);
         let integ = integrator(rk4, sub);
-        let mut batch = Batch::new(&nets, e, integ).unwrap();
+        let mut batch = batch_in(&nets, e, integ, precision(f32));
+        prop_assert_eq!(batch.precision(), precision(f32));
         let rows = p * e;
         // Row r sits out step t when (r + t) % 3 == 0.
         let on = |r: usize, t: usize| !(r + t).is_multiple_of(3);
@@ -51,13 +67,19 @@ proptest! {
                 .filter(|&t| on(r, t))
                 .flat_map(|t| (0..m).map(move |k| input(r, t, k)))
                 .collect();
-            single.run(&own, own.len() / m.max(1), &integ).unwrap();
+            single.run_in(&own, own.len() / m.max(1), &integ, precision(f32), None).unwrap();
             let mine = &states[r * n..(r + 1) * n];
             if m > 0 {
                 prop_assert_eq!(bits(single.state()), bits(mine), "row {}", r);
             }
             if on(r, steps - 1) {
-                let want: Vec<f64> = (0..n).map(|i| sigmoid(mine[i] - nets[r / e].theta()[i])).collect();
+                let theta = nets[r / e].theta();
+                let rate = |i: usize| if f32 {
+                    sigmoid_f32(mine[i] as f32 - theta[i] as f32) as f64
+                } else {
+                    sigmoid(mine[i] - theta[i])
+                };
+                let want: Vec<f64> = (0..n).map(rate).collect();
                 prop_assert_eq!(bits(&want), bits(&rates[r * n..(r + 1) * n]));
             }
         }
@@ -204,6 +226,12 @@ fn rows_left_out_keep_their_states_and_their_rates() {
 /// ends on its own episodes.
 #[test]
 fn packing_the_running_rows_does_not_change_their_bits() {
+    for f32 in [false, true] {
+        packing_keeps_the_bits_in(precision(f32));
+    }
+}
+
+fn packing_keeps_the_bits_in(precision: Precision) {
     let (p, e, n, m, steps) = (40, 3, 4, 2, 40);
     let nets = random_networks(p, n, m, 11);
     let integ = integrator(false, 2);
@@ -211,7 +239,7 @@ fn packing_the_running_rows_does_not_change_their_bits() {
     let end = |r: usize| 1 + (r * 37) % 25; // the first episode's last step
     let restart = |r: usize| r.is_multiple_of(5).then_some(30); // a second episode from step 30
     let on = |r: usize, t: usize| t < end(r) || restart(r).is_some_and(|s| t >= s);
-    let mut batch = Batch::new(&nets, e, integ).unwrap();
+    let mut batch = batch_in(&nets, e, integ, precision);
     let mut rates = vec![0.0; rows * n];
     for t in 0..steps {
         let fresh: Vec<bool> = (0..rows).map(|r| restart(r) == Some(t)).collect();
@@ -227,7 +255,9 @@ fn packing_the_running_rows_does_not_change_their_bits() {
             let own: Vec<f64> = (from..to)
                 .flat_map(|t| (0..m).map(move |k| input(r, t, k)))
                 .collect();
-            single.run(&own, to - from, &integ).unwrap();
+            single
+                .run_in(&own, to - from, &integ, precision, None)
+                .unwrap();
         };
         run(0, end(r), &mut single);
         if let Some(s) = restart(r) {
@@ -237,7 +267,7 @@ fn packing_the_running_rows_does_not_change_their_bits() {
         assert_eq!(
             bits(single.state()),
             bits(&states[r * n..(r + 1) * n]),
-            "row {r}"
+            "row {r}, {precision:?}"
         );
     }
 }
@@ -250,12 +280,12 @@ proptest! {
     #[test]
     fn assigned_rows_equal_network_run_bit_for_bit(
         n in 1usize..6, m in 1usize..3, p in 1usize..12, e in 1usize..3, fewer in 0usize..20,
-        steps in 2usize..8, rk4 in any::<bool>(), seed in 0u64..1000,
+        steps in 2usize..8, rk4 in any::<bool>(), seed in 0u64..1000, f32 in any::<bool>(),
     ) {
         let nets = random_networks(p, n, m, seed);
         let integ = integrator(rk4, 2);
         let rows = (p * e).saturating_sub(fewer).max(1);
-        let mut batch = Batch::with_rows(&nets, e, rows, integ).unwrap();
+        let mut batch = Batch::with_rows_in(&nets, e, rows, integ, precision(f32)).unwrap();
         prop_assert_eq!(batch.rows(), rows);
         let mut owner: Vec<usize> = (0..rows).map(|r| r / e).collect();
         let mut since = vec![0usize; rows];
@@ -284,7 +314,7 @@ proptest! {
                 .filter(|&t| on(r, t))
                 .flat_map(|t| (0..m).map(move |k| input(r, t, k)))
                 .collect();
-            single.run(&own, own.len() / m, &integ).unwrap();
+            single.run_in(&own, own.len() / m, &integ, precision(f32), None).unwrap();
             prop_assert_eq!(bits(single.state()), bits(&states[r * n..(r + 1) * n]), "row {}", r);
         }
     }

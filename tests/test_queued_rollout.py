@@ -43,16 +43,39 @@ class WaitingSeeker(FarSeeker):
 
 @settings(max_examples=12, deadline=None)
 @given(p=st.integers(1, 8), episodes=st.integers(1, 3), extra=st.integers(0, 30),
-       waiting=st.booleans(), seed=st.integers(0, 50))
+       waiting=st.booleans(), seed=st.integers(0, 50), precision=st.sampled_from(["f64", "f32"]))
 def test_fewer_rows_give_the_same_returns_and_lengths(p: int, episodes: int, extra: int,
-                                                     waiting: bool, seed: int) -> None:
+                                                     waiting: bool, seed: int, precision: str) -> None:
     nets = seekers(p, seed)
-    everything = rollout(nets, FarSeeker(), episodes=episodes, max_steps=1000)
+    everything = rollout(nets, FarSeeker(), episodes=episodes, max_steps=1000, precision=precision)
     rows = episodes + extra % (p * episodes)
     env = WaitingSeeker() if waiting else FarSeeker()
-    queued = rollout(nets, env, episodes=episodes, max_steps=1000, rows=rows)
+    queued = rollout(nets, env, episodes=episodes, max_steps=1000, rows=rows, precision=precision)
     assert np.array_equal(queued.returns, everything.returns)
     assert np.array_equal(queued.lengths, everything.lengths)
+
+
+class RateWatcher(FarSeeker):
+    """The far seeker, noting whether every rate it was given is a float32 value."""
+
+    all_f32 = True
+
+    def step(self, rates, active):
+        self.all_f32 &= bool(np.array_equal(rates.astype(np.float32).astype(np.float64), rates))
+        return super().step(rates, active)
+
+
+def test_a_rollout_in_f32_steps_in_f32_and_ends_where_f64_does_here() -> None:
+    nets = seekers(8)
+    runs = {}
+    for precision in ("f64", "f32"):
+        env = RateWatcher()
+        runs[precision] = rollout(nets, env, episodes=2, max_steps=2000, precision=precision)
+        assert env.all_f32 == (precision == "f32")  # f64 rates are not all float32 values
+    # The goal is reached or not: here rounding changes no outcome.
+    assert np.array_equal(runs["f32"].returns, runs["f64"].returns)
+    with pytest.raises(InvalidArgumentError, match='precision is "f16"'):
+        rollout(nets, FarSeeker(), max_steps=10, precision="f16")
 
 
 def test_the_step_limit_holds_for_each_episode_from_its_own_start() -> None:

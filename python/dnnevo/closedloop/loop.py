@@ -59,6 +59,7 @@ def rollout(
     generation: int = 0,
     purpose: str = "trial",
     rows: int | None = None,
+    precision: str = "f64",
 ) -> Rollout:
     """Runs ``episodes`` episodes of every network in ``env``, all at once, for at most
     ``max_steps`` time steps of ``substeps`` integration steps of ``dt`` each.
@@ -76,6 +77,9 @@ def rollout(
     generation, purpose))``: the same for every network of a generation (common random numbers)
     and for every run with this seed. Evolution draws with ``purpose="trial"``; judge a champion
     on fresh conditions with ``purpose="evaluate"``, which no run draws from.
+
+    ``precision="f32"`` integrates the networks in single precision (:class:`dnnevo.Batch`); the
+    environment still sees float64 rates, float32 values widened.
     """
     if nonnegative("episodes", episodes) < 1:
         raise InvalidArgumentError("episodes is 0; it must be at least 1")
@@ -88,8 +92,9 @@ def rollout(
             return _queued(networks, env, episodes=episodes, max_steps=max_steps, rows=rows,
                            rng=np.random.default_rng(_core.condition_seed(seed, generation, purpose)),
                            batch=_core.Batch(networks, replicas=episodes, rows=rows, dt=dt,
-                                             substeps=substeps, method=method))
-    batch = _core.Batch(networks, replicas=episodes, dt=dt, substeps=substeps, method=method)
+                                             substeps=substeps, method=method, precision=precision))
+    batch = _core.Batch(networks, replicas=episodes, dt=dt, substeps=substeps, method=method,
+                        precision=precision)
     batch.reset()
     rows, m = batch.rows, batch.n_inputs
     if getattr(env, "observation_size", m) != m:

@@ -31,3 +31,11 @@ def test_a_log_gets_one_line_per_run_and_no_bar() -> None:
     started, finished = out.getvalue().splitlines()
     assert started == "[1/2] landmark/seed-0 ..."
     assert finished.startswith("[1/2] done landmark/seed-0 (3 s); 1 to go; ETA ")
+
+
+def test_no_more_runs_are_running_than_are_left() -> None:
+    # Dask's scheduler may still count the run that has just ended: 15 of 16 done, it says 2.
+    out = io.StringIO()
+    view = RunsView(16, 14, stream=out)
+    view.finished("sequence-2bit-paper/seed-3", "done", wall=443.0, running=2)
+    assert "; 1 running, 0 queued; " in out.getvalue()

@@ -46,9 +46,12 @@ class RunsView:
     def finished(self, name: str, status: str, *, wall: float | None = None, message: str = "",
                  running: int | None = None) -> None:
         """Shows that run ``name`` has ended with ``status`` (``done``, ``failed``, ...) after
-        ``wall`` seconds, with ``running`` runs still going if known."""
+        ``wall`` seconds, with ``running`` runs still going if known (at most the runs left: a
+        cluster may still count a run that has just ended)."""
         self.done += 1
         self.failed += status != "done"
+        if running is not None:
+            running = min(running, self.total - self.done)
         queued = self.total - self.done - (running or 0)
         state = f"{running} running, {queued} queued" if running is not None else f"{queued} to go"
         counts = f"{state}, {self.failed} not done" if self.failed else state

@@ -9,7 +9,7 @@ Workload (preset sequence-1bit, paper §5.2):
 Figures, in seconds per generation (median of timed runs after a quarter-second warm-up, over generations
 0, 1, 2, ... so the timings vary as in a run):
   dnnevo assess   dnnevo.evaluate("sequence", genomes, generation=g, seed=0, config=cfg), all cores
-                    (and with threads=1, for a per-core comparison)
+                    (and with threads=1, for a per-core comparison, and with precision = "f32")
   dnnevo generation one whole generation of the GA on the Rust side (evaluate + breed), as
                     dnnevo.evolution.evolve runs it (GeneticAlgorithm.step)
   numpy evaluate    tests/sequence_reference.py, batched over P with einsum, one core, with the
@@ -30,7 +30,9 @@ each of --timed generations is timed twice, as the evaluation alone
 (GeneticAlgorithm.step: evaluation, validation of the 10 best candidates, breeding). Both wall
 and CPU seconds (all threads of the process) are printed, medians over the timed generations,
 with the share of distinct genomes in them and the projected wall time of the preset's whole
-run. The script uses only public API, so the same script times an older build:
+run. The same population is also evaluated with precision = "f32" (the same work in single
+precision), and its wall time and the f64/f32 ratio are printed beside. The script uses only
+public API, so the same script times an older build (without the f32 columns):
 
     python bench/sequence.py --presets [--warm 10] [--timed 5]
 """
@@ -38,6 +40,7 @@ run. The script uses only public API, so the same script times an older build:
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import resource
 import statistics
 import sys
@@ -89,8 +92,10 @@ def presets_part(args) -> int:
     print(f"workload: the three costliest presets of dnnevo reproduce at their paper sizes, seed 0; "
           f"{args.warm} untimed generations, then {args.timed} timed (medians); all cores")
     print()
+    single = "precision" in {f.name for f in dataclasses.fields(dnnevo.EvolutionConfig)}
     header = (f"{'preset':<24}  {'N':>2}  {'gens':>4}  {'distinct':>8}  {'eval wall s':>11}  "
-              f"{'eval CPU s':>10}  {'gen wall s':>10}  {'gen CPU s':>9}  {'run (proj.)':>11}")
+              f"{'eval CPU s':>10}  {'gen wall s':>10}  {'gen CPU s':>9}  {'run (proj.)':>11}"
+              + (f"  {'eval f32 wall s':>15}  {'f64/f32':>7}" if single else ""))
     print(header)
     print("-" * len(header))
     start = time.perf_counter()
@@ -99,18 +104,23 @@ def presets_part(args) -> int:
         ga = dnnevo.GeneticAlgorithm(cfg, seed=0)
         for _ in range(args.warm):
             ga.step()
-        evals, gens, distinct = [], [], []
+        evals, gens, distinct, singles = [], [], [], []
         for _ in range(args.timed):
             genomes = ga.ask().genomes
             distinct.append(len(np.unique(genomes.view(np.uint64), axis=0)) / len(genomes))
             evals.append(clocked(lambda: dnnevo.evaluate(cfg.task, genomes, generation=ga.generation,
                                                          seed=0, config=cfg)))
+            if single:
+                f32 = dataclasses.replace(cfg, precision="f32")
+                singles.append(clocked(lambda: dnnevo.evaluate(cfg.task, genomes, generation=ga.generation,
+                                                               seed=0, config=f32)))
             gens.append(clocked(ga.step))
         med = lambda xs, i: statistics.median(x[i] for x in xs)  # noqa: E731
         run = med(gens, 0) * cfg.generations
         print(f"{name:<24}  {cfg.size:>2}  {cfg.generations:>4}  {statistics.median(distinct):>8.0%}  "
               f"{med(evals, 0):>11.3f}  {med(evals, 1):>10.3f}  {med(gens, 0):>10.3f}  "
-              f"{med(gens, 1):>9.3f}  {run / 60:>9.1f} m")
+              f"{med(gens, 1):>9.3f}  {run / 60:>9.1f} m"
+              + (f"  {med(singles, 0):>15.3f}  {med(evals, 0) / med(singles, 0):>6.2f}x" if single else ""))
     print(f"total benchmark time: {time.perf_counter() - start:.1f} s")
     return 0
 
@@ -160,6 +170,9 @@ def main(argv=None) -> int:
         return dnnevo.evaluate("sequence", genomes, generation=g, seed=seed, config=cfg)
 
     t_eval, _ = median_time(dnnevo_evaluate, args.repeats)
+    f32 = dataclasses.replace(cfg, precision="f32")
+    t_eval32, _ = median_time(
+        lambda g: dnnevo.evaluate("sequence", genomes, generation=g, seed=seed, config=f32), args.repeats)
     t_eval1, _ = median_time(
         lambda g: dnnevo.evaluate("sequence", genomes, generation=g, seed=seed, config=cfg,
                                   threads=1), args.repeats)
@@ -181,6 +194,7 @@ def main(argv=None) -> int:
     t_numpy = statistics.median(numpy_times)
 
     rows = [("dnnevo assess", t_eval), ("dnnevo assess, 1 thread", t_eval1),
+            ("dnnevo assess, f32", t_eval32),
             ("dnnevo generation (eval + GA)", t_gen),
             ("numpy evaluate (1 core)", t_numpy)]
     header = (f"{'code':<30}  {'s/generation':>12}  {'generations/s':>13}  "
@@ -196,6 +210,8 @@ def main(argv=None) -> int:
           f"(one core each: {t_numpy / t_eval1:.1f}x; dnnevo on {threads()} threads: "
           f"{t_eval1 / t_eval:.2f}x its 1-thread speed)")
     print(f"speed-up, dnnevo generation vs numpy evaluate alone: {t_numpy / t_gen:.1f}x")
+    print(f"speed-up, dnnevo assess in f32 vs f64 (precision = \"f32\", the same work): "
+          f"{t_eval / t_eval32:.2f}x")
     print(f"GA share of a dnnevo generation: {max(0.0, t_gen - t_eval) / t_gen:.2%} "
           f"(difference of two medians; noisy)")
     n_ok, n, max_diff = agree

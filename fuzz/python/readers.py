@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo import EvolutionConfig, Network
+from dnnevo.config import with_later_defaults
 from dnnevo.errors import DnnevoError
 from dnnevo.evolution.ga import GeneticAlgorithm
 from dnnevo.experiments import examples, plan, report, results
@@ -89,9 +90,11 @@ def _run_config() -> tuple[EvolutionConfig, dict[str, Any]]:
 
 @cache
 def _sweep_settings() -> dict[str, Any]:
-    """The settings ``dnnevo sweep`` checks the seed sweep's ``sweep.json`` against."""
+    """The settings ``dnnevo sweep`` checks the seed sweep's ``sweep.json`` against: the seed's
+    own, with the settings added since it was written at their defaults, as today's command
+    would make them."""
     settings: dict[str, Any] = json.loads(_seed("sweep", "seed-sweep.json"))
-    return settings
+    return {**settings, "config": with_later_defaults(settings["config"])}
 
 
 # -- the readers -----------------------------------------------------------------------------------

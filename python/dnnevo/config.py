@@ -31,7 +31,7 @@ cannot drift. Python checks types only."""
 #: Settings added after run folders began to carry a config digest. At their defaults they are
 #: left out of the digest (``dnnevo.runs.config_digest``), and a stored config without them reads as
 #: having their defaults (:func:`with_later_defaults`), so folders written before them still resume.
-LATER_SETTINGS = ("mutation", "mutation_scale", "champion_step_check")
+LATER_SETTINGS = ("mutation", "mutation_scale", "champion_step_check", "precision")
 
 
 def with_later_defaults(stored: Any) -> Any:
@@ -128,6 +128,12 @@ class EvolutionConfig:
     n_inputs: int = _DEFAULTS["n_inputs"]
     """Sensors per network; a built-in task checks it matches."""
     integrator: IntegratorConfig = field(default_factory=IntegratorConfig)
+    precision: str = _DEFAULTS["precision"]
+    """The floating-point type a built-in task's networks compute in: ``"f64"`` (the reference
+    for every published result and preset) or ``"f32"``, opt-in single precision: each input
+    rounded to ``f32`` as the network reads it, every state and rate ``f32``, with bits of their
+    own that are the same on every CPU (see ``docs/benchmarks.md`` for what it gains and
+    ``docs/closed-loop.md`` for when to stay in ``f64``). The world and the scores stay ``f64``."""
     ranges: Ranges = field(default_factory=Ranges)
     task_params: Mapping[str, Any] = field(default_factory=dict)
     """Task-specific settings, passed to the task as they are."""
@@ -204,6 +210,7 @@ _TYPES: dict[str, type] = {
     "task": str, "population": int, "generations": int, "crossover_rate": float,
     "mutation_rate": float, "mutation": str, "mutation_scale": float, "elitism": int,
     "validation_candidates": int, "champion_step_check": bool, "selection": str, "fill": str, "size": int, "n_inputs": int,
+    "precision": str,
 }
 """The type of each plain field of :class:`EvolutionConfig`; the values are checked in Rust."""
 

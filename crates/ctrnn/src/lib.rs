@@ -48,3 +48,4 @@ pub use population::{Block, Inputs, Population};
 pub use streams as rng;
 pub use streams::{Purpose, Stream};
 pub use validation::Validation;
+pub use vector::Elem;

@@ -23,6 +23,40 @@ use crate::vector::Elem;
 /// A block of [`LANES`] networks stepped together.
 pub type Block = Lanes<LANES>;
 
+/// Packs `networks` (at least one, all with the same N and M), given as networks or as
+/// references to them, into blocks of [`LANES`] computing in `E`, for tasks that compute each
+/// row's inputs from the networks' outputs. Block `b`, lane `l` is network `b * LANES + l`; a
+/// block's unused lanes repeat its first network. In `f32` the parameters and initial states are
+/// rounded here, once.
+///
+/// # Example
+/// ```
+/// use ctrnn::{Integrator, Network, LANES};
+/// let nets = vec![Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None)?; LANES + 1];
+/// let mut blocks = ctrnn::population::pack::<f32, _>(&nets)?;
+/// assert_eq!((blocks.len(), blocks[1].len()), (2, 1));
+/// blocks[1].step_row(&[[1.0; LANES]], &Integrator::default());
+/// assert_eq!(blocks[1].state(0)[0], 0.1f32);
+/// # Ok::<(), ctrnn::Error>(())
+/// ```
+pub fn pack<E: Elem, N: Borrow<Network>>(networks: &[N]) -> Result<Vec<Lanes<LANES, E>>> {
+    let refs: Vec<&Network> = networks.iter().map(Borrow::borrow).collect();
+    let first = refs
+        .first()
+        .ok_or_else(|| Error::InvalidArgument("a population needs at least 1 network".into()))?;
+    let (n, m) = (first.size(), first.n_inputs());
+    if let Some(p) = refs.iter().position(|x| (x.size(), x.n_inputs()) != (n, m)) {
+        return Err(Error::InvalidArgument(format!(
+            "network {p} has N = {}, M = {}; every network of a population must have N = {n}, M = {m}",
+            refs[p].size(),
+            refs[p].n_inputs()
+        )));
+    }
+    refs.par_chunks(LANES)
+        .map(Lanes::new)
+        .collect::<Result<Vec<_>>>()
+}
+
 /// Input rows for a population run.
 #[derive(Clone, Copy, Debug)]
 pub enum Inputs<'a> {
@@ -73,26 +107,11 @@ impl Population {
         precision: Precision,
     ) -> Result<Self> {
         let refs: Vec<&Network> = networks.iter().map(Borrow::borrow).collect();
-        let first = refs.first().ok_or_else(|| {
-            Error::InvalidArgument("a population needs at least 1 network".into())
-        })?;
-        let (n, m) = (first.size(), first.n_inputs());
-        if let Some(p) = refs.iter().position(|x| (x.size(), x.n_inputs()) != (n, m)) {
-            return Err(Error::InvalidArgument(format!(
-                "network {p} has N = {}, M = {}; every network of a population must have N = {n}, M = {m}",
-                refs[p].size(),
-                refs[p].n_inputs()
-            )));
-        }
-        fn pack<E: Elem>(refs: &[&Network]) -> Result<Vec<Lanes<LANES, E>>> {
-            refs.par_chunks(LANES)
-                .map(Lanes::new)
-                .collect::<Result<Vec<_>>>()
-        }
         let blocks = match precision {
             Precision::F64 => Blocks::F64(pack(&refs)?),
             Precision::F32 => Blocks::F32(pack(&refs)?),
         };
+        let (n, m) = (refs[0].size(), refs[0].n_inputs());
         Ok(Population {
             size: n,
             n_inputs: m,
@@ -124,19 +143,6 @@ impl Population {
             Blocks::F32(_) => Precision::F32,
         }
     }
-    /// The blocks, for tasks that compute each row's inputs from the networks' outputs.
-    /// Block `b`, lane `l` is network `b * LANES + l`.
-    ///
-    /// Fails if the population computes in `f32`: tasks run in `f64` only, for now.
-    pub fn blocks_mut(&mut self) -> Result<&mut [Block]> {
-        match &mut self.blocks {
-            Blocks::F64(blocks) => Ok(blocks),
-            Blocks::F32(_) => Err(Error::InvalidArgument(
-                "this population computes in f32; tasks step f64 blocks only".into(),
-            )),
-        }
-    }
-
     /// The current states, row-major `P x N` (in `f64`, widened from `f32` if it computes in
     /// `f32`).
     pub fn states(&self) -> Vec<f64> {

@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
-use ctrnn::{Error, Integrator, Lanes, Method, Result};
+use ctrnn::{Elem, Error, Integrator, Lanes, Method, Result};
 use serde::de::DeserializeOwned;
 
 /// Reads a task config from a JSON object of its fields (`null` means all defaults). Unknown or
@@ -31,6 +31,32 @@ pub(crate) fn config_from_params<C: DeserializeOwned + Default>(
     }
 }
 
+/// `$body` with `$E` naming the element type of `$precision` (`f64` or `f32`): the one place a
+/// task's run turns its [`ctrnn::Precision`] setting into the type its lanes compute in. `$body`
+/// is compiled once for each type.
+macro_rules! in_precision {
+    ($precision:expr, $E:ident => $body:expr) => {
+        match $precision {
+            ::ctrnn::Precision::F64 => {
+                type $E = f64;
+                $body
+            }
+            ::ctrnn::Precision::F32 => {
+                type $E = f32;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use in_precision;
+
+/// The state of a one-network block, widened to `f64` (exactly).
+pub(crate) fn lane_state<E: Elem>(lanes: &Lanes<1, E>) -> Vec<f64> {
+    let mut state = vec![E::default(); lanes.size()];
+    lanes.lane_state(0, &mut state);
+    state.into_iter().map(E::to_f64).collect()
+}
+
 /// Whether the caller asked to stop.
 pub(crate) fn interrupted(cancel: Option<&AtomicBool>) -> bool {
     cancel.is_some_and(|c| c.load(Ordering::Relaxed))
@@ -45,14 +71,14 @@ pub struct Diverged {
 
 impl Diverged {
     /// The first non-finite state of `lanes`, if any.
-    pub fn find<const L: usize>(lanes: &Lanes<L>) -> std::result::Result<(), Diverged> {
+    pub fn find<const L: usize, E: Elem>(lanes: &Lanes<L, E>) -> std::result::Result<(), Diverged> {
         for neuron in 0..lanes.size() {
             let row = lanes.state(neuron);
-            if let Some(lane) = (0..lanes.len()).find(|&l| !row[l].is_finite()) {
+            if let Some(lane) = (0..lanes.len()).find(|&l| !row[l].finite()) {
                 return Err(Diverged {
                     lane,
                     neuron,
-                    value: row[lane],
+                    value: row[lane].to_f64(),
                 });
             }
         }

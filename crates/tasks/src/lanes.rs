@@ -8,13 +8,15 @@
 //!   time, groups in parallel, so that one network still fills every lane and core.
 //!
 //! A lane's result never depends on its neighbours, so both give the same bits for a pair. When
-//! blocks or groups fail, the error is the first one's in order, whatever the threads.
+//! blocks or groups fail, the error is the first one's in order, whatever the threads. Both
+//! compute in the element type `E` of the lanes their callback takes: `f64`, or `f32` (see
+//! [`ctrnn::Precision`]).
 
 use std::borrow::Borrow;
 use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{Block, Error, Lanes, Network, Population, Result, LANES};
+use ctrnn::{Elem, Error, Lanes, Network, Result, LANES};
 use rayon::prelude::*;
 
 use crate::common::{interrupted, Diverged};
@@ -24,12 +26,13 @@ use crate::common::{interrupted, Diverged};
 /// is the block's first network), and `finish(acc)` gives the block's results, which are joined
 /// in block order. Stops with
 /// [`Error::Interrupted`] between trials once `cancel` is set; a divergence names its network.
-pub fn by_block<A, T: Send>(
+pub fn by_block<E: Elem, A, T: Send>(
     networks: &[Network],
     trials: usize,
     cancel: Option<&AtomicBool>,
     start: impl Fn(usize) -> A + Sync,
-    trial: impl Fn(&mut A, usize, &mut Block, usize) -> std::result::Result<(), Diverged> + Sync,
+    trial: impl Fn(&mut A, usize, &mut Lanes<LANES, E>, usize) -> std::result::Result<(), Diverged>
+        + Sync,
     finish: impl Fn(A) -> Vec<T> + Sync,
 ) -> Result<Vec<T>> {
     blocks(networks, &|p| p, trials, cancel, start, trial, finish)
@@ -37,13 +40,14 @@ pub fn by_block<A, T: Send>(
 
 /// [`by_block`] on `networks` that stand for others: a divergence on `networks[p]` names
 /// network `names[p]`.
-pub fn by_block_named<A, T: Send>(
+pub fn by_block_named<E: Elem, A, T: Send>(
     networks: &[&Network],
     names: &[usize],
     trials: usize,
     cancel: Option<&AtomicBool>,
     start: impl Fn(usize) -> A + Sync,
-    trial: impl Fn(&mut A, usize, &mut Block, usize) -> std::result::Result<(), Diverged> + Sync,
+    trial: impl Fn(&mut A, usize, &mut Lanes<LANES, E>, usize) -> std::result::Result<(), Diverged>
+        + Sync,
     finish: impl Fn(A) -> Vec<T> + Sync,
 ) -> Result<Vec<T>> {
     debug_assert_eq!(networks.len(), names.len());
@@ -58,21 +62,20 @@ pub fn by_block_named<A, T: Send>(
     )
 }
 
-fn blocks<N: Borrow<Network> + Sync, A, T: Send>(
+fn blocks<E: Elem, N: Borrow<Network> + Sync, A, T: Send>(
     networks: &[N],
     name: &(dyn Fn(usize) -> usize + Sync),
     trials: usize,
     cancel: Option<&AtomicBool>,
     start: impl Fn(usize) -> A + Sync,
-    trial: impl Fn(&mut A, usize, &mut Block, usize) -> std::result::Result<(), Diverged> + Sync,
+    trial: impl Fn(&mut A, usize, &mut Lanes<LANES, E>, usize) -> std::result::Result<(), Diverged>
+        + Sync,
     finish: impl Fn(A) -> Vec<T> + Sync,
 ) -> Result<Vec<T>> {
     if networks.is_empty() {
         return Ok(vec![]);
     }
-    let mut population = Population::new(networks)?;
-    let per_block = population
-        .blocks_mut()?
+    let per_block = ctrnn::population::pack::<E, N>(networks)?
         .par_iter_mut()
         .enumerate()
         .map(|(b, block)| {
@@ -158,12 +161,12 @@ pub fn pairs(networks: usize, trials: usize) -> Vec<(usize, usize)> {
 /// its first pair. `run(lanes, lane_pairs, len)` runs lane `l` on `lane_pairs[l]` from a fresh
 /// state and returns the `len` real lanes' results. Stops with [`Error::Interrupted`] between
 /// groups once `cancel` is set; a divergence names its network.
-pub fn by_pair<T: Send>(
+pub fn by_pair<E: Elem, T: Send>(
     networks: &[&Network],
     groups: &[&[(usize, usize)]],
     cancel: Option<&AtomicBool>,
     run: impl Fn(
-            &mut Lanes<LANES>,
+            &mut Lanes<LANES, E>,
             [(usize, usize); LANES],
             usize,
         ) -> std::result::Result<Vec<T>, Diverged>
@@ -179,7 +182,7 @@ pub fn by_pair<T: Send>(
             let lane_pairs: [(usize, usize); LANES] =
                 std::array::from_fn(|l| group[if l < group.len() { l } else { 0 }]);
             let refs: [&Network; LANES] = std::array::from_fn(|l| networks[lane_pairs[l].0]);
-            let mut lanes = Lanes::<LANES>::new(&refs)?;
+            let mut lanes = Lanes::<LANES, E>::new(&refs)?;
             run(&mut lanes, lane_pairs, group.len()).map_err(|d| d.error(|lane| lane_pairs[lane].0))
         })
         .collect::<Vec<Result<_>>>();

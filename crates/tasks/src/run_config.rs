@@ -17,7 +17,9 @@
 
 use ctrnn::ga::MutationKind;
 use ctrnn::validation::STEP_CHECK_FINER;
-use ctrnn::{Error, Fill, GaConfig, Integrator, Layout, Ranges, Result, Selection, Task};
+use ctrnn::{
+    Error, Fill, GaConfig, Integrator, Layout, Precision, Ranges, Result, Selection, Task,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::common::{config_from_params, TIME_STEP};
@@ -61,6 +63,10 @@ pub struct RunConfig {
     pub n_inputs: usize,
     /// How a built-in task integrates its networks. Default [`TIME_STEP`].
     pub integrator: Integrator,
+    /// The floating-point type a built-in task's networks compute in: `"f64"` (default, the
+    /// reference for every published result) or `"f32"`, opt-in single precision (see
+    /// [`Precision`]).
+    pub precision: Precision,
     /// Gene ranges. Default [`Ranges::default`].
     pub ranges: Ranges,
     /// The task's own settings, passed to it as they are.
@@ -86,6 +92,7 @@ impl Default for RunConfig {
             size: 5,
             n_inputs: 2,
             integrator: TIME_STEP,
+            precision: Precision::F64,
             ranges: ga.ranges,
             task_params: serde_json::Map::new(),
         }
@@ -93,7 +100,7 @@ impl Default for RunConfig {
 }
 
 /// The settings a task's parameters may not hold, because the run config sets them.
-const SET_BY_RUN: [&str; 2] = ["size", "integrator"];
+const SET_BY_RUN: [&str; 3] = ["size", "integrator", "precision"];
 
 impl RunConfig {
     /// Reads and validates a config from JSON text. Errors name the field (`integrator.dt`).
@@ -174,12 +181,14 @@ impl RunConfig {
         }
     }
 
-    /// The parameters a built-in task is built from: `size`, `integrator`, then `task_params`.
+    /// The parameters a built-in task is built from: `size`, `integrator`, `precision`, then
+    /// `task_params`.
     pub fn task_params(&self) -> serde_json::Value {
         let mut params = self.task_params.clone();
         params.insert("size".into(), self.size.into());
         let integrator = serde_json::to_value(self.integrator).expect("settings always serialise");
         params.insert("integrator".into(), integrator);
+        params.insert("precision".into(), self.precision.name().into());
         serde_json::Value::Object(params)
     }
 

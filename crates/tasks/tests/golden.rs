@@ -147,3 +147,60 @@ fn evolution_fingerprint(config: &RunConfig) -> u64 {
     }
     fingerprint(all)
 }
+
+/// Small evolution runs of each built-in task in single precision (`precision = "f32"`): their
+/// own fingerprints, the same on every kernel, and not those of the same runs in `f64`.
+#[test]
+fn a_small_evolution_run_in_f32_keeps_its_stored_bits_for_every_task() {
+    let runs = [
+        (
+            "sequence",
+            0xc827_0a93_fddd_5f9a,
+            serde_json::json!({"triggers": 4, "trials_per_target": 1, "validation_trials": 2}),
+        ),
+        (
+            "nav1d",
+            0x00ed_7224_f35d_51e5,
+            serde_json::json!({"objective": "classify", "max_steps": 60, "validation_chains": 2}),
+        ),
+        (
+            "landmark",
+            0xabc1_bc13_20ba_37e5,
+            serde_json::json!({"trials_per_landmark": 2, "validation_trials": 2}),
+        ),
+    ];
+    for (task, stored, params) in runs {
+        let config = small_run(task, params, Precision::F32);
+        same_on_every_kernel(
+            &format!("a small {task} evolution run in f32"),
+            stored,
+            || evolution_fingerprint(&config),
+        );
+        let f64_run = RunConfig {
+            precision: Precision::F64,
+            ..config.clone()
+        };
+        assert_ne!(
+            evolution_fingerprint(&f64_run),
+            stored,
+            "{task}: f32 gave f64's bits"
+        );
+    }
+}
+
+fn small_run(task: &str, params: serde_json::Value, precision: Precision) -> RunConfig {
+    let defaults = tasks::build(task, &serde_json::Value::Null)
+        .unwrap()
+        .layout();
+    RunConfig {
+        task: task.into(),
+        population: 16,
+        generations: 2,
+        validation_candidates: 2,
+        size: defaults.size,
+        n_inputs: defaults.n_inputs,
+        precision,
+        task_params: params.as_object().unwrap().clone(),
+        ..RunConfig::default()
+    }
+}

@@ -26,6 +26,7 @@ EXAMPLE = """examples:
   dnnevo assess runs/lm --robot-like --json    the whole assessment as JSON on stdout
   dnnevo assess runs/demo --dt 0.01            the same champion integrated 10x finer
   dnnevo assess runs/demo --dt-check           also at a 10x finer step and with RK4
+  dnnevo assess runs/demo --precision f64      an f32 run's champion judged in f64
 
 Each rate gets a 95% Wilson score interval. Verdict: pass when the interval lies at or above the
 task's threshold (sequence: 90% of trials per target; landmark and nav1d: 95%), fail when it lies
@@ -60,10 +61,15 @@ def assess(args: argparse.Namespace) -> int:
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
     if args.dt is not None:
         config = with_dt(config, args.dt, "--dt")
+    evolved_in = config.precision
+    if args.precision is not None:
+        config = dataclasses.replace(config, precision=args.precision)
     a = tasks.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
     extra = task.evaluate_extra(config, champion, seed)
     if args.dt is not None:
         extra = {"integrator": dataclasses.asdict(config.integrator), **extra}
+    if config.precision != "f64" or evolved_in != "f64":
+        extra = {"precision": config.precision, "evolved_in": evolved_in, **extra}
     check = None
     if args.dt_check:
         check = step_check(lambda c: tasks.assess(c, champion, a.trials, seed=seed, robot_like=args.robot_like),
@@ -88,6 +94,8 @@ def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:
         i = extra["integrator"]
         lines.append(f"integrated with dt = {i['dt']:g}, {i['substeps']} steps per time step "
                      "(--dt); the run was evolved with its config's step")
+    if "precision" in extra:
+        lines.append(f"computed in {extra['precision']}; the run was evolved in {extra['evolved_in']}")
     lines += task.extra_lines(extra)
     return lines
 

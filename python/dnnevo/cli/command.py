@@ -202,6 +202,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dt-check", action="store_true",
                    help="also judge the champion on the same trials at a 10x finer step and with "
                         "RK4; a success that fails there is flagged as a step artefact (exit 1)")
+    p.add_argument("--precision", choices=["f64", "f32"], default=None,
+                   help="compute the champion in this precision instead of the run's (e.g. an f32 "
+                        "run's champion in f64)")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        epilog="example: dnnevo plot runs/demo")

@@ -63,7 +63,9 @@ def success_rule(env: Any, task: str) -> tuple[Any, float]:
 class ClosedLoop:
     """``fitness(networks, *, generation, seed)``: the networks' mean returns in ``env``, for
     ``episodes`` episodes of at most ``max_steps`` time steps, each of ``substeps`` integration
-    steps of ``dt`` (by default the run config's defaults, as for a task named in a config).
+    steps of ``dt`` (by default the run config's defaults, as for a task named in a config), the
+    networks computing in ``precision`` (``"f64"``, or ``"f32"``: see
+    :func:`~dnnevo.closedloop.rollout`).
     The champion is chosen on ``validation_episodes`` episodes of their own (:meth:`validate`).
     ``rows`` runs at most that many episodes at once, starting a waiting episode in a row whose
     episode ended (:func:`~dnnevo.closedloop.rollout`; the environment needs ``restart``);
@@ -80,14 +82,17 @@ class ClosedLoop:
     def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int,
                  dt: float = _INTEGRATOR.dt, substeps: int = _INTEGRATOR.substeps,
                  method: str = _INTEGRATOR.method, name: str | None = None,
-                 validation_episodes: int = VALIDATION_EPISODES, rows: int | None = None) -> None:
+                 validation_episodes: int = VALIDATION_EPISODES, rows: int | None = None,
+                 precision: str = "f64") -> None:
         if isinstance(validation_episodes, bool) or not isinstance(validation_episodes, int | np.integer) \
                 or validation_episodes < 1:
             raise ConfigError(f"validation_episodes is {validation_episodes!r}; expected a whole "
                               "number of episodes, at least 1")
         self.env = env
+        if precision not in ("f64", "f32"):
+            raise ConfigError(f"precision is {precision!r}; expected 'f64' or 'f32'")
         self.settings = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps,
-                             method=method)
+                             method=method, precision=precision)
         self.validation_episodes = int(validation_episodes)
         if rows is not None and (isinstance(rows, bool) or not isinstance(rows, int | np.integer)
                                  or rows < episodes):
@@ -114,10 +119,12 @@ class ClosedLoop:
         self.fitness_source = "\n".join([source, fingerprint(attributes), fingerprint(recorded)])
 
     def _recorded(self) -> dict[str, Any]:
-        """The settings a run records: the rollout's, the validation set's size when it is not
-        the default and ``rows`` when set (so that runs from before they were settings keep their
-        digest)."""
+        """The settings a run records: the rollout's (its precision only when ``"f32"``), the
+        validation set's size when it is not the default and ``rows`` when set (so that runs from
+        before they were settings keep their digest)."""
         recorded = dict(self.settings)
+        if recorded["precision"] == "f64":
+            del recorded["precision"]
         if self.validation_episodes != VALIDATION_EPISODES:
             recorded["validation_episodes"] = self.validation_episodes
         if self.rows is not None:
@@ -130,16 +137,22 @@ class ClosedLoop:
 
     def configured(self, config: EvolutionConfig) -> EvolutionConfig:
         """``config`` saying what this fitness function runs: its name as ``task``, the rollout's
-        episodes and step limit as ``task_params`` and its integration as ``integrator``. The
+        episodes and step limit as ``task_params`` and its integration as ``integrator`` and
+        ``precision``. The
         environment's own parameters are not known, so ``task_params`` holds no others: a
         command that builds the task from the config builds it with its defaults, and the digest
         then tells whether that is the same task."""
         s = self._recorded()
         params = {k: s[k] for k in ROLLOUT_KEYS if k in s}
+        if config.precision not in ("f64", self.settings["precision"]):
+            raise ConfigError(f"config.precision is {config.precision!r} but this ClosedLoop computes "
+                              f"in {self.settings['precision']!r}; give ClosedLoop(..., "
+                              f"precision={config.precision!r})")
         return dataclasses.replace(
             config,
             task=f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}",
             integrator=IntegratorConfig(method=s["method"], dt=s["dt"], substeps=s["substeps"]),
+            precision=self.settings["precision"],
             task_params=params,
         )
 

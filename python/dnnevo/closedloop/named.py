@@ -106,7 +106,8 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> Closed
         raise ConfigError(f"n_inputs is {config.n_inputs}; {cls.__name__}.observation_size is "
                           f"{env.observation_size} (set n_inputs = {env.observation_size})")
     i = config.integrator
-    loop = ClosedLoop(env, **settings, dt=i.dt, substeps=i.substeps, method=i.method, name=config.task)
+    loop = ClosedLoop(env, **settings, dt=i.dt, substeps=i.substeps, method=i.method,
+                      precision=config.precision, name=config.task)
     if digest is not None and loop.digest() != digest:
         raise ConfigError(f"the run was evolved with another version of {config.task} (its source, "
                           "the environment's attributes or the rollout's settings differ, or the run "

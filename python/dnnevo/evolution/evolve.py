@@ -166,6 +166,12 @@ def evolve(
         config = task.configured(config or EvolutionConfig())
     elif callable(task):
         config = dataclasses.replace(config or EvolutionConfig(), task=_python_task_name(task))
+        if config.precision != "f64":
+            raise ConfigError(
+                f"precision is {config.precision!r}, but a fitness function integrates its networks "
+                "itself: leave precision at 'f64' and compute in f32 inside it (Network.run or "
+                "Batch with precision='f32'), or wrap an environment in ClosedLoop(..., "
+                "precision='f32')")
     else:
         config = _task_config(task, config)
         _check_layout(config)

@@ -206,7 +206,8 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
     env, s = loop.env, config.integrator
     max_steps = int(loop.settings["max_steps"])  # type: ignore[call-overload]
     method = cast(Literal["euler", "rk4"], s.method)
-    batch = _core.Batch([net], replicas=episodes, dt=s.dt, substeps=s.substeps, method=method)
+    batch = _core.Batch([net], replicas=episodes, dt=s.dt, substeps=s.substeps, method=method,
+                        precision=cast(Literal["f64", "f32"], config.precision))
     batch.reset()
     rng = np.random.default_rng(_core.condition_seed(seed, 0, "evaluate"))
     m = batch.n_inputs

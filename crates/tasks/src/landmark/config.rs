@@ -1,7 +1,7 @@
 //! The settings of the landmark-recognition experiment: the network, the two worlds, the robot
 //! trial, and the "robot-like" conditions of the stand-in for the paper's real-robot test.
 
-use ctrnn::{Error, Integrator, Result};
+use ctrnn::{Error, Integrator, Precision, Result};
 
 use crate::common::TIME_STEP;
 use serde::{Deserialize, Serialize};
@@ -74,6 +74,10 @@ pub struct LandmarkConfig {
     /// time, so by default one robot step of 0.1 s is one network time step. Default 10 Euler
     /// steps of 0.1.
     pub integrator: Integrator,
+    /// The floating-point type the networks compute in: `"f64"` (default, the reference) or
+    /// `"f32"`, opt-in single precision (see [`ctrnn::Precision`]). The world, the inputs and the
+    /// scores stay `f64`; each input is rounded to `f32` as the network reads it.
+    pub precision: Precision,
 }
 
 impl Default for LandmarkConfig {
@@ -92,6 +96,7 @@ impl Default for LandmarkConfig {
             robot_like: RobotLike::default(),
             training: Training::default(),
             integrator: TIME_STEP,
+            precision: Precision::F64,
         }
     }
 }

@@ -3,13 +3,15 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES};
+use ctrnn::{
+    Elem, Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES,
+};
 use rayon::prelude::*;
 use serde::Serialize;
 use sim2d::{Echo, Sim, SimSpec, World, WorldSpec};
 
 use super::config::{config_error, LandmarkConfig};
-use crate::common::{check_inputs, config_from_params, interrupted, Diverged, Memo};
+use crate::common::{check_inputs, config_from_params, in_precision, interrupted, Diverged, Memo};
 use crate::lanes::{by_block, by_pair, pairs};
 
 /// The fraction of fresh trials a network must classify right to have solved the task.
@@ -226,20 +228,25 @@ impl LandmarkTask {
     }
 
     /// Feeds `inputs[l]` to lane `l` (all of the same length) from a reset state; `observe` sees
-    /// the network after each step. Returns the classifier's final output on every lane.
-    fn run_lanes<const L: usize>(
+    /// the network after each step. Returns the classifier's final output on every lane (widened to
+    /// `f64`, exactly).
+    fn run_lanes<const L: usize, E: Elem>(
         &self,
-        lanes: &mut Lanes<L>,
+        lanes: &mut Lanes<L, E>,
         inputs: [&[f64]; L],
-        mut observe: impl FnMut(&Lanes<L>),
+        mut observe: impl FnMut(&Lanes<L, E>),
     ) -> std::result::Result<[f64; L], Diverged> {
         lanes.reset();
         for t in 0..inputs[0].len() {
-            lanes.step_row(&[inputs.map(|x| x[t])], &self.config.integrator);
+            // The network reads the sonar in its own precision.
+            lanes.step_row(
+                &[inputs.map(|x| E::from_f64(x[t]))],
+                &self.config.integrator,
+            );
             observe(lanes);
         }
         Diverged::find(lanes)?;
-        Ok(lanes.output(self.config.classifier))
+        Ok(lanes.output(self.config.classifier).map(E::to_f64))
     }
 
     /// Each network's final classifier output on each trial: `out[p][t]`.
@@ -250,7 +257,7 @@ impl LandmarkTask {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<Vec<f64>>> {
         self.check(networks)?;
-        by_block(
+        in_precision!(self.config.precision, E => by_block::<E, _, _>(
             networks,
             trials.len(),
             cancel,
@@ -263,7 +270,7 @@ impl LandmarkTask {
                 Ok(())
             },
             |out| out,
-        )
+        ))
     }
 
     /// Each network's final classifier output on each trial (`out[p][t]`), with (network,
@@ -295,11 +302,11 @@ impl LandmarkTask {
             rest = tail;
         }
         let refs: Vec<&Network> = networks.iter().collect();
-        let results = by_pair(&refs, &groups, cancel, |lanes, lane_pairs, len| {
+        let results = in_precision!(self.config.precision, E => by_pair::<E, _>(&refs, &groups, cancel, |lanes, lane_pairs, len| {
             let inputs = lane_pairs.map(|(_, t)| trials[t].input.as_slice());
             let f = self.run_lanes(lanes, inputs, |_| {})?;
             Ok(f[..len].to_vec())
-        })?;
+        }))?;
         let mut out = vec![vec![0.0; trials.len()]; networks.len()];
         for (&(p, t), y) in pairs.iter().zip(results) {
             out[p][t] = y;
@@ -334,14 +341,15 @@ impl LandmarkTask {
     /// Runs `net` through one trial, recorded step by step. Bit-identical to the evaluation.
     pub fn record(&self, net: &Network, sensing: Sensing) -> Result<Record> {
         self.check(std::slice::from_ref(net))?;
-        let mut lanes = Lanes::<1>::new(&[net])?;
         let n = net.size();
         let mut outputs = Vec::with_capacity(sensing.input.len());
-        let f = self
-            .run_lanes(&mut lanes, [sensing.input.as_slice()], |lanes| {
-                outputs.push((0..n).map(|i| lanes.output(i)[0]).collect());
+        let f = in_precision!(self.config.precision, E => {
+            let mut lanes = Lanes::<1, E>::new(&[net])?;
+            self.run_lanes(&mut lanes, [sensing.input.as_slice()], |lanes| {
+                outputs.push((0..n).map(|i| lanes.output(i)[0].to_f64()).collect());
             })
-            .map_err(|d| d.error(|_| 0))?;
+        })
+        .map_err(|d| d.error(|_| 0))?;
         Ok(Record {
             sensing,
             outputs,

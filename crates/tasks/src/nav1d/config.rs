@@ -1,7 +1,7 @@
 //! The settings of the one-dimensional navigation experiments: the world's geometry and timing,
 //! which neurons are motors and classifier, and what an evaluation scores.
 
-use ctrnn::{Error, Integrator, Result};
+use ctrnn::{Error, Integrator, Precision, Result};
 
 use crate::common::TIME_STEP;
 use crate::Aggregate;
@@ -152,6 +152,10 @@ pub struct Nav1dConfig {
     /// How one time step is integrated: `substeps` steps of `dt` (one time step is `dt *
     /// substeps` units of simulated time). Default 10 Euler steps of dt = 0.1.
     pub integrator: Integrator,
+    /// The floating-point type the networks compute in: `"f64"` (default, the reference) or
+    /// `"f32"`, opt-in single precision (see [`ctrnn::Precision`]). The world, the inputs and the
+    /// scores stay `f64`; each input is rounded to `f32` as the network reads it.
+    pub precision: Precision,
     /// How often the agent moves and its sensors are read: `"continuous"` (default) at every
     /// integration step, `"stepped"` once per time step (see [`World`]). Time limits and
     /// reinforcement periods are in time steps either way.
@@ -185,6 +189,7 @@ impl Default for Nav1dConfig {
             start_jitter: 0.0,
             landmark_jitter: 0.0,
             integrator: TIME_STEP,
+            precision: Precision::F64,
             world: World::Continuous,
         }
     }

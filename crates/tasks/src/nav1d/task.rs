@@ -3,13 +3,15 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES};
+use ctrnn::{
+    Elem, Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES,
+};
 use serde::Serialize;
 
 use super::config::{Nav1dConfig, Objective};
 use super::environment::Environment;
 use super::world::{run_chains, Condition, Side};
-use crate::common::{check_inputs, config_from_params};
+use crate::common::{check_inputs, config_from_params, in_precision, lane_state};
 use crate::lanes::{by_block, by_pair, pairs};
 use crate::Aggregate;
 
@@ -278,7 +280,7 @@ impl Nav1dTask {
                     .map(move |_| of_type)
             })
             .collect();
-        let scores = by_block(
+        let scores = in_precision!(self.config.precision, E => by_block::<E, _, _>(
             networks,
             chains.len(),
             cancel,
@@ -306,7 +308,7 @@ impl Nav1dTask {
                 Ok(())
             },
             |scores| scores,
-        )?;
+        ))?;
         let (mut scores, near_first): (Vec<Vec<f64>>, Vec<usize>) = scores.into_iter().unzip();
         if self.config.sharing {
             share(&mut scores);
@@ -357,7 +359,7 @@ impl Nav1dTask {
         }
         let pairs = pairs(nets.len(), chains.len());
         let groups: Vec<&[(usize, usize)]> = pairs.chunks(LANES).collect();
-        let episodes = by_pair(nets, &groups, cancel, |lanes, lane_pairs, len| {
+        let episodes = in_precision!(self.config.precision, E => by_pair::<E, _>(nets, &groups, cancel, |lanes, lane_pairs, len| {
             let lane_chains = lane_pairs.map(|(_, e)| chains[e].as_slice());
             let outcome = run_chains(&self.config, lanes, lane_chains, true, |_, _, _| {})?;
             Ok(lane_pairs[..len]
@@ -373,7 +375,7 @@ impl Nav1dTask {
                     }
                 })
                 .collect())
-        })?;
+        }))?;
         Ok(episodes
             .chunks(chains.len())
             .map(<[Episode]>::to_vec)
@@ -462,7 +464,6 @@ impl Nav1dTask {
                 )));
             }
         }
-        let mut lanes = Lanes::<1>::new(&[net])?;
         let n = net.size();
         let mut rec = Record {
             conditions: chain.to_vec(),
@@ -478,6 +479,8 @@ impl Nav1dTask {
         };
         // The landmark input summed over the ticks of the time step so far, and their count.
         let (mut landmark, mut ticks) = (0.0, 0usize);
+        let outcome = in_precision!(self.config.precision, E => {
+        let mut lanes = Lanes::<1, E>::new(&[net])?;
         let outcome = run_chains(
             &self.config,
             &mut lanes,
@@ -493,16 +496,18 @@ impl Nav1dTask {
                 rec.x.push(tick.x);
                 rec.landmark.push(landmark / ticks as f64);
                 rec.reinforcement.push(inputs.get(1).map_or(0.0, |r| r[0]));
-                rec.outputs.push(outputs.iter().map(|o| o[0]).collect());
+                rec.outputs.push(outputs.iter().map(|o| o[0].to_f64()).collect());
                 rec.trial.push(tick.trial);
                 rec.moving.push(tick.moving);
                 (landmark, ticks) = (0.0, 0);
             },
         )
         .map_err(|d| d.error(|_| 0))?;
+        rec.final_state = lane_state(&lanes);
+        outcome
+        });
         rec.reached = outcome.reached.iter().map(|r| r[0]).collect();
         rec.classification = outcome.classification.iter().map(|c| c[0]).collect();
-        lanes.lane_state(0, &mut rec.final_state);
         Ok(rec)
     }
 

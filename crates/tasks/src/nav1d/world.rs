@@ -24,7 +24,7 @@
 //! classification. The next trial of a chain starts at its own start position, from the state the
 //! last one left.
 
-use ctrnn::{Integrator, Lanes, Stream};
+use ctrnn::{Elem, Integrator, Lanes, Stream};
 use serde::{Deserialize, Serialize};
 
 use super::config::Nav1dConfig;
@@ -182,15 +182,15 @@ pub(crate) struct Outcome<const L: usize> {
 /// length), one tick at a time; while no agent moves, the ticks up to the next end of a time step
 /// go together (the same integration steps, with the inputs held). With `reset` the state starts
 /// at 0. `observe(inputs, outputs, ticks)` sees the inputs, every neuron's firing rate after the
-/// ticks (`outputs[i][l]`) and what the last of them did on each lane, while any lane's chain is
+/// ticks (`outputs[i][l]`, in the lanes' precision) and what the last of them did on each lane, while any lane's chain is
 /// still running. This is the only trial loop: evaluation (`L = LANES`) and recording (`L = 1`)
 /// both run it, so they agree bit for bit.
-pub(crate) fn run_chains<const L: usize>(
+pub(crate) fn run_chains<const L: usize, E: Elem>(
     config: &Nav1dConfig,
-    lanes: &mut Lanes<L>,
+    lanes: &mut Lanes<L, E>,
     chains: [&[Condition]; L],
     reset: bool,
-    mut observe: impl FnMut(&[[f64; L]], &[[f64; L]], &Ticks<L>),
+    mut observe: impl FnMut(&[[f64; L]], &[[E; L]], &Ticks<L>),
 ) -> Result<Outcome<L>, Diverged> {
     let k = chains[0].len();
     debug_assert!(chains.iter().all(|c| c.len() == k));
@@ -246,18 +246,20 @@ pub(crate) fn run_chains<const L: usize>(
         };
         // The one-tick path is kept apart: a tick count that changes from call to call costs it
         // 10 %.
+        // The network reads its inputs in its own precision (0 and 1 are exact in both).
+        let read = inputs.map(|row| row.map(E::from_f64));
         if count > 1 {
             let ticks = Integrator {
                 substeps: tick.substeps * count,
                 ..tick
             };
             if changed {
-                lanes.step_row(&inputs[..m], &ticks);
+                lanes.step_row(&read[..m], &ticks);
             } else {
                 lanes.step_held(&ticks);
             }
         } else if changed {
-            lanes.step_row(&inputs[..m], &tick);
+            lanes.step_row(&read[..m], &tick);
         } else {
             lanes.step_held(&tick);
         }
@@ -266,7 +268,7 @@ pub(crate) fn run_chains<const L: usize>(
         let (vl, vr) = (&out[left_motor], &out[right_motor]);
         let mut event = false;
         for l in 0..L {
-            let moved = x[l] + tick_time * (vr[l] - vl[l]);
+            let moved = x[l] + tick_time * (vr[l].to_f64() - vl[l].to_f64());
             let xl = if moving[l] { moved } else { x[l] };
             x[l] = xl;
             left[l] -= count;
@@ -307,7 +309,7 @@ pub(crate) fn run_chains<const L: usize>(
             // The trial is over.
             let t = trial[l];
             reached[t][l] = goal[l];
-            classification[t][l] = classifier.map_or(f64::NAN, |c| out[c][l]);
+            classification[t][l] = classifier.map_or(f64::NAN, |c| out[c][l].to_f64());
             trial[l] += 1;
             inputs[1][l] = 0.0;
             goal[l] = false;

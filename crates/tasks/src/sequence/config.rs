@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use ctrnn::{Error, Integrator, Result};
+use ctrnn::{Error, Integrator, Precision, Result};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::common::{config_from_params, TIME_STEP};
@@ -125,6 +125,10 @@ pub struct SequenceConfig {
     /// How one time step is integrated; `dt * substeps` is the length of a time step in units of
     /// simulated time. Default 10 Euler steps of dt = 0.1.
     pub integrator: Integrator,
+    /// The floating-point type the networks compute in: `"f64"` (default, the reference) or
+    /// `"f32"`, opt-in single precision (see [`ctrnn::Precision`]). The world, the inputs and the
+    /// scores stay `f64`; each input is rounded to `f32` as the network reads it.
+    pub precision: Precision,
     /// Whether each individual draws its own timings (`Purpose::Trial` stream with its index)
     /// instead of sharing the generation's. Default false.
     pub independent_conditions: bool,
@@ -157,6 +161,7 @@ impl Default for SequenceConfig {
             clamp: Clamp::Trial,
             aggregate: Aggregate::Mean,
             integrator: TIME_STEP,
+            precision: Precision::F64,
             independent_conditions: false,
             chain: false,
             validation_trials: 32,

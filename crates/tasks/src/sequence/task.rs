@@ -2,10 +2,12 @@
 
 use std::sync::atomic::AtomicBool;
 
-use ctrnn::{Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES};
+use ctrnn::{
+    Elem, Error, Lanes, Layout, Network, Purpose, Result, Stream, Task, Validation, LANES,
+};
 use serde::{Deserialize, Serialize};
 
-use crate::common::check_inputs;
+use crate::common::{check_inputs, in_precision, lane_state};
 use crate::lanes::{by_block_named, by_pair, pairs, Kinds};
 use crate::Aggregate;
 
@@ -210,7 +212,7 @@ impl SequenceTask {
             None => networks.iter().enumerate().map(|(p, net)| (net, p)).unzip(),
         };
         // Lane-major within a block: [lane][trial][trigger].
-        let r = by_block_named(
+        let r = in_precision!(config.precision, E => by_block_named::<E, _, _>(
             &run,
             &names,
             n_trials,
@@ -249,7 +251,7 @@ impl SequenceTask {
                 Ok(())
             },
             |out| out,
-        )?;
+        ))?;
         let r = match &kinds {
             Some(kinds) => {
                 let per = n_trials * k;
@@ -386,28 +388,31 @@ impl SequenceTask {
         }
         check_inputs(std::slice::from_ref(net), 2, SENSORS)?;
         let bits = to_bits(pattern);
-        let mut lanes = Lanes::<1>::new(&[net])?;
         let n = net.size();
         let mut trigger = vec![];
         let mut reinforcement = vec![];
         let mut output = vec![];
         let mut outputs = vec![];
-        let outcome = run_lanes(
-            &self.config,
-            &mut lanes,
-            &bits,
-            [timing],
-            reset,
-            true,
-            |inputs, lanes| {
-                trigger.push(inputs[0][0]);
-                reinforcement.push(inputs[1][0]);
-                let rates: Vec<f64> = (0..n).map(|i| lanes.output(i)[0]).collect();
-                output.push(rates[0]);
-                outputs.push(rates);
-            },
-        )
-        .map_err(|d| d.error(|_| 0))?;
+        let (outcome, final_state) = in_precision!(self.config.precision, E => {
+            let mut lanes = Lanes::<1, E>::new(&[net])?;
+            let outcome = run_lanes(
+                &self.config,
+                &mut lanes,
+                &bits,
+                [timing],
+                reset,
+                true,
+                |inputs, lanes| {
+                    trigger.push(inputs[0][0]);
+                    reinforcement.push(inputs[1][0]);
+                    let rates: Vec<f64> = (0..n).map(|i| lanes.output(i)[0].to_f64()).collect();
+                    output.push(rates[0]);
+                    outputs.push(rates);
+                },
+            )
+            .map_err(|d| d.error(|_| 0))?;
+            (outcome, lane_state(&lanes))
+        });
         let targets: Vec<u8> = (0..timing.len()).map(|k| bits[k % bits.len()]).collect();
         let r: Vec<f64> = outcome.r.iter().map(|x| x[0]).collect();
         let mean_output: Vec<f64> = outcome.mean_output.iter().map(|x| x[0]).collect();
@@ -416,8 +421,6 @@ impl SequenceTask {
             .zip(&mean_output)
             .map(|(&b, &m)| correct(b, m))
             .collect();
-        let mut final_state = vec![0.0; n];
-        lanes.lane_state(0, &mut final_state);
         Ok(TrialRecord {
             target: pattern.to_string(),
             trigger,
@@ -516,7 +519,7 @@ impl SequenceTask {
             let mut pairs = pairs(nets.len(), per_target);
             pairs.sort_by_key(|&(_, j)| self.trial_steps(&timings[j]));
             let groups: Vec<&[(usize, usize)]> = pairs.chunks(LANES).collect();
-            let sorted = by_pair(nets, &groups, cancel, |lanes, lane_pairs, len| {
+            let sorted = in_precision!(config.precision, E => by_pair::<E, _>(nets, &groups, cancel, |lanes, lane_pairs, len| {
                 let lane_timings = lane_pairs.map(|(_, j)| timings[j].as_slice());
                 let outcome = run_lanes(config, lanes, bits, lane_timings, true, false, |_, _| {})?;
                 Ok((0..len)
@@ -527,7 +530,7 @@ impl SequenceTask {
                         (performance(&r, base), ok)
                     })
                     .collect())
-            })?;
+            }))?;
             let mut judged = vec![(0.0, false); sorted.len()];
             for (&(n, j), result) in pairs.iter().zip(sorted) {
                 judged[n * per_target + j] = result;

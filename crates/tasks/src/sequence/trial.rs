@@ -1,7 +1,7 @@
 //! One trial's protocol, run on a block of lanes in lockstep: triggers, delays, reinforcement
 //! and gaps, and the timings drawn for them.
 
-use ctrnn::{Lanes, Stream};
+use ctrnn::{Elem, Lanes, Stream};
 
 use crate::common::Diverged;
 
@@ -76,14 +76,14 @@ pub(super) struct Outcome<const L: usize> {
 /// after the last trigger window, which gives the same R values. This is the only trial loop: the
 /// population evaluation (`L = LANES`) and the single-network record (`L = 1`) both run it, so
 /// they agree bit for bit.
-pub(super) fn run_lanes<const L: usize>(
+pub(super) fn run_lanes<const L: usize, E: Elem>(
     config: &SequenceConfig,
-    lanes: &mut Lanes<L>,
+    lanes: &mut Lanes<L, E>,
     bits: &[u8],
     timings: [&[(usize, usize)]; L],
     reset: bool,
     full: bool,
-    mut observe: impl FnMut(&[[f64; L]; 2], &Lanes<L>),
+    mut observe: impl FnMut(&[[f64; L]; 2], &Lanes<L, E>),
 ) -> std::result::Result<Outcome<L>, Diverged> {
     let n_triggers = timings[0].len();
     debug_assert!(timings.iter().all(|t| t.len() == n_triggers));
@@ -106,11 +106,12 @@ pub(super) fn run_lanes<const L: usize>(
                 0.0
             };
         }
-        lanes.step_row(&inputs, &config.integrator);
+        // The network reads its inputs in its own precision (an exact copy in `f64`).
+        lanes.step_row(&inputs.map(|row| row.map(E::from_f64)), &config.integrator);
         // All the rates, in the kernel's vectors: the next step starts from them rather than
         // computing them again, so neuron 0's cost nothing (`output(0)`, one lane at a time, cost
         // 4% of an evaluation).
-        let out = lanes.outputs()[0];
+        let out = lanes.outputs()[0].map(E::to_f64);
         for (l, c) in cursors.iter_mut().enumerate() {
             if c.phase == Phase::Done {
                 continue;

@@ -1,4 +1,4 @@
-use ctrnn::{Layout, Network, Purpose, Stream, Task};
+use ctrnn::{Layout, Network, Precision, Purpose, Stream, Task};
 use tasks::landmark::*;
 
 mod trials;
@@ -76,7 +76,16 @@ fn sensing_is_keyed_by_the_stream_and_sees_the_landmark() {
 
 #[test]
 fn batched_outputs_equal_the_record_and_ignore_threads() {
-    let t = task(small());
+    for precision in [Precision::F64, Precision::F32] {
+        batched_outputs_equal_the_record_and_ignore_threads_in(precision);
+    }
+}
+
+fn batched_outputs_equal_the_record_and_ignore_threads_in(precision: Precision) {
+    let t = task(LandmarkConfig {
+        precision,
+        ..small()
+    });
     let nets = random_networks(11, 5);
     let trials = t.trials(9, 1).unwrap();
     assert_eq!(
@@ -88,6 +97,8 @@ fn batched_outputs_equal_the_record_and_ignore_threads() {
         for (k, s) in trials.iter().enumerate() {
             let rec = t.record(net, s.clone()).unwrap();
             assert_eq!(rec.classification.to_bits(), out[p][k].to_bits());
+            let single = rec.outputs.iter().flatten().all(|&y| y as f32 as f64 == y);
+            assert_eq!(single, precision == Precision::F32);
             assert_eq!(rec.outputs.len(), s.input.len());
         }
     }

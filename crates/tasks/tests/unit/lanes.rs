@@ -44,7 +44,7 @@ fn pairs_come_back_in_order_and_a_divergence_names_its_network() {
 #[test]
 fn blocks_return_results_in_network_order() {
     let nets: Vec<Network> = (0..40).map(|i| neuron(1.0 + i as f64)).collect();
-    let got = by_block(
+    let got = by_block::<f64, _, _>(
         &nets,
         3,
         None,
@@ -59,7 +59,7 @@ fn blocks_return_results_in_network_order() {
     )
     .unwrap();
     assert_eq!(got, (0..40).collect::<Vec<_>>());
-    assert!(by_block(
+    assert!(by_block::<f64, _, _>(
         &[] as &[Network],
         3,
         None,

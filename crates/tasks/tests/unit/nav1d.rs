@@ -1,4 +1,4 @@
-use ctrnn::{Layout, Network, Task};
+use ctrnn::{Layout, Network, Precision, Task};
 
 use tasks::nav1d::*;
 use tasks::testing;
@@ -161,9 +161,13 @@ fn the_rightward_network_reaches_exactly_the_goal_right_trials() {
 fn batched_evaluation_equals_the_record_and_ignores_threads() {
     let cases = [Objective::Goal, Objective::Classify, Objective::Single]
         .into_iter()
-        .flat_map(|o| [World::Continuous, World::Stepped].map(|w| (o, w)));
-    for (objective, world) in cases {
-        let t = task(jittered(objective, world));
+        .flat_map(|o| [World::Continuous, World::Stepped].map(|w| (o, w)))
+        .flat_map(|c| [Precision::F64, Precision::F32].map(|p| (c, p)));
+    for ((objective, world), precision) in cases {
+        let t = task(Nav1dConfig {
+            precision,
+            ..jittered(objective, world)
+        });
         let nets = random_networks(19, 5, 2, 11);
         let fitness = t.evaluate(&nets, 4, 9, None).unwrap();
         let chains = t.chains(9, 4);
@@ -171,6 +175,12 @@ fn batched_evaluation_equals_the_record_and_ignores_threads() {
             let (mut sum, mut count) = (0.0, 0);
             for chain in &chains {
                 let rec = t.record(net, chain, true).unwrap();
+                let single = rec.outputs.iter().flatten().all(|&y| y as f32 as f64 == y);
+                assert_eq!(
+                    single,
+                    precision == Precision::F32,
+                    "{objective:?} {world:?} {p}"
+                );
                 for (k, c) in chain.iter().enumerate() {
                     if let Some((s, _)) = t.judge(k, c, rec.reached[k], rec.classification[k]) {
                         sum += s;
@@ -181,7 +191,7 @@ fn batched_evaluation_equals_the_record_and_ignores_threads() {
             assert_eq!(
                 fitness[p].to_bits(),
                 (sum / count as f64).to_bits(),
-                "{objective:?} {world:?} {p}"
+                "{objective:?} {world:?} {precision:?} {p}"
             );
         }
         let one = rayon::ThreadPoolBuilder::new()

@@ -56,6 +56,14 @@ fn every_bad_value_names_its_field() {
             "population: invalid value: integer `-1`",
         ),
         (r#"{"task_params": {"size": 3}}"#, "task_params.size is set"),
+        (
+            r#"{"task_params": {"precision": "f32"}}"#,
+            "task_params.precision is set",
+        ),
+        (
+            r#"{"precision": "f16"}"#,
+            "precision: unknown variant `f16`, expected `f64` or `f32`",
+        ),
         ("[1]", "the parameters must be a JSON object"),
         ("{", "not valid JSON"),
     ] {
@@ -72,13 +80,16 @@ fn every_bad_value_names_its_field() {
 }
 
 #[test]
-fn the_task_gets_the_runs_size_and_integrator() {
+fn the_task_gets_the_runs_size_integrator_and_precision() {
     let json = r#"{"size": 7, "task_params": {"targets": ["0", "1"]}}"#;
     let config = RunConfig::from_json(json).unwrap();
     assert_eq!(config.build_task().unwrap().layout().size, 7);
     let params = config.task_params();
     assert_eq!(params["integrator"]["substeps"], 10);
     assert_eq!(params["targets"][1], "1");
+    assert_eq!(params["precision"], "f64");
+    let single = RunConfig::from_json(r#"{"precision": "f32"}"#).unwrap();
+    assert_eq!(single.task_params()["precision"], "f32");
     let own = RunConfig {
         task: "python:m.f".into(),
         ..RunConfig::default()

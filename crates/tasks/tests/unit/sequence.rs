@@ -1,6 +1,6 @@
 //! Tests of the sequence task.
 
-use ctrnn::{Error, Layout, Method, Network, Purpose, Stream, Task};
+use ctrnn::{Error, Layout, Method, Network, Precision, Purpose, Stream, Task};
 use std::sync::atomic::AtomicBool;
 use tasks::sequence::*;
 use tasks::testing::sequence::{correct, mean, score};
@@ -191,7 +191,16 @@ fn constant_outputs_score_half_or_nothing() {
 
 #[test]
 fn batched_evaluation_equals_run_trial() {
-    let t = task(small());
+    for precision in [Precision::F64, Precision::F32] {
+        batched_evaluation_equals_run_trial_in(precision);
+    }
+}
+
+fn batched_evaluation_equals_run_trial_in(precision: Precision) {
+    let t = task(SequenceConfig {
+        precision,
+        ..small()
+    });
     let nets = random_networks(19, 11);
     let (seed, generation) = (5, 3);
     let scores = t.scores(&nets, generation, seed, None).unwrap();
@@ -203,6 +212,13 @@ fn batched_evaluation_equals_run_trial() {
         for trial in 0..n_trials {
             let timing = t.timings(seed, generation, trial);
             let rec = t.run_trial(net, trial / 2, &timing, true).unwrap();
+            // In f32 the network's rates are f32s.
+            let single = |x: f64| x as f32 as f64 == x;
+            if precision == Precision::F32 {
+                assert!(rec.output.iter().all(|&y| single(y)), "network {p}");
+            } else {
+                assert!(!rec.output.iter().all(|&y| single(y)), "network {p}");
+            }
             let at = (p * n_trials + trial) * k;
             assert_eq!(rec.r, scores.r[at..at + k], "network {p}, trial {trial}");
             fitness += performance(&rec.r, 0.5);
@@ -244,7 +260,16 @@ fn the_error_of_several_diverging_networks_names_the_first_whatever_the_threads(
 
 #[test]
 fn evaluation_does_not_depend_on_threads() {
-    let t = task(small());
+    for precision in [Precision::F64, Precision::F32] {
+        evaluation_does_not_depend_on_threads_in(precision);
+    }
+}
+
+fn evaluation_does_not_depend_on_threads_in(precision: Precision) {
+    let t = task(SequenceConfig {
+        precision,
+        ..small()
+    });
     let nets = random_networks(37, 2);
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()

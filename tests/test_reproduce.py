@@ -334,6 +334,37 @@ def test_the_ablation_removes_one_departure_of_the_working_2bit_route_at_a_time(
     assert (base.seed_populations, base.spare_neurons, want["task_params.clamp"]) == (True, 6, "evaluation")
 
 
+def test_the_precision_family_runs_its_experiments_again_in_f32_and_nothing_else() -> None:
+    single = [e for e in plan.EXPERIMENTS if e.family == "precision"]
+    assert "precision" in plan.FAMILIES and "precision" not in results.REFERENCE_FAMILIES
+    evolved = [e for e in single if e.kind == plan.EVOLVE]
+    assert [e.name for e in evolved] == [f"{n}-f32" for n in ("landmark", "nav1d-classifier", "nav1d-far",
+                                                              "nav1d-near", "sequence-1bit", "sequence-3bit")]
+    for e in evolved:
+        f64 = plan.experiment(e.name.removesuffix("-f32"))
+        config, reference = (_flat(jobs.Settings().config(x).to_dict()) for x in (e, f64))
+        assert {k: v for k, v in config.items() if v != reference[k]} == {"precision": "f32"}, e.name
+        assert (e.needs, f64.needs, reference["precision"]) == ((), (), "f64")
+    system = plan.experiment("nav1d-system-f32")
+    assert system.kind == plan.SYSTEM
+    assert system.needs == tuple(f"{n}-f32" for n in plan.experiment("nav1d-system").needs)
+
+
+@pytest.mark.slow
+def test_the_precision_family_runs_in_f32_and_its_system_composes_f32_parts(tmp_path: Path) -> None:
+    out = tmp_path / "f32"
+    r = run_cli("reproduce", "--only", "precision", "--seeds", "0", "--quick", "--in-process", "--no-figures",
+                "--out", out)
+    assert r.returncode == 0, r.stderr
+    order = plan.jobs([0], only=["precision"])
+    for job in order:
+        if job.spec.kind == plan.EVOLVE:
+            assert 'precision = "f32"' in (out / job.id / "config.toml").read_text(), job.id
+        assert f"| {job.experiment} | not in the paper | 1/1 |" in r.stdout
+    system = json.loads((out / "nav1d-system-f32/seed-0.json").read_text())
+    assert system["inputs"].keys() == {f"{n}/seed-0/best.json" for n in plan.experiment("nav1d-system-f32").needs}
+
+
 @pytest.mark.slow
 def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collects_its_own(tmp_path: Path) -> None:
     """``--only ablation`` plans the same seed's 1-bit and alternating jobs (of the sequence family)

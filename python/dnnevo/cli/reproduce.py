@@ -36,6 +36,8 @@ network) and sequence learning (1-bit, alternating, the incremental 2-bit route 
 runs, direct 2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). --only ablation
 runs the working incremental 2-bit route with one of its departures from the paper removed at a
 time, with the 1-bit and alternating runs it composes (those the folder holds are used).
+--only precision runs the landmark, navigation (with the integrated system), 1-bit and 3-bit
+experiments again with precision = "f32", to compare their success counts with f64's.
 --only classic runs the field's benchmarks written as Python tasks instead (walker, categorical
 perception, double pole). Each evolution has its own run folder OUT/EXPERIMENT/seed-N and its result in
 OUT/EXPERIMENT/seed-N.json (the robot-like test, the held-out worlds, the integrated systems
@@ -50,6 +52,7 @@ EXAMPLE = """examples:
   dnnevo reproduce --only classic --quick --seeds 0 --out runs/repro-classic
   dnnevo reproduce --out reproduce --workers 4 --threads-per-worker 2
   dnnevo reproduce --only ablation --out reproduce      uses the sequence runs it holds
+  dnnevo reproduce --only precision --quick --seeds 0 --out runs/repro-f32   seconds
   dnnevo reproduce --out /shared/reproduce --scheduler tcp://HOST:8786
 
 By default the runs go to a Dask LocalCluster of one worker process per core, one run at a time

@@ -35,9 +35,11 @@ PAPER_FAMILIES = ("landmark", "robots", "nav1d", "sequence")
 """The paper's experiment families, in the paper's order (``robots`` is §3.2's other robot
 tasks): what ``dnnevo reproduce`` runs unless ``--only`` says otherwise."""
 
-FAMILIES = (*PAPER_FAMILIES, "ablation", "classic")
+FAMILIES = (*PAPER_FAMILIES, "ablation", "precision", "classic")
 """Every family; ``--only`` picks among them. ``ablation`` is the working incremental 2-bit route
 (``sequence-2bit``) with one of its departures from the paper removed at a time (issue 47);
+``precision`` is the 1-bit, 3-bit, landmark and navigation experiments again in single precision
+(``precision = "f32"``), whose success counts are compared with the f64 ones (issue 49);
 ``classic`` is the field's benchmarks written as Python tasks (:mod:`dnnevo.classic`), which the
 paper does not have."""
 
@@ -107,6 +109,15 @@ _ABLATION: tuple[tuple[str, tuple[str, ...], bool, int, str], ...] = (
      "composing the two runs' last populations member by member: their champions are composed (with "
      "6 spare neurons) and the first population is that composite and its mutants, as in the paper"),
 )
+
+# The experiments run again in single precision, with the seeds and the fresh trials of their f64
+# runs, so that their success counts can be compared (issue 49).
+_F32 = ("landmark", "nav1d-classifier", "nav1d-far", "nav1d-near", "sequence-1bit", "sequence-3bit")
+
+
+def _f32(name: str) -> str:
+    return f"{name}-f32"
+
 
 EXPERIMENTS: tuple[Experiment, ...] = (
     Experiment("landmark", "landmark", EVOLVE, "§3: solved by generation 15 in simulation",
@@ -200,6 +211,13 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                  seed_populations=populations, spare_neurons=spare,
                  note=f"the working route, sequence-2bit, without {removed}")
       for name, overrides, populations, spare, removed in _ABLATION),
+    *(Experiment(_f32(name), "precision", EVOLVE, "not in the paper", preset=name, overrides=("precision=f32",),
+                 note=f"{name} computed in single precision (precision = \"f32\"); its counts are compared "
+                      f"with {name}'s, which has the same seeds and fresh trials")
+      for name in _F32),
+    Experiment("nav1d-system-f32", "precision", SYSTEM, "not in the paper",
+               needs=tuple(_f32(n) for n in ("nav1d-classifier", "nav1d-far", "nav1d-near")),
+               note="nav1d-system with the parts evolved in single precision, which compute in it"),
     Experiment("legged-walker", "classic", EVOLVE, "not in the paper", preset="legged-walker",
                note="Beer and Gallagher's one-legged walker, a task written in Python "
                     "(dnnevo.classic.walker)"),

@@ -376,3 +376,27 @@ def test_an_examples_table_is_rendered_from_its_record_and_checked(repo: Path) -
     record.unlink()
     r = _results("render", "--root", repo, "--check")
     assert r.returncode == 2 and "demo.json does not exist; make it with the example's --record" in r.stderr
+
+
+def test_the_precision_table_sets_each_f32_experiment_beside_its_f64_one_on_shared_seeds() -> None:
+    from dnnevo.experiments import precision
+    from dnnevo.experiments.scheduler import Outcome, Task
+
+    stored = {s: json.loads((ROOT / f"docs/results/sequence-1bit/seed-{s}.json").read_text()) for s in range(6)}
+    order = plan.jobs(range(8), ("precision", "sequence", "nav1d", "landmark"))
+
+    def table(single: dict[int, dict]) -> dict[str, tuple[str, ...]]:
+        found = {**{f"sequence-1bit/seed-{s}": r for s, r in stored.items()},
+                 **{f"sequence-1bit-f32/seed-{s}": r for s, r in single.items()}}
+        outcomes = {j.id: Outcome(Task(j.id, j.needs, print), "done", found[j.id]) if j.id in found
+                    else Outcome(Task(j.id, j.needs, print), results.NOT_RUN) for j in order}
+        return {row[0]: row for row in precision.rows(order, outcomes)}
+
+    # The same results on seeds 0-3: the same counts, on the 4 seeds both have.
+    row = table({s: stored[s] for s in range(4)})["sequence-1bit / sequence-1bit-f32"]
+    assert row[1:] == ("4", "4/4 (51.0%-100%)", "4/4 (51.0%-100%)", "4/4 (51.0%-100%)", "4/4 (51.0%-100%)", "yes")
+    assert table({})["landmark / landmark-f32"][1:] == ("none yet", "-", "-", "-", "-", "-")
+    # Four of six f32 seeds never met the rule: 2/6 lies outside 6/6's interval.
+    never = {s: {**r, "run": {**r["run"], "first_success": None, "succeeded": False}} for s, r in stored.items()}
+    row = table({s: never[s] if s < 4 else stored[s] for s in stored})["sequence-1bit / sequence-1bit-f32"]
+    assert row[2:4] == ("6/6 (61.0%-100%)", "2/6 (9.7%-70.0%)") and row[-1] == "no"

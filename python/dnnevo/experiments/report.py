@@ -37,7 +37,7 @@ from dnnevo.runs import RunDir, save_figure, write_atomic
 from dnnevo.tasks import landmark_transfer, nav1d
 from dnnevo.experiments.scheduler import Outcome
 
-__all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "SUMMARY_HEADER",
+__all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "k_of_n", "SUMMARY_HEADER",
            "REPORT_FILES"]
 
 REPORT_FILES = ("report.md", "report.html")
@@ -62,7 +62,8 @@ def _pct(x: float) -> str:
     return f"{100 * x:.0f}%" if x in (0.0, 1.0) else f"{100 * x:.1f}%"
 
 
-def _k_of_n(k: int, n: int) -> str:
+def k_of_n(k: int, n: int) -> str:
+    """``k/n`` with its 95% Wilson interval, as every table of the report writes a count."""
     lo, hi = stats.wilson(k, n)
     return f"{k}/{n} ({_pct(lo)}-{_pct(hi)})"
 
@@ -96,12 +97,12 @@ def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[st
         median = (f"{_generation(m.median)} ({_generation(m.lo)}-{_generation(m.hi)})" if m.reached
                   else f"not reached ({m.censored} of {s.seeds} seeds never met the rule)")
         artefacts = f"{s.artefacts}/{s.checked}" if s.checked else "not checked"
-        return (*head, _k_of_n(s.succeeded, s.seeds), _k_of_n(s.passed, s.seeds), median, artefacts,
+        return (*head, k_of_n(s.succeeded, s.seeds), k_of_n(s.passed, s.seeds), median, artefacts,
                 _median_wall([r.wall_s for r in runs]))
     if e.kind == plan.ROBOT_LIKE:
         verdicts = [Assessment.from_dict(o.result["assessment"]).verdict for o in done if o.result]
         passed = sum(v == "pass" for v in verdicts)
-        return (*head, "-", _k_of_n(passed, len(verdicts)) if verdicts else "-", "-", "-", _median_wall(walls))
+        return (*head, "-", k_of_n(passed, len(verdicts)) if verdicts else "-", "-", "-", _median_wall(walls))
     if e.kind == plan.HAND_DESIGNED:
         counts = [hand_counts(o.result) for o in done if o.result]
         return (*head, "-", _hand_pooled(counts) if counts else "-", "-", "-", _median_wall(walls))
@@ -109,7 +110,7 @@ def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[st
         worlds = [world_counts(o.result) for o in done if o.result]
         every = sum(_meets_every(w) for w in worlds)
         text = (f"seeds right in >85% with the interval's lower end >80% in every held-out world: "
-                f"{_k_of_n(every, len(worlds))}" if worlds else "-")
+                f"{k_of_n(every, len(worlds))}" if worlds else "-")
         return (*head, "-", text, "-", "-", _median_wall(walls))
     rates = [o.result["goal_rate"] for o in done if o.result]
     text = f"goal in {', '.join(_pct(r) for r in rates)} of trials" if rates else "-"
@@ -127,7 +128,7 @@ def _hand_pooled(counts: Sequence[dict[str, dict[str, tuple[int, int]]]]) -> str
     parts = []
     for world in WORLDS:
         pooled = {c: tuple(sum(x[world][c][i] for x in counts) for i in (0, 1)) for c in HAND_CONDITIONS}
-        parts.append(f"{world} {_k_of_n(*pooled['with'])} / {_k_of_n(*pooled['without'])}")
+        parts.append(f"{world} {k_of_n(*pooled['with'])} / {k_of_n(*pooled['without'])}")
     return "goal reached with / without detectors: " + "; ".join(parts)
 
 
@@ -166,7 +167,7 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
             bounds = "; ".join(f"{w} " + " / ".join(_pct(held[w][b] / held[w]["n"]) for b in
                                                     ("threshold", "observer", "observer, other worlds") if b in held[w])
                                for w in WORLD_PLACES)
-            rows.append((str(job.seed), *(_k_of_n(held[w]["right"], held[w]["n"]) for w in WORLD_PLACES),
+            rows.append((str(job.seed), *(k_of_n(held[w]["right"], held[w]["n"]) for w in WORLD_PLACES),
                          "yes" if _meets_every(held) else "no", bounds,
                          f"{res['trials']} trials per landmark per world, seed {res['test_seed']}; bounds "
                          f"fitted on {res['fit_trials']} per landmark, seed {res['fit_seed']}",
@@ -174,7 +175,7 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
         elif e.kind == plan.HAND_DESIGNED:
             res = o.result
             counts = hand_counts(res)
-            rows.append((str(job.seed), *(f"{_k_of_n(*counts[w]['with'])} / {_k_of_n(*counts[w]['without'])}"
+            rows.append((str(job.seed), *(f"{k_of_n(*counts[w]['with'])} / {k_of_n(*counts[w]['without'])}"
                                           for w in WORLDS),
                          f"{res['starts']} starts per world, seed {res['seed']}, trials of {res['steps']} steps",
                          f"{res['wall_s']:.0f} s"))

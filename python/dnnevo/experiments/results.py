@@ -48,7 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo.errors import DnnevoError
-from dnnevo.experiments import examples, jobs, plan, report
+from dnnevo.experiments import examples, jobs, plan, precision, report
 from dnnevo.experiments.scheduler import Outcome, Task
 from dnnevo.runs import RunFileError, first_difference, short, write_atomic
 from dnnevo.runs.files import checked, read_json
@@ -77,6 +77,7 @@ NOT_RUN = "not yet run"
 """The status of a job with no stored result."""
 
 _README_KEY = "results-table"
+_PRECISION_KEY = "precision-vs-f64"
 _MARKER = re.compile(r"<!-- (results-table|results:([a-z0-9:-]+?)):begin -->")
 
 
@@ -113,10 +114,11 @@ class Results:
         """Every job of those families over the seeds, done or not."""
         return plan.jobs(self.seeds, self.families)
 
-    def outcomes(self) -> dict[str, Outcome]:
-        """Each job's outcome: ``done`` with its result, or :data:`NOT_RUN`."""
+    def outcomes(self, order: Sequence[plan.Job] | None = None) -> dict[str, Outcome]:
+        """Each job's outcome (of ``order``, default :attr:`order`): ``done`` with its result, or
+        :data:`NOT_RUN`."""
         return {j.id: _done(j, self.found[j.id]) if j.id in self.found
-                else Outcome(Task(j.id, j.needs, _nothing), NOT_RUN) for j in self.order}
+                else Outcome(Task(j.id, j.needs, _nothing), NOT_RUN) for j in (self.order if order is None else order)}
 
 
 def _done(job: plan.Job, result: dict[str, Any]) -> Outcome:
@@ -451,6 +453,18 @@ def _family(results: Results, family: str) -> list[report.Block]:
     return out
 
 
+def _precision(results: Results) -> list[report.Block]:
+    single = [e for e in plan.EXPERIMENTS if e.family == precision.FAMILY]
+    families = dict.fromkeys([precision.FAMILY, *(precision.twin(e).family for e in single)])
+    order = plan.jobs(results.seeds, tuple(families))
+    found = sum(j.id in results.found for j in order if j.spec.family == precision.FAMILY)
+    text = (f"From the results in {RESULTS_DIR.as_posix()}/: each experiment run again with "
+            f"precision = \"f32\" beside its f64 runs, on the seeds both have done "
+            f"({found} f32 runs collected). Intervals are 95% Wilson intervals.")
+    rows = precision.rows(order, results.outcomes(order))
+    return [report.Block("p", text), report.Block("table", rows=(precision.HEADER, *rows))]
+
+
 def _machine(results: Results) -> list[report.Block]:
     if results.settings is None:
         return [report.Block("p", f"No results yet in {RESULTS_DIR.as_posix()}/.")]
@@ -515,7 +529,10 @@ def blocks(results: Results, key: str) -> list[report.Block]:
         return _family(results, key)
     if key == "machine":
         return _machine(results)
-    raise DnnevoError(f"unknown results marker {key!r}; markers are summary, summary:FAMILY, FAMILY, machine "
+    if key == _PRECISION_KEY:
+        return _precision(results)
+    raise DnnevoError(f"unknown results marker {key!r}; markers are summary, summary:FAMILY, FAMILY, machine, "
+                      f"{_PRECISION_KEY} "
                       f"(FAMILY one of {', '.join(plan.FAMILIES)}), example:NAME, and results-table in the README")
 
 

@@ -152,7 +152,7 @@ class ClosedLoop:
             config,
             task=f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}",
             integrator=IntegratorConfig(method=s["method"], dt=s["dt"], substeps=s["substeps"]),
-            precision=self.settings["precision"],
+            precision=str(self.settings["precision"]),
             task_params=params,
         )
 

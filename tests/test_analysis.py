@@ -3,6 +3,7 @@ differences, and lesions that are exact."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -224,6 +225,12 @@ def test_replay_reproduces_a_recorded_trial_and_settles_to_names_attractors() ->
     (out0, in0), (out1, in1) = analysis.recorded_trials(config, net, seed=0)
     states = analysis.replay(config, net, in1)
     assert 1 / (1 + np.exp(-(states - net.theta))) == pytest.approx(out1, abs=1e-12)
+    # A run in f32 is replayed in f32: its states are float32 values, its rates the recorded ones.
+    single = dataclasses.replace(config, precision="f32")
+    _, (out32, in32) = analysis.recorded_trials(single, net, seed=0)
+    states32 = analysis.replay(single, net, in32)
+    assert np.array_equal(states32.astype(np.float32), states32)
+    assert 1 / (1 + np.exp(-(states32 - net.theta))) == pytest.approx(out32, abs=1e-6)
     stable = [e for e in analysis.equilibria(net, [0.0, 0.0]) if e.stable]
     assert len(stable) == 2
     # Each attractor's own state settles to it; a state far from both settles somewhere valid.

@@ -138,6 +138,9 @@ def test_a_closed_loop_computes_in_its_precision_and_records_it(tmp_path: Path) 
     assert tomllib.loads((tmp_path / "run/config.toml").read_text())["precision"] == "f32"
     resumed = dnnevo.resume(tmp_path / "run", single, progress=False)
     assert resumed.best == result.best
+    with pytest.raises(ConfigError, match="computes in f32, not f64"):
+        dnnevo.resume(tmp_path / "run", ClosedLoop(Glide(), episodes=2, max_steps=10), progress=False,
+                      new_fitness=True)
     with pytest.raises(ConfigError, match="this ClosedLoop computes in 'f64'"):
         double.configured(dataclasses.replace(config, precision="f32"))
     with pytest.raises(ConfigError, match="precision is 'f16'"):

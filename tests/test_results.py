@@ -400,3 +400,26 @@ def test_the_precision_table_sets_each_f32_experiment_beside_its_f64_one_on_shar
     never = {s: {**r, "run": {**r["run"], "first_success": None, "succeeded": False}} for s, r in stored.items()}
     row = table({s: never[s] if s < 4 else stored[s] for s in stored})["sequence-1bit / sequence-1bit-f32"]
     assert row[2:4] == ("6/6 (61.0%-100%)", "2/6 (9.7%-70.0%)") and row[-1] == "no"
+
+
+def test_a_manifest_written_before_a_later_setting_still_matches_todays_configs(tmp_path: Path) -> None:
+    """The reference reproduce.json predates ``precision``: a reproduction of today's code with
+    the same settings continues in its folder, and its results may be collected beside it."""
+    from dnnevo.experiments import jobs
+    from dnnevo.runs import check_settings
+    from dnnevo.runs.settings import manifest_with_later_defaults
+
+    stored = json.loads((ROOT / "docs/results/reproduce.json").read_text())
+    assert all("precision" not in c for c in stored["configs"].values())
+    today = json.loads(json.dumps(jobs.Settings(**stored["settings"]).to_dict()))  # as read from a file
+    today["configs"] = {k: v for k, v in today["configs"].items() if k in stored["configs"]}
+    manifest = tmp_path / "reproduce.json"
+    manifest.write_text(json.dumps(stored))
+    check_settings(manifest, today, what="reproduction", force=False)
+    joined = results._joined(stored, today)
+    assert joined is not None and joined["configs"] == stored["configs"]  # what it held, unchanged
+    f32 = {**today, "configs": {k: {**v, "precision": "f32"} for k, v in today["configs"].items()}}
+    assert results._joined(stored, f32) is None
+    with pytest.raises(Exception, match="precision = 'f64', not 'f32'"):
+        check_settings(manifest, f32, what="reproduction", force=False)
+    assert manifest_with_later_defaults({"x": 1}) == {"x": 1}

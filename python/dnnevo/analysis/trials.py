@@ -57,11 +57,13 @@ def trial_outputs(config: EvolutionConfig, net: _core.Network, *, seed: int) -> 
 
 def replay(config: EvolutionConfig, net: _core.Network, inputs: npt.ArrayLike) -> _Array:
     """The states (T, N) of ``net`` from ``v = 0`` driven by recorded ``inputs`` (T, M), one row
-    per time step, with the config's integrator: a recorded sequence or landmark trial exactly;
-    a nav1d trial to within the recording's time step (its landmark input is the fraction of a
-    time step spent on the landmark)."""
+    per time step, with the config's integrator and precision: a recorded sequence or landmark
+    trial exactly; a nav1d trial to within the recording's time step (its landmark input is the
+    fraction of a time step spent on the landmark)."""
     n = net.copy()
     n.reset()
     i = config.integrator
     method = cast(Literal["euler", "rk4"], i.method)
-    return np.asarray(n.run(np.asarray(inputs, dtype=float), dt=i.dt, substeps=i.substeps, method=method).states)
+    precision = cast(Literal["f64", "f32"], config.precision)
+    return np.asarray(n.run(np.asarray(inputs, dtype=float), dt=i.dt, substeps=i.substeps, method=method,
+                            precision=precision).states)

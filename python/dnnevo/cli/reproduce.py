@@ -18,7 +18,7 @@ from dnnevo.experiments import plan
 from dnnevo.experiments import report
 from dnnevo.experiments import scheduler
 from dnnevo.errors import ConfigError, DnnevoError
-from dnnevo.runs import LOCK_NAME, RunDir, RunFileError, check_settings, write_atomic
+from dnnevo.runs import LOCK_NAME, RunDir, RunFileError, check_settings, manifest_with_later_defaults, write_atomic
 from dnnevo.runs.files import read_json, remove_temporaries
 from dnnevo.experiments.runsview import RunsView
 
@@ -197,7 +197,7 @@ def _begin(root: Path, settings: jobs.Settings, experiments: set[str]) -> None:
     if manifest.exists() or manifest.is_symlink():
         # Experiments added to dnnevo since the folder was begun join it; the others must match.
         try:
-            found = read_json(manifest)
+            found = manifest_with_later_defaults(read_json(manifest))
             recorded = found["configs"]
         except (RunFileError, TypeError, KeyError):
             recorded = None  # check_settings names what is wrong

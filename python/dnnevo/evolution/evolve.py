@@ -238,6 +238,10 @@ def resume(
                 raise ConfigError(f"{run.path} was evolved with {ga.config.task}, not {task}")
             fitness = _named_fitness(run, ga.config, table)
         elif task is not None:
+            if isinstance(task, ClosedLoop) and task.settings["precision"] != ga.config.precision:
+                raise ConfigError(f"{run.path} computes in {ga.config.precision}, not "
+                                  f"{task.settings['precision']}; give ClosedLoop(..., "
+                                  f"precision={ga.config.precision!r})")
             fitness = task
             name = task if isinstance(task, str) else _python_task_name(task)
             digest = None if isinstance(task, str) else _fitness_digest(task)

@@ -50,7 +50,7 @@ from typing import Any
 from dnnevo.errors import DnnevoError
 from dnnevo.experiments import examples, jobs, plan, precision, report
 from dnnevo.experiments.scheduler import Outcome, Task
-from dnnevo.runs import RunFileError, first_difference, short, write_atomic
+from dnnevo.runs import RunFileError, first_difference, manifest_with_later_defaults, short, write_atomic
 from dnnevo.runs.files import checked, read_json
 
 __all__ = ["RESULTS_DIR", "SETTINGS_FILE", "PROVENANCE_FILE", "REFERENCE_FAMILIES", "Results", "load", "collect",
@@ -261,7 +261,9 @@ def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
         return None
     if {k: v for k, v in held.items() if k != "configs"} != {k: v for k, v in found.items() if k != "configs"}:
         return None
-    if any(mine[k] != theirs[k] for k in mine.keys() & theirs.keys()):
+    # Configs compare with the settings added since either was written at their defaults.
+    old, new = (manifest_with_later_defaults({"configs": c})["configs"] for c in (mine, theirs))
+    if any(old[k] != new[k] for k in mine.keys() & theirs.keys()):
         return None
     return {**held, "configs": {**mine, **{k: v for k, v in theirs.items() if k not in mine}}}
 

@@ -11,8 +11,8 @@ from dnnevo.runs.checkpoint import Checkpoint
 from dnnevo.runs.files import RunFileError, save_figure, short, write_atomic, write_atomic_with
 from dnnevo.runs.history import LOG_COLUMNS
 from dnnevo.runs.rundir import LOCK_NAME, RunDir
-from dnnevo.runs.settings import check_settings, config_digest, first_difference
+from dnnevo.runs.settings import check_settings, config_digest, first_difference, manifest_with_later_defaults
 
 __all__ = ["LOCK_NAME", "LOG_COLUMNS", "Checkpoint", "RunDir", "RunFileError", "check_settings",
-           "config_digest", "first_difference", "save_figure", "short", "write_atomic",
+           "config_digest", "first_difference", "manifest_with_later_defaults", "save_figure", "short", "write_atomic",
            "write_atomic_with"]

@@ -14,7 +14,8 @@ from dnnevo.config import LATER_SETTINGS, EvolutionConfig, with_later_defaults
 from dnnevo.errors import ConfigError
 from dnnevo.runs.files import RunFileError, checked, read_json, short
 
-__all__ = ['MAX_CONFIG_DEPTH', 'depth', 'check_settings', 'config_digest', 'first_difference']
+__all__ = ['MAX_CONFIG_DEPTH', 'depth', 'check_settings', 'config_digest', 'first_difference',
+           'manifest_with_later_defaults']
 
 def config_digest(config: EvolutionConfig, seed: int) -> str:
     """SHA-256 of the complete run config (every setting and the seed), as canonical JSON."""
@@ -26,6 +27,22 @@ def config_digest(config: EvolutionConfig, seed: int) -> str:
     doc = {"config": settings, "seed": seed}
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"), allow_nan=False)
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def manifest_with_later_defaults(found: dict[str, Any]) -> dict[str, Any]:
+    """A settings manifest as read (a sweep's ``config``, a reproduction's ``configs`` by
+    experiment), each config with the settings added since it was written at their defaults
+    (:func:`~dnnevo.config.with_later_defaults`), as today's command would record it.
+
+    >>> manifest_with_later_defaults({"configs": {"a": {"population": 3}}})["configs"]["a"]["precision"]
+    'f64'
+    """
+    out = dict(found)
+    if "config" in out:
+        out["config"] = with_later_defaults(out["config"])
+    if isinstance(out.get("configs"), dict):
+        out["configs"] = {k: with_later_defaults(v) for k, v in out["configs"].items()}
+    return out
 
 
 def first_difference(a: Any, b: Any, prefix: str = "") -> tuple[str, Any, Any] | None:
@@ -60,8 +77,7 @@ def check_settings(manifest: Path, settings: dict[str, Any], *, what: str, force
         raise RunFileError(f"{manifest}: unreadable ({problem}); choose another --out{again}") from None
     if not isinstance(found, dict):
         raise RunFileError(f"{manifest}: expected a JSON object of settings; choose another --out{again}")
-    if "config" in found:
-        found = {**found, "config": with_later_defaults(found["config"])}
+    found = manifest_with_later_defaults(found)
     with checked(manifest):
         diff = first_difference(found, json.loads(json.dumps(settings)))
     if diff is not None:

@@ -156,3 +156,16 @@ def test_bootstrap_bounds_are_data_values(values: list[float]) -> None:
     assert m.lo in values and m.hi in values and m.lo <= m.hi
     assert m.censored == values.count(INF)
     assert m.reached == (m.censored <= len(values) / 2)
+
+
+def test_fisher_exact_matches_hand_computed_tables_and_is_symmetric() -> None:
+    # [[6, 0], [2, 4]]: of the C(12, 8) = 495 tables with 8 successes, the two as unlikely as
+    # this one (6/6 with 2/6, and 2/6 with 6/6) have 15 each.
+    assert stats.fisher_exact(6, 6, 2, 6) == pytest.approx(30 / 495, rel=1e-12)
+    assert stats.fisher_exact(10, 10, 9, 10) == 1.0
+    assert stats.fisher_exact(0, 5, 0, 7) == 1.0
+    for k1, n1, k2, n2 in [(9, 10, 6, 10), (3, 8, 7, 9), (0, 10, 10, 10), (4, 4, 0, 12)]:
+        p = stats.fisher_exact(k1, n1, k2, n2)
+        assert 0 < p <= 1 and p == pytest.approx(stats.fisher_exact(k2, n2, k1, n1), rel=1e-12)
+    with pytest.raises(InvalidArgumentError, match="counts 11 of 10"):
+        stats.fisher_exact(11, 10, 1, 10)

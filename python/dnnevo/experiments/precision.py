@@ -26,7 +26,7 @@ _SUFFIX = "-f32"
 
 HEADER = ("experiment (f64 / f32)", "seeds done by both", "met the rule during the run: f64",
           "f32", "final champions passing on fresh trials: f64", "f32",
-          "each count inside the other's 95% interval")
+          "f64 vs f32, Fisher's exact test, two-sided p (met / passing)")
 
 
 def twin(e: plan.Experiment) -> plan.Experiment:
@@ -50,9 +50,9 @@ def rows(order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> list[tuple[
             a, b = (sweep.summarize([sweep.SeedResult.from_dict(done[s]["run"]) for s in seeds])
                     for done in (double, single))
             n = len(seeds)
-            agree = _inside(a.succeeded, b.succeeded, n) and _inside(a.passed, b.passed, n)
+            p = [stats.fisher_exact(x, n, y, n) for x, y in ((a.succeeded, b.succeeded), (a.passed, b.passed))]
             out.append((*head, k_of_n(a.succeeded, n), k_of_n(b.succeeded, n), k_of_n(a.passed, n),
-                        k_of_n(b.passed, n), "yes" if agree else "no"))
+                        k_of_n(b.passed, n), f"{p[0]:.2f} / {p[1]:.2f}"))
         else:
             rates = [[float(done[s]["goal_rate"]) for s in seeds] for done in (double, single)]
             goal = [f"goal in {statistics.mean(r):.1%} of trials (mean over seeds)" for r in rates]
@@ -64,10 +64,3 @@ def _done(name: str, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) ->
     """The stored result of every seed of experiment ``name`` that is done."""
     return {j.seed: o.result for j in order if j.experiment == name
             and (o := outcomes[j.id]).status == "done" and o.result is not None}
-
-
-def _inside(a: int, b: int, n: int) -> bool:
-    """Whether each of the counts ``a`` and ``b`` of ``n`` lies inside the other's Wilson
-    interval."""
-    (alo, ahi), (blo, bhi) = stats.wilson(a, n), stats.wilson(b, n)
-    return alo <= b / n <= ahi and blo <= a / n <= bhi

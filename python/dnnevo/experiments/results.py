@@ -462,7 +462,8 @@ def _precision(results: Results) -> list[report.Block]:
     found = sum(j.id in results.found for j in order if j.spec.family == precision.FAMILY)
     text = (f"From the results in {RESULTS_DIR.as_posix()}/: each experiment run again with "
             f"precision = \"f32\" beside its f64 runs, on the seeds both have done "
-            f"({found} f32 runs collected). Intervals are 95% Wilson intervals.")
+            f"({found} f32 runs collected). Intervals are 95% Wilson intervals; a p-value is the chance "
+            f"of counts at least this far apart if f32 and f64 had one success rate.")
     rows = precision.rows(order, results.outcomes(order))
     return [report.Block("p", text), report.Block("table", rows=(precision.HEADER, *rows))]
 

@@ -35,7 +35,13 @@ PAPER_FAMILIES = ("landmark", "robots", "nav1d", "sequence")
 """The paper's experiment families, in the paper's order (``robots`` is §3.2's other robot
 tasks): what ``dnnevo reproduce`` runs unless ``--only`` says otherwise."""
 
-FAMILIES = (*PAPER_FAMILIES, "ablation", "precision", "classic")
+PRECISION_FAMILY = "precision"
+"""The family of the experiments repeated in single precision."""
+
+F32_SUFFIX = "-f32"
+"""What an f32 experiment's name adds to the name of the f64 experiment it repeats."""
+
+FAMILIES = (*PAPER_FAMILIES, "ablation", PRECISION_FAMILY, "classic")
 """Every family; ``--only`` picks among them. ``ablation`` is the working incremental 2-bit route
 (``sequence-2bit``) with one of its departures from the paper removed at a time (issue 47);
 ``precision`` is the 1-bit, 3-bit, landmark and navigation experiments again in single precision
@@ -116,7 +122,7 @@ _F32 = ("landmark", "nav1d-classifier", "nav1d-far", "nav1d-near", "sequence-1bi
 
 
 def _f32(name: str) -> str:
-    return f"{name}-f32"
+    return f"{name}{F32_SUFFIX}"
 
 
 EXPERIMENTS: tuple[Experiment, ...] = (
@@ -211,11 +217,11 @@ EXPERIMENTS: tuple[Experiment, ...] = (
                  seed_populations=populations, spare_neurons=spare,
                  note=f"the working route, sequence-2bit, without {removed}")
       for name, overrides, populations, spare, removed in _ABLATION),
-    *(Experiment(_f32(name), "precision", EVOLVE, "not in the paper", preset=name, overrides=("precision=f32",),
+    *(Experiment(_f32(name), PRECISION_FAMILY, EVOLVE, "not in the paper", preset=name, overrides=("precision=f32",),
                  note=f"{name} computed in single precision (precision = \"f32\"); its counts are compared "
                       f"with {name}'s, which has the same seeds and fresh trials")
       for name in _F32),
-    Experiment("nav1d-system-f32", "precision", SYSTEM, "not in the paper",
+    Experiment(_f32("nav1d-system"), PRECISION_FAMILY, SYSTEM, "not in the paper",
                needs=tuple(_f32(n) for n in ("nav1d-classifier", "nav1d-far", "nav1d-near")),
                note="nav1d-system with the parts evolved in single precision, which compute in it"),
     Experiment("legged-walker", "classic", EVOLVE, "not in the paper", preset="legged-walker",

@@ -10,19 +10,16 @@ from __future__ import annotations
 
 import statistics
 from collections.abc import Sequence
-from typing import Any
 
 from dnnevo.evaluation import stats
 from dnnevo.experiments import plan, sweep
-from dnnevo.experiments.report import k_of_n
+from dnnevo.experiments.report import done_results, k_of_n
 from dnnevo.experiments.scheduler import Outcome
 
 __all__ = ["FAMILY", "HEADER", "twin", "rows"]
 
-FAMILY = "precision"
+FAMILY = plan.PRECISION_FAMILY
 """The family of the f32 experiments."""
-
-_SUFFIX = "-f32"
 
 HEADER = ("experiment (f64 / f32)", "seeds done by both", "met the rule during the run: f64",
           "f32", "final champions passing on fresh trials: f64", "f32",
@@ -31,7 +28,7 @@ HEADER = ("experiment (f64 / f32)", "seeds done by both", "met the rule during t
 
 def twin(e: plan.Experiment) -> plan.Experiment:
     """The f64 experiment that ``e`` (of the ``precision`` family) repeats in f32."""
-    return plan.experiment(e.name.removesuffix(_SUFFIX))
+    return plan.experiment(e.name.removesuffix(plan.F32_SUFFIX))
 
 
 def rows(order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> list[tuple[str, ...]]:
@@ -41,7 +38,7 @@ def rows(order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> list[tuple[
         if e.family != FAMILY:
             continue
         f64 = twin(e)
-        double, single = (_done(x.name, order, outcomes) for x in (f64, e))
+        double, single = (done_results(x.name, order, outcomes) for x in (f64, e))
         seeds = sorted(double.keys() & single.keys())
         head = (f"{f64.name} / {e.name}", str(len(seeds)) if seeds else "none yet")
         if not seeds:
@@ -59,8 +56,3 @@ def rows(order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> list[tuple[
             out.append((*head, "-", "-", *goal, "-"))
     return out
 
-
-def _done(name: str, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> dict[int, dict[str, Any]]:
-    """The stored result of every seed of experiment ``name`` that is done."""
-    return {j.seed: o.result for j in order if j.experiment == name
-            and (o := outcomes[j.id]).status == "done" and o.result is not None}

@@ -24,6 +24,7 @@ import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from dnnevo import _core, figures, plot, presets
 from dnnevo.experiments import plan
@@ -37,7 +38,7 @@ from dnnevo.runs import RunDir, save_figure, write_atomic
 from dnnevo.tasks import landmark_transfer, nav1d
 from dnnevo.experiments.scheduler import Outcome
 
-__all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "k_of_n", "SUMMARY_HEADER",
+__all__ = ["Block", "build", "write", "markdown", "summary_row", "seed_table", "describe", "k_of_n", "done_results", "SUMMARY_HEADER",
            "REPORT_FILES"]
 
 REPORT_FILES = ("report.md", "report.html")
@@ -76,9 +77,14 @@ def _median_wall(values: Sequence[float]) -> str:
     return f"{statistics.median(values):.0f} s" if values else "-"
 
 
+def done_results(name: str, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> dict[int, dict[str, Any]]:
+    """The stored result of each seed of experiment ``name`` that is done, by seed."""
+    return {j.seed: o.result for j in order if j.experiment == name
+            and (o := outcomes[j.id]).status == "done" and o.result is not None}
+
+
 def _runs(name: str, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> list[sweep.SeedResult]:
-    return [sweep.SeedResult.from_dict(o.result["run"]) for j in order if j.experiment == name
-            and (o := outcomes[j.id]).status == "done" and o.result is not None]
+    return [sweep.SeedResult.from_dict(r["run"]) for r in done_results(name, order, outcomes).values()]
 
 
 def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str, Outcome]) -> tuple[str, ...]:

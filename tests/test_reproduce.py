@@ -272,24 +272,24 @@ def test_the_report_says_the_same_in_markdown_and_html(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_reproduce_in_process_resumes_and_refuses_other_settings(tmp_path: Path) -> None:
     out = tmp_path / "repro"
-    args = ["reproduce", "--only", "sequence", "--seeds", "0", "--quick", "--eval-trials", "10",
+    args = ["reproduce", "--only", "nav1d", "--seeds", "0", "--quick", "--eval-trials", "10",
             "--no-dt-check", "--in-process", "--out", out]
     r = run_cli(*args)
     assert r.returncode == 0, r.stderr
-    n = len(plan.jobs([0], only=["sequence"]))
+    n = len(plan.jobs([0], only=["nav1d"]))
     assert f"{n} runs in" in r.stdout and "(0 already done)" in r.stdout
     for name in report.REPORT_FILES:
         assert (out / name).stat().st_size > 1000
     md = (out / "report.md").read_text()
-    assert "| sequence-2bit-paper | §5.3: success in 2 of 2 runs | 1/1 |" in md
-    assert "sequence-3bit" in md and "landmark" not in md.split("## Environment")[0]
+    assert "| nav1d-single | §4.2: failed (not quantified) | 1/1 |" in md
+    assert "nav1d-system" in md and "| landmark |" not in md.split("## Environment")[0]
     assert "![" in md
     # Every run done: the report is made again, here without its figures.
     again = run_cli(*args, "--no-figures")
     assert again.returncode == 0 and f"({n} already done)" in again.stdout, again.stderr
     md = (out / "report.md").read_text()
     assert "![" not in md and "--no-dt-check --no-figures" in md
-    assert "| sequence-2bit-paper | §5.3: success in 2 of 2 runs | 1/1 |" in md
+    assert "| nav1d-single | §4.2: failed (not quantified) | 1/1 |" in md
     other = run_cli(*[a if a != "10" else "11" for a in args])
     assert_one_line_error(other, "eval_trials", "= 10, not 11")
 

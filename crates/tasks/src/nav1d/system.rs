@@ -90,7 +90,9 @@ fn same_world(a: &Nav1dConfig, b: &Nav1dConfig, which: &str) -> Result<()> {
 impl System {
     /// Assembles the system. The classifier's task gives the world (start, landmark, jitter);
     /// the parts must agree on its size and timing. The classifier's task must have a
-    /// classifier neuron inside its network.
+    /// classifier neuron inside its network. Each part computes in its own task's precision, the
+    /// one it was evolved in, so parts of different precisions may be composed: they share no
+    /// state, and the classifier's output is read as a number.
     pub fn new(classifier: Part, far: Part, near: Part) -> Result<Self> {
         let c = classifier.task.config();
         if c.objective != Objective::Classify {

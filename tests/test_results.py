@@ -234,9 +234,16 @@ def test_a_result_that_differs_from_the_one_collected_is_refused(tmp_path: Path,
     kept = dest / "landmark" / "seed-0.json"
     result = json.loads(kept.read_text())
     result["wall_s"] += 1000.0  # wall times may differ
+    # A result collected before a setting existed lacks it in its config: it is the same run.
+    assert result["config"].pop("precision") == "f64"
     kept.write_text(json.dumps(result))
     r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", "def5678")
     assert r.returncode == 0, r.stderr
+    result["config"]["precision"] = "f32"  # not its default: another run
+    kept.write_text(json.dumps(result))
+    r = _results("collect", reproduction, dest, "--seeds", "0", "--only", "landmark", "--commit", "def5678")
+    assert r.returncode != 0 and "config.precision" in r.stderr
+    del result["config"]["precision"]
     result["run"]["best_fitness"] = 0.123
     kept.write_text(json.dumps(result))
     before = {p: p.read_bytes() for p in dest.rglob("*.json")}

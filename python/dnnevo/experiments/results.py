@@ -268,6 +268,15 @@ def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
     return {**held, "configs": {**mine, **{k: v for k, v in theirs.items() if k not in mine}}}
 
 
+def _comparable(result: Any) -> Any:
+    """What two machines that ran the same job must agree on: its result without wall times,
+    its config with the settings added since it was written at their defaults (a result
+    collected before a setting existed is the same run as one collected after)."""
+    if isinstance(result, dict) and isinstance(result.get("config"), dict):
+        result = manifest_with_later_defaults(result)
+    return _timeless(result)
+
+
 def _timeless(result: Any) -> Any:
     """A job's result without its wall times (``wall_s`` at any depth): what two machines that
     ran the same job must agree on."""
@@ -352,8 +361,8 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             kept = jobs.result_path(dest, job)
             if not kept.exists():
                 continue
-            diff = first_difference(_timeless(read_json(kept)),
-                                    _timeless(read_json(jobs.result_path(source, job))))
+            diff = first_difference(_comparable(read_json(kept)),
+                                    _comparable(read_json(jobs.result_path(source, job))))
             if diff is not None:
                 raise DnnevoError(f"{job.id}: the result in {source} differs from the one in {dest} "
                                   f"at {diff[0]} ({short(diff[2])} against {short(diff[1])}); runs "

@@ -143,3 +143,24 @@ def test_the_walker_preset_runs_resumes_and_is_judged_from_the_command_line(tmp_
     assert r.returncode == 0 and "3 generations" in r.stdout, r.stdout + r.stderr
     r = run_cli("assess", run, "--trials", "10")
     assert r.returncode in (0, 1) and "success needs >= 90%" in r.stdout, r.stdout + r.stderr
+
+
+def test_the_judging_helpers_compute_in_the_precision_they_are_given() -> None:
+    """A champion evolved in f32 is judged in f32: each helper passes ``precision`` to the loop,
+    whose f32 trajectory is close to f64's but not the same, and an unknown precision is named."""
+    from dnnevo.classic import categorical as cp
+    from dnnevo.classic import walker as lw
+
+    net = dnnevo.Network.random(5, 1, seed=3)
+    f64, f32 = (lw.gait(net, precision=p)[1] for p in ("f64", "f32"))
+    assert not np.array_equal(f64, f32) and np.allclose(f64, f32, atol=1e-3)
+    assert not np.array_equal(*(lw.velocities(net, episodes=3, precision=p) for p in ("f64", "f32")))
+    seer = dnnevo.Network.random(8, 7, seed=4)
+    offsets = [cp.paths(seer, pairs=2, precision=p)[1] for p in ("f64", "f32")]
+    assert not np.array_equal(*offsets) and np.allclose(*offsets, atol=1e-2)
+    assert cp.grid_accuracy(seer, pairs=2, precision="f32")[1] == 4
+    pole = dnnevo.Network.random(5, 3, seed=5)
+    assert 0 <= dp.generalization(pole, precision="f32") <= len(dp.GRID)
+    assert dp.long_test(pole, steps=50, precision="f32") <= 50
+    with pytest.raises(InvalidArgumentError, match='precision is "f16"'):
+        dp.long_test(pole, steps=5, precision="f16")

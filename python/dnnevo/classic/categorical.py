@@ -206,13 +206,13 @@ class CategoricalPerception:
 
 
 def grid_accuracy(net: _core.Network, *, dt: float = 0.1, pairs: int = GRID_OFFSETS,
-                  method: str = "euler") -> tuple[int, int, float]:
+                  method: str = "euler", precision: str = "f64") -> tuple[int, int, float]:
     """``net`` on every whole offset from -50 to 50 with both shapes (``pairs`` offsets per
     shape): (episodes classified correctly, episodes, mean performance). ``dt`` is the world's
-    and the network's step alike."""
+    and the network's step alike; the network computes in ``precision``."""
     env = CategoricalPerception(start="grid", dt=dt)
     result = rollout([net], env, episodes=2 * pairs, max_steps=env.steps, dt=dt, substeps=1,
-                     method=method)
+                     method=method, precision=precision)
     ok = env.success(result.returns[0], result.lengths[0])
     return int(ok.sum()), len(ok), float(result.returns[0].mean())
 
@@ -233,14 +233,15 @@ class _Traced(CategoricalPerception):
         return out
 
 
-def paths(net: _core.Network, *, dt: float = 0.1, pairs: int = 21, method: str = "euler"
-          ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
+def paths(net: _core.Network, *, dt: float = 0.1, pairs: int = 21, method: str = "euler",
+          precision: str = "f64") -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
     """``net``'s episodes on the grid of ``pairs`` offsets per shape: the object's height at each
     step (shape ``(T,)``), its horizontal offset from the agent (shape ``(2 pairs, T)``, episode
-    ``e`` a circle when even), and which episodes were classified correctly."""
+    ``e`` a circle when even), and which episodes were classified correctly; the network
+    computes in ``precision``."""
     env = _Traced(start="grid", dt=dt)
     result = rollout([net], env, episodes=2 * pairs, max_steps=env.steps, dt=dt, substeps=1,
-                     method=method)
+                     method=method, precision=precision)
     height = HEIGHT - FALL_SPEED * dt * np.arange(env.steps + 1)
     ok = env.success(result.returns[0], result.lengths[0])
     return height, np.array(env.trace).T, ok

@@ -198,19 +198,21 @@ class DoublePole:
 
 
 def long_test(net: _core.Network, *, steps: int = LONG_STEPS, velocities: bool = False,
-              dt: float = 0.1, substeps: int = 10, method: str = "euler") -> int:
-    """Control steps ``net`` balances from the standard start, up to ``steps``."""
+              dt: float = 0.1, substeps: int = 10, method: str = "euler", precision: str = "f64") -> int:
+    """Control steps ``net`` balances from the standard start, up to ``steps``; the network
+    computes in ``precision`` (``"f32"`` for a champion evolved in it)."""
     env = DoublePole(velocities=velocities, steps=steps)
-    rollout([net], env, max_steps=steps, dt=dt, substeps=substeps, method=method)
+    rollout([net], env, max_steps=steps, dt=dt, substeps=substeps, method=method, precision=precision)
     return int(env.balanced[0])
 
 
 def generalization(net: _core.Network, *, velocities: bool = False, dt: float = 0.1,
-                   substeps: int = 10, method: str = "euler") -> int:
-    """Of the 625 :data:`GRID` starts, how many ``net`` balances for 1,000 steps."""
+                   substeps: int = 10, method: str = "euler", precision: str = "f64") -> int:
+    """Of the 625 :data:`GRID` starts, how many ``net`` balances for 1,000 steps, computing in
+    ``precision``."""
     env = DoublePole(velocities=velocities, start="grid")
     rollout([net], env, episodes=len(GRID), max_steps=GENERALIZATION_STEPS, dt=dt,
-            substeps=substeps, method=method)
+            substeps=substeps, method=method, precision=precision)
     return int(env.success(np.zeros(0), np.zeros(0, dtype=np.int64)).sum())
 
 

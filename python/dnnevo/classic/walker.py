@@ -177,12 +177,14 @@ def optimal_velocity(dt: float = 0.1) -> float:
 
 
 def velocities(net: _core.Network, *, sensor: bool = True, episodes: int = 20,
-               dt: float = 0.1, seed: int = 0, method: str = "euler") -> npt.NDArray[np.float64]:
+               dt: float = 0.1, seed: int = 0, method: str = "euler", precision: str = "f64"
+               ) -> npt.NDArray[np.float64]:
     """``net``'s average velocity in ``episodes`` episodes from random starting angles drawn
-    from ``seed`` with ``purpose="evaluate"`` (fresh, never a training episode)."""
+    from ``seed`` with ``purpose="evaluate"`` (fresh, never a training episode), the network
+    computing in ``precision``."""
     env = LeggedWalker(sensor=sensor, start="random", dt=dt)
     result = rollout([net], env, episodes=episodes, max_steps=env.steps, dt=dt, substeps=1,
-                     method=method, seed=seed, purpose="evaluate")
+                     method=method, seed=seed, purpose="evaluate", precision=precision)
     return np.asarray(result.returns[0])
 
 
@@ -202,12 +204,13 @@ class _Traced(LeggedWalker):
         return out
 
 
-def gait(net: _core.Network, *, sensor: bool = True, dt: float = 0.1, method: str = "euler"
-         ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_],
+def gait(net: _core.Network, *, sensor: bool = True, dt: float = 0.1, method: str = "euler",
+         precision: str = "f64") -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_],
                     npt.NDArray[np.float64]]:
     """One episode of ``net`` from the forward start: time, the leg's angle, whether the foot is
-    down, and the body's position, at each step (shape ``(T + 1,)`` each)."""
+    down, and the body's position, at each step (shape ``(T + 1,)`` each); the network computes
+    in ``precision``."""
     env = _Traced(sensor=sensor, dt=dt)
-    rollout([net], env, max_steps=env.steps, dt=dt, substeps=1, method=method)
+    rollout([net], env, max_steps=env.steps, dt=dt, substeps=1, method=method, precision=precision)
     angle, down, x = (np.array([step[k][0] for step in env.trace]) for k in range(3))
     return dt * np.arange(len(angle)), angle, down, x

@@ -15,6 +15,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "examples"))
 
 import incremental_plateau  # noqa: E402
+import nav1d_parents  # noqa: E402
 import nav1d_transfer  # noqa: E402
 import trigger_answers  # noqa: E402
 import cartpole_memory  # noqa: E402
@@ -79,6 +80,29 @@ def test_trigger_answers(capsys: pytest.CaptureFixture[str]) -> None:
                                      for word in ("wanted", "answered", "correct"))
         assert len(wanted) == len(answered) == len(correct) >= 8
         assert correct.endswith("++++") and answered.endswith(wanted[-4:])
+
+
+def test_nav1d_parents(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """One row per near seeker, under its own seed; the founder is the first network of the
+    founded run's first population, scored as evaluation scores it."""
+    from cli_helpers import run_cli
+
+    from dnnevo.evolution.seeding import Seeding
+
+    run = tmp_path / "near"
+    r = run_cli("run", "nav1d-near", "--quick", "--set", "task_params.chained=true", "--set",
+                "task_params.reinforcement_input=true", "--set", "n_inputs=2", "--set", "generations=2",
+                "--out", run, "--seed", "5")
+    assert r.returncode == 0, r.stderr
+    nav1d_parents.main([str(run)])
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 3 and lines[0].startswith("| seed | founder |")
+    cells = lines[2].strip("| ").split(" | ")
+    assert cells[0] == "5" and all(0.0 <= float(c) <= 2.0 for c in cells[1:])
+    cfg = dnnevo.presets.get(nav1d_parents.PRESET)
+    founder = Seeding((run,), False, 0.0, nav1d_parents.SPARE).networks(cfg.size, 5)[0]
+    score = dnnevo.evaluate(cfg.task, [founder], generation=0, seed=5, config=cfg)[0]
+    assert cells[1] == f"{score:.3f}"
 
 
 def test_nav1d_transfer(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

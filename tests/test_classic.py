@@ -146,8 +146,9 @@ def test_the_walker_preset_runs_resumes_and_is_judged_from_the_command_line(tmp_
 
 
 def test_the_judging_helpers_compute_in_the_precision_they_are_given() -> None:
-    """A champion evolved in f32 is judged in f32: each helper passes ``precision`` to the loop,
-    whose f32 trajectory is close to f64's but not the same, and an unknown precision is named."""
+    """A champion evolved in f32 is judged in f32: each helper passes ``precision`` to the loop
+    (an unknown precision is named from there), and an f32 trajectory is close to f64's but not
+    the same."""
     from dnnevo.classic import categorical as cp
     from dnnevo.classic import walker as lw
 
@@ -162,5 +163,9 @@ def test_the_judging_helpers_compute_in_the_precision_they_are_given() -> None:
     pole = dnnevo.Network.random(5, 3, seed=5)
     assert 0 <= dp.generalization(pole, precision="f32") <= len(dp.GRID)
     assert dp.long_test(pole, steps=50, precision="f32") <= 50
-    with pytest.raises(InvalidArgumentError, match='precision is "f16"'):
-        dp.long_test(pole, steps=5, precision="f16")
+    # Each helper hands its precision to the loop, which names a precision it does not know.
+    for judge in (dp.long_test, dp.generalization, dp.solves, lw.velocities, lw.gait, cp.grid_accuracy, cp.paths):
+        net = pole if judge in (dp.long_test, dp.generalization, dp.solves) else seer if judge in (
+            cp.grid_accuracy, cp.paths) else dnnevo.Network.random(5, 1, seed=3)
+        with pytest.raises(InvalidArgumentError, match='precision is "f16"'):
+            judge(net, precision="f16")  # type: ignore[operator]

@@ -242,6 +242,6 @@ def paths(net: _core.Network, *, dt: float = 0.1, pairs: int = 21, method: str =
     env = _Traced(start="grid", dt=dt)
     result = rollout([net], env, episodes=2 * pairs, max_steps=env.steps, dt=dt, substeps=1,
                      method=method, precision=precision)
-    height = HEIGHT - FALL_SPEED * dt * np.arange(env.steps + 1)
+    height = np.asarray(HEIGHT - FALL_SPEED * dt * np.arange(env.steps + 1), dtype=np.float64)
     ok = env.success(result.returns[0], result.lengths[0])
     return height, np.array(env.trace).T, ok

@@ -182,7 +182,7 @@ class DoublePole:
         settled = b > JIGGLE_WINDOW
         total = self.jiggle[:, rows].sum(axis=0)
         fitness[settled] += 0.9 * 0.75 / total[settled]
-        return fitness
+        return np.asarray(fitness, dtype=np.float64)
 
     def success(self, returns: npt.NDArray[np.float64], lengths: npt.NDArray[np.int64]
                 ) -> npt.NDArray[np.bool_]:

@@ -212,5 +212,6 @@ def gait(net: _core.Network, *, sensor: bool = True, dt: float = 0.1, method: st
     in ``precision``."""
     env = _Traced(sensor=sensor, dt=dt)
     rollout([net], env, max_steps=env.steps, dt=dt, substeps=1, method=method, precision=precision)
-    angle, down, x = (np.array([step[k][0] for step in env.trace]) for k in range(3))
-    return dt * np.arange(len(angle)), angle, down, x
+    angle, x = (np.array([step[k][0] for step in env.trace], dtype=np.float64) for k in (0, 2))
+    down = np.array([step[1][0] for step in env.trace], dtype=np.bool_)
+    return np.asarray(dt * np.arange(len(angle)), dtype=np.float64), angle, down, x

@@ -24,8 +24,10 @@ class Environment(Protocol):
     zero, as in the built-in tasks.
     """
 
-    observation_size: int
-    """The number of sensors ``M``: the networks' ``n_inputs``."""
+    @property
+    def observation_size(self) -> int:
+        """The number of sensors ``M``: the networks' ``n_inputs`` (an attribute or a
+        property)."""
 
     def reset(self, episodes: npt.NDArray[np.int64], rng: np.random.Generator) -> npt.ArrayLike:
         """Starts one episode in every row and returns the first observations, shape ``(B, M)``.

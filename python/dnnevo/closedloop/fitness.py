@@ -91,7 +91,7 @@ class ClosedLoop:
         self.env = env
         if precision not in ("f64", "f32"):
             raise ConfigError(f"precision is {precision!r}; expected 'f64' or 'f32'")
-        self.settings = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps,
+        self.settings: dict[str, Any] = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps,
                              method=method, precision=precision)
         self.validation_episodes = int(validation_episodes)
         if rows is not None and (isinstance(rows, bool) or not isinstance(rows, int | np.integer)

@@ -74,6 +74,8 @@ class GymEnvironment:
             obs_space, act_space = probe.observation_space, probe.action_space
         finally:
             probe.close()
+        if obs_space.shape is None:
+            raise ConfigError(f"{env_id}'s observation space has no shape; dnnevo needs a box of numbers")
         width = int(np.prod(obs_space.shape))
         self.columns = np.arange(width) if observations is None else np.asarray(observations)
         if self.columns.size and (self.columns.min() < 0 or self.columns.max() >= width):

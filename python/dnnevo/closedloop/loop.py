@@ -84,23 +84,25 @@ def rollout(
     if nonnegative("episodes", episodes) < 1:
         raise InvalidArgumentError("episodes is 0; it must be at least 1")
     nonnegative("max_steps", max_steps)
+    # The binding checks method, precision and purpose and names a value it does not know
+    # (InvalidArgumentError): they are plain strings here, as in ClosedLoop and the configs.
+    integrator: dict[str, Any] = dict(dt=dt, substeps=substeps, method=method, precision=precision)
+    draw: Any = purpose
     if rows is not None:
         if nonnegative("rows", rows) < episodes:
             raise InvalidArgumentError(f"rows is {rows}; it must be at least episodes ({episodes}), "
                                        "so that the first reset sees every episode number")
         if rows < len(networks) * episodes:
             return _queued(networks, env, episodes=episodes, max_steps=max_steps, rows=rows,
-                           rng=np.random.default_rng(_core.condition_seed(seed, generation, purpose)),
-                           batch=_core.Batch(networks, replicas=episodes, rows=rows, dt=dt,
-                                             substeps=substeps, method=method, precision=precision))
-    batch = _core.Batch(networks, replicas=episodes, dt=dt, substeps=substeps, method=method,
-                        precision=precision)
+                           rng=np.random.default_rng(_core.condition_seed(seed, generation, draw)),
+                           batch=_core.Batch(networks, replicas=episodes, rows=rows, **integrator))
+    batch = _core.Batch(networks, replicas=episodes, **integrator)
     batch.reset()
     rows, m = batch.rows, batch.n_inputs
     if getattr(env, "observation_size", m) != m:
         raise TaskError(f"{_name(env)}.observation_size is {env.observation_size}; the networks "
                         f"have {m} inputs")
-    rng = np.random.default_rng(_core.condition_seed(seed, generation, purpose))
+    rng = np.random.default_rng(_core.condition_seed(seed, generation, draw))
     labels = np.tile(np.arange(episodes, dtype=np.int64), batch.networks)
     obs = observations(_call(env, "reset", labels, rng), env, "reset", rows, m)
     active = np.ones(rows, dtype=bool)

@@ -35,7 +35,8 @@ from dnnevo.runs import RunDir, RunFileError, first_difference, short
 
 __all__ = ["EvolutionResult", "evaluate", "evolve", "resume"]
 
-FitnessFn = Callable[[list[_core.Network]], npt.ArrayLike]
+# Called as fitness(networks), or fitness(networks, *, generation, seed) when it takes those keywords.
+FitnessFn = Callable[..., npt.ArrayLike]
 Callback = Callable[[dict[str, float], GeneticAlgorithm], Any]
 
 #: Seconds between two checkpoints (one is also written at the end and on interruption).

@@ -331,10 +331,11 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
         raise DnnevoError(f"{source} holds no {SETTINGS_FILE}: not a reproduction's folder")
     manifest = _read_settings(settings_file)
     if (dest / SETTINGS_FILE).exists():
-        manifest = _joined(read_json(dest / SETTINGS_FILE), manifest)
-        if manifest is None:
+        joined = _joined(read_json(dest / SETTINGS_FILE), manifest)
+        if joined is None:
             raise DnnevoError(f"{dest / SETTINGS_FILE} holds another reproduction's settings than {settings_file}; "
                               f"empty {dest} first to replace them")
+        manifest = joined
     old = _read_provenance(dest / PROVENANCE_FILE)
     if old and old.get("seeds") != sorted(seeds):
         raise DnnevoError(f"{dest / PROVENANCE_FILE} covers seeds {old.get('seeds')}, not {sorted(seeds)}; "

@@ -106,3 +106,25 @@ def test_a_native_vector_environment_starts_queued_episodes_at_its_next_step() -
     assert np.array_equal(queued.returns, queued.lengths.astype(float))  # reward 1 per step
     lo, hi = np.percentile(everything.lengths, [0, 100])
     assert lo - 5 <= np.median(queued.lengths) <= hi + 5
+
+
+class _Words:
+    """A stand-in environment whose observations are text: a space without a shape."""
+
+    def __init__(self) -> None:
+        import gymnasium as gym
+
+        self.observation_space = gym.spaces.Text(5)
+        self.action_space = gym.spaces.Discrete(2)
+        self.metadata: dict = {}
+
+    def close(self) -> None:
+        pass
+
+
+def test_an_observation_space_without_a_shape_is_named_in_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    import gymnasium as gym
+
+    monkeypatch.setattr(gym, "make", lambda env_id, **kwargs: _Words())
+    with pytest.raises(ConfigError, match="Words-v0's observation space has no shape"):
+        GymEnvironment("Words-v0")

@@ -59,6 +59,18 @@ def test_run_show_assess_resume_sweep(tmp_path: Path) -> None:
     assert r.returncode == 0 and "sequence-1bit" in r.stdout
 
 
+def test_a_preset_meant_to_start_from_earlier_runs_warns_without_them(tmp_path: Path) -> None:
+    r = dnnevo("run", "nav1d-single-incremental", "--quick", "--set", "generations=1",
+               "--out", str(tmp_path / "single"))
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.splitlines()[0] == (
+        "dnnevo: warning: nav1d-single-incremental is meant to start from earlier runs (--seed-from "
+        "a chained nav1d-near run --spare-neurons 3); without --seed-from this run starts from "
+        "random networks")
+    r = dnnevo("run", "sequence-1bit", "--quick", "--set", "generations=1", "--out", str(tmp_path / "one"))
+    assert r.returncode == 0 and "warning" not in r.stderr, r.stderr
+
+
 @pytest.mark.parametrize(
     ("args", "fragment"),
     [

@@ -13,7 +13,7 @@ from typing import Any
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig, apply_overrides
 from dnnevo.errors import ConfigError, did_you_mean
 
-__all__ = ["Preset", "get", "names", "PRESETS"]
+__all__ = ["Preset", "get", "names", "unseeded_warning", "PRESETS"]
 
 
 @dataclass(frozen=True)
@@ -24,6 +24,9 @@ class Preset:
     config: EvolutionConfig
     quick: dict[str, Any] = field(default_factory=dict)
     """Overrides of the ``--quick`` variant."""
+    seeded_by: str = ""
+    """The ``--seed-from`` options the experiment is meant to start from (``dnnevo run`` and
+    ``sweep`` warn when they are missing); empty when it starts from random networks."""
 
 
 _QUICK = {"population": 60, "generations": 8}
@@ -76,12 +79,12 @@ _DIRECT16_CLAMP_EVAL = dataclasses.replace(_DIRECT16, task_params={**_DIRECT16.t
 # artefacts or undecided on fresh trials (README).
 _INCREMENTAL16 = Preset(
     "the paper's incremental route (§5.3) as it works here: 16 neurons, rank selection, elitism "
-    "20, score clamped once, champions validated on 128 trials per target and at dt/10; "
-    "--seed-from a sequence-1bit run --seed-from a sequence-2bit-alternating run "
-    "--seed-populations --spare-neurons 6; 1000 x 500",
+    "20, score clamped once, champions validated on 128 trials per target and at dt/10; 1000 x 500",
     dataclasses.replace(_DIRECT16_CLAMP_EVAL, champion_step_check=True,
                         task_params={**_DIRECT16_CLAMP_EVAL.task_params, "validation_trials": 128}),
     _QUICK,
+    "--seed-from a sequence-1bit run --seed-from a sequence-2bit-alternating run "
+    "--seed-populations --spare-neurons 6",
 )
 
 
@@ -116,10 +119,10 @@ PRESETS: dict[str, Preset] = {
     ),
     # The paper's incremental route read literally; it fails here (README), sequence-2bit works.
     "sequence-2bit-paper": Preset(
-        "paper §5.3 read literally: 0*, 1*, (01)*, (10)* from composites, 10 neurons; "
-        "--seed-from a sequence-1bit run --seed-from a sequence-2bit-alternating run",
+        "paper §5.3 read literally: 0*, 1*, (01)*, (10)* from composites, 10 neurons",
         _sequence(_TWO_BIT, 10, 500, 0.002, "generation-mean"),
         _QUICK,
+        "--seed-from a sequence-1bit run --seed-from a sequence-2bit-alternating run",
     ),
     "sequence-2bit-direct": Preset(
         "paper §5.3, the route that failed: the 2-bit task from random 10-neuron networks",
@@ -178,10 +181,11 @@ PRESETS: dict[str, Preset] = {
     "nav1d-single-incremental": Preset(
         "beyond the paper (§4.2): one network for the whole task, seeded from a chained near "
         "seeker, near_first_weight 0.5, rank selection, elitism 20, champions checked at dt/10; "
-        "--seed-from a chained nav1d-near run --spare-neurons 3; 8 neurons, 1000 x 500",
+        "8 neurons, 1000 x 500",
         dataclasses.replace(_SINGLE, generations=500, selection="rank", elitism=20, champion_step_check=True,
                             task_params={**_SINGLE.task_params, "near_first_weight": 0.5}),
         _QUICK,
+        "--seed-from a chained nav1d-near run --spare-neurons 3",
     ),
     # The paper solved it by generation 15; 100 generations (4 s) leave room for slower seeds.
     "landmark": Preset(
@@ -274,6 +278,24 @@ PRESETS: dict[str, Preset] = {
 def names() -> list[str]:
     """The preset names, sorted."""
     return sorted(PRESETS)
+
+
+def unseeded_warning(name: str, seeded: bool) -> str | None:
+    """A warning when preset ``name`` is meant to start from earlier runs (:attr:`Preset.seeded_by`)
+    and the run is not ``seeded``; None otherwise.
+
+    >>> unseeded_warning("sequence-1bit", seeded=False) is None
+    True
+    >>> unseeded_warning("sequence-2bit", seeded=True) is None
+    True
+    >>> print(unseeded_warning("nav1d-single-incremental", seeded=False))
+    nav1d-single-incremental is meant to start from earlier runs (--seed-from a chained nav1d-near run --spare-neurons 3); without --seed-from this run starts from random networks
+    """
+    preset = PRESETS.get(name)
+    if seeded or preset is None or not preset.seeded_by:
+        return None
+    return (f"{name} is meant to start from earlier runs ({preset.seeded_by}); without "
+            "--seed-from this run starts from random networks")
 
 
 def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -> EvolutionConfig:

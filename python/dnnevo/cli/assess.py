@@ -65,7 +65,7 @@ def assess(args: argparse.Namespace) -> int:
     if args.precision is not None:
         config = dataclasses.replace(config, precision=args.precision)
     a = tasks.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
-    extra = task.evaluate_extra(config, champion, seed)
+    extra = task.assess_extra(config, champion, seed)
     if args.dt is not None:
         extra = {"integrator": dataclasses.asdict(config.integrator), **extra}
     if config.precision != "f64" or evolved_in != "f64":

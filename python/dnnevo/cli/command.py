@@ -135,7 +135,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("preset", help="preset name (see 'dnnevo presets'), or python:module.Class for a "
                                   "closed-loop task class")
     p.add_argument("--seed", type=_nonnegative, default=0, help="random seed (default 0)")
-    p.add_argument("--out", type=Path, help="run folder (default runs/PRESET-seedN)")
+    p.add_argument("--out", type=Path, help="run folder (default runs/PRESET-seedN; with --quick, runs/PRESET-quick-seedN)")
     p.add_argument("--force", action="store_true",
                    help="overwrite a non-empty run folder (its run files and figures are removed)")
     seeding.add_arguments(p)
@@ -151,8 +151,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("dir", type=Path)
     p.add_argument("--threads", type=_positive)
     p.add_argument("--generations", type=_positive, metavar="N",
-                   help="run until generation N (extends a finished run; config.toml and the "
-                        "checkpoint are updated to say so)")
+                   help="run until generation N: more than the run's count extends it, fewer "
+                        "(not below the generations done) ends it sooner; config.toml and the "
+                        "checkpoint are updated to say so")
 
     p = sub.add_parser("show", help="summarise a run and write fitness.png", epilog="example: dnnevo show runs/demo")
     p.add_argument("dir", type=Path)
@@ -224,6 +225,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     stem = args.preset.removeprefix(PYTHON_TASK)
     out = args.out or Path("runs") / f"{stem}{'-quick' if args.quick else ''}-seed{args.seed}"
     how = seeding.Seeding.from_args(args)
+    _cli_sweep.warn_unseeded(args.preset, how)
     seeds = how.networks(config.size, args.seed) if how else None
     info = how.info() if how else None
     result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,
@@ -272,7 +274,9 @@ def _finished(path: Path) -> int | None:
 def _cmd_presets(args: argparse.Namespace) -> int:
     width = max(map(len, presets.names()))
     for name in presets.names():
-        print(f"{name:<{width}}  {presets.PRESETS[name].summary}")
+        preset = presets.PRESETS[name]
+        seeded_by = f"; {preset.seeded_by}" if preset.seeded_by else ""
+        print(f"{name:<{width}}  {preset.summary}{seeded_by}")
     return 0
 
 

@@ -65,6 +65,9 @@ class EvolutionResult:
     seed: int
     run_dir: Path | None
     interrupted: bool = False
+    """True when Ctrl-C or SIGTERM stopped the run before its last generation: ``evolve``
+    returns the champion so far rather than raising, and ``dnnevo.resume(run_dir)`` continues
+    the run. A script that needs the whole run checks this."""
     best_validation: tuple[float, float] | None = None
     """The champion's validation ``(rate, score)``, or None when it was chosen by training
     fitness."""

@@ -158,7 +158,8 @@ class RunDir:
         else:
             shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
             what = f"it holds files that are not a dnnevo run ({shown})"
-        return f"{self.path} is not empty; {what}; or choose another --out, or pass --force to overwrite"
+        return (f"{self.path} is not empty; {what}; or choose another folder (--out; out= in Python), "
+                "or overwrite it (--force; force=True in Python)")
 
     def create(self, *, force: bool, extra: tuple[str, ...] = ()) -> None:
         """Readies the locked folder for a new run: one that holds more than a lock file and

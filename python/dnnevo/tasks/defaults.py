@@ -11,7 +11,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.evaluation import assessment
 from dnnevo.evaluation.assessment import Assessment
 
-__all__ = ["evaluate_extra", "extra_lines", "overall", "rate_column"]
+__all__ = ["assess_extra", "extra_lines", "overall", "rate_column"]
 
 
 def rate_column(a: Assessment) -> tuple[str, dict[str, str]] | None:
@@ -24,7 +24,7 @@ def overall(a: Assessment) -> str:
     return assessment.verdict_line(a)
 
 
-def evaluate_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
+def assess_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
     """No further test."""
     return {}
 

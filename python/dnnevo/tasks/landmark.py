@@ -30,14 +30,14 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, combine, rate
 from dnnevo.runs import RunDir, save_figure, write_atomic_with
-from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
+from dnnevo.tasks.defaults import assess_extra, extra_lines, overall, rate_column
 
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 __all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT", "OUTPUT_NEURON", "FRAME_STEPS", "NAME", "ROBOT_LIKE", "THRESHOLD", "UNIT", "Record", "params",
-           "assess", "cast_rays", "default_world", "draw", "evaluate_extra", "extra_lines", "judge",
+           "assess", "cast_rays", "default_world", "draw", "assess_extra", "extra_lines", "judge",
            "overall", "preface", "rate_column", "record", "recorded_trials"]
 
 NAME = "landmark"

@@ -39,7 +39,7 @@ from dnnevo.errors import ConfigError
 from dnnevo.evaluation import assessment
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, Rate, combine
 from dnnevo.runs import RunDir, save_figure
-from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
+from dnnevo.tasks.defaults import assess_extra, extra_lines, overall, rate_column
 
 
 if TYPE_CHECKING:
@@ -63,7 +63,7 @@ __all__ = [
     "chains",
     "draw",
     "draw_system",
-    "evaluate_extra",
+    "assess_extra",
     "extra_lines",
     "fresh_chains",
     "goal_rate_table",

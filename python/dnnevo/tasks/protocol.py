@@ -62,11 +62,11 @@ class Task(Protocol):
     def overall(self, a: Assessment) -> str:
         """``assess``'s verdict line."""
 
-    def evaluate_extra(self, config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
+    def assess_extra(self, config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
         """Further tests ``assess`` runs on a champion, as JSON types (``{}`` for none)."""
 
     def extra_lines(self, extra: dict[str, Any]) -> list[str]:
-        """The text of :meth:`evaluate_extra`'s tests."""
+        """The text of :meth:`assess_extra`'s tests."""
 
     def draw(self, run: RunDir, config: EvolutionConfig, seed: int, *, animate: bool = False) -> list[str]:
         """Writes the task's figures of the run's champion into its folder; returns their names."""

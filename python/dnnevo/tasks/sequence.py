@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 __all__ = ["ANALYSIS_CONDITIONS", "DEFAULT_TRIALS", "INPUT_NAMES", "MAIN_INPUT", "OUTPUT_NEURON", "NAME", "ROBOT_LIKE", "SWITCH_AFTER", "SWITCH_HOLD", "SWITCH_TRIALS",
-           "THRESHOLD", "UNIT", "Switch", "TrialRecord", "assess", "draw", "evaluate_extra",
+           "THRESHOLD", "UNIT", "Switch", "TrialRecord", "assess", "draw", "assess_extra",
            "extra_lines", "fig5_pair", "fresh_timings", "judge", "overall", "preface",
            "rate_column", "recorded_trials", "run_trial", "switch_lines", "switch_table", "switch_test",
            "switch_trial", "target_list", "timings", "trial_order"]
@@ -322,7 +322,7 @@ def overall(a: Assessment) -> str:
     return f"overall: {a.verdict} ({why[a.verdict]})"
 
 
-def evaluate_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
+def assess_extra(config: EvolutionConfig, champion: _core.Network, seed: int) -> dict[str, Any]:
     """The switch test (:func:`switch_test`)."""
     return switch_test(config, champion, seed)
 

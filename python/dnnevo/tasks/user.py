@@ -32,7 +32,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError
 from dnnevo.evaluation.assessment import INDEPENDENT, Assessment, rate
 from dnnevo.runs import RunDir, save_figure
-from dnnevo.tasks.defaults import evaluate_extra, extra_lines, overall, rate_column
+from dnnevo.tasks.defaults import assess_extra, extra_lines, overall, rate_column
 from dnnevo.tasks.protocol import Analysis, View
 
 __all__ = ["DEFAULT_TRIALS", "Episode", "UserTask", "analysed", "record"]
@@ -63,7 +63,7 @@ class UserTask:
 
     rate_column = staticmethod(rate_column)
     overall = staticmethod(overall)
-    evaluate_extra = staticmethod(evaluate_extra)
+    assess_extra = staticmethod(assess_extra)
     extra_lines = staticmethod(extra_lines)
 
     def __init__(self, name: str) -> None:

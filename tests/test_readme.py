@@ -9,6 +9,7 @@ import os
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from test_docs import run_python_blocks
@@ -24,6 +25,29 @@ def test_python_example_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert (tmp_path / "net.json").is_file()
     assert sorted(os.listdir(tmp_path / "runs" / "py")) == [
         ".dnnevo.lock", "best.json", "checkpoint.json", "config.toml", "log.csv"]
+
+
+def test_the_light_task_is_as_easy_as_the_readme_says(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """The count of generation-0 networks that already reach the light in 200 fresh episodes is
+    computed here from the README's own class and config, not typed."""
+    from test_docs import blocks
+
+    from dnnevo import GeneticAlgorithm
+    from dnnevo.closedloop import rollout
+
+    text = README.read_text(encoding="utf-8")
+    claim = re.search(r"The task is easy: (\d+) of the 200 random networks that `evolve` starts from",
+                      " ".join(text.split()))
+    assert claim, "the README's claim about the light task moved"
+    code = next(code for _, code in blocks(README, ("python",)) if "class Light" in code)
+    namespace: dict[str, object] = {"__name__": "readme_example"}
+    monkeypatch.chdir(tmp_path)
+    exec(code.split("result = ")[0], namespace)  # the imports, the class and the config
+    networks = GeneticAlgorithm(namespace["config"], seed=0).ask().networks
+    fresh = rollout(networks, namespace["Light"](), episodes=200, max_steps=300, purpose="evaluate")
+    lengths = np.asarray(fresh.lengths).reshape(len(networks), 200)
+    assert int((lengths < 300).all(axis=1).sum()) == int(claim.group(1))
 
 
 def test_readme_is_short_and_undated() -> None:

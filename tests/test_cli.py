@@ -88,6 +88,16 @@ def test_a_preset_meant_to_start_from_earlier_runs_warns_without_them(tmp_path: 
         (["run", "sequence-1bit", "--quick", "--set", "population=-5"], "population is -5; it must be at least 2"),
         (["run", "sequence-1bit", "--quick", "--set", "generations=-3"], "generations is -3; it must be at least 1"),
         (["run", "sequence-1bit", "--quick", "--set", "nonsense"], "is not key=value"),
+        # A task's parameters are named as the config names them, in the config's words.
+        (["run", "sequence-1bit", "--quick", "--set", "task_params.triggers=0"],
+         "error: task_params.triggers is 0; it must be >= 1"),
+        (["run", "sequence-1bit", "--quick", "--set", "task_params.triggers=1.5"],
+         "sequence: task_params.triggers: invalid type: floating point `1.5`, expected an integer >= 0"),
+        # A nested table is reached through its dots, as in config.toml.
+        (["run", "landmark-robust", "--quick", "--set", "task_params.training.cone_deg=-1"],
+         "error: task_params.training.cone_deg is -1"),
+        (["run", "landmark", "--quick", "--set", "task_params.trials_per_landmark.x=1"],
+         "task_params.trials_per_landmark.x cannot be set: trials_per_landmark is 3, not a table"),
         (["run", "sequence-1bit", "--seed", "-1"], "-1 is negative"),
         (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
         (["resume", "/no/such/dir"], "/no/such/dir does not exist"),

@@ -299,6 +299,27 @@ def _parse_value(text: str) -> Any:
         return text
 
 
+def _with_key(table: dict[str, Any], path: list[str], value: Any, key: str) -> dict[str, Any]:
+    """``table`` with ``path`` set to ``value``: ``task_params.training.cone_deg`` reaches into
+    the nested table (made when missing), as in the config file; ``key`` is the setting's whole
+    name, for the error.
+
+    >>> _with_key({"a": 1, "b": {"c": 2}}, ["b", "d"], 3, "task_params.b.d")
+    {'a': 1, 'b': {'c': 2, 'd': 3}}
+    >>> _with_key({"a": 1}, ["a", "c"], 3, "task_params.a.c")
+    Traceback (most recent call last):
+      ...
+    dnnevo.errors.ConfigError: task_params.a.c cannot be set: a is 1, not a table
+    """
+    head, rest = path[0], path[1:]
+    if not rest:
+        return {**table, head: value}
+    inner = table.get(head, {})
+    if not isinstance(inner, dict):
+        raise ConfigError(f"{key} cannot be set: {head} is {inner!r}, not a table")
+    return {**table, head: _with_key(inner, rest, value, key)}
+
+
 def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> EvolutionConfig:
     """Applies ``key=value`` overrides, e.g. ``population=50``, ``integrator.dt=0.05``,
     ``ranges.tau=[1, 5]`` or ``task_params.targets=["01", "10"]``."""
@@ -321,7 +342,7 @@ def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> Evolutio
                 raise ConfigError(
                     f"unknown setting {key!r}{hint}; {head} has {', '.join(sorted(d[head]))}"
                 )
-            d[head] = {**d[head], sub: value}
+            d[head] = _with_key(d[head], sub.split(".") if head == "task_params" else [sub], value, key)
         else:
             d[head] = value
     return EvolutionConfig.from_dict(d)

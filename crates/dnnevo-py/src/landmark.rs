@@ -8,6 +8,7 @@ use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tasks::landmark::{LandmarkTask, Record};
+use tasks::RunConfig;
 
 use crate::arrays::AnyInt;
 use crate::detach::detached;
@@ -24,9 +25,13 @@ pub struct PyLandmarkTask {
 }
 
 impl PyLandmarkTask {
-    pub(crate) fn from_params(params: &serde_json::Value) -> PyResult<Self> {
+    /// The task a run config names; an error in its `task_params` is named as the config
+    /// names it.
+    pub(crate) fn from_run(run: &RunConfig) -> PyResult<Self> {
         Ok(PyLandmarkTask {
-            inner: LandmarkTask::from_params(params).py_err()?,
+            inner: LandmarkTask::from_params(&run.task_params())
+                .map_err(|e| run.in_task_params(e))
+                .py_err()?,
         })
     }
 }

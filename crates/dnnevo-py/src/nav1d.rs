@@ -7,6 +7,7 @@ use numpy::{PyArray1, PyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use tasks::nav1d::{Condition, Environment, Nav1dTask, Part, Record, Side, System};
+use tasks::RunConfig;
 
 use crate::arrays::AnyInt;
 use crate::detach::detached;
@@ -22,9 +23,13 @@ pub struct PyNav1dTask {
 }
 
 impl PyNav1dTask {
-    pub(crate) fn from_params(params: &serde_json::Value) -> PyResult<Self> {
+    /// The task a run config names; an error in its `task_params` is named as the config
+    /// names it.
+    pub(crate) fn from_run(run: &RunConfig) -> PyResult<Self> {
         Ok(PyNav1dTask {
-            inner: Nav1dTask::from_params(params).py_err()?,
+            inner: Nav1dTask::from_params(&run.task_params())
+                .map_err(|e| run.in_task_params(e))
+                .py_err()?,
         })
     }
 }

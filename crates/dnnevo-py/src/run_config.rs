@@ -65,11 +65,10 @@ impl PyRunConfig {
 
 /// The task object for `run.task`.
 fn build(py: Python<'_>, run: &RunConfig) -> PyResult<Py<PyAny>> {
-    let params = run.task_params();
     Ok(match run.task.as_str() {
-        "sequence" => Py::new(py, PySequenceTask::from_params(&params)?)?.into_any(),
-        "nav1d" => Py::new(py, PyNav1dTask::from_params(&params)?)?.into_any(),
-        "landmark" => Py::new(py, PyLandmarkTask::from_params(&params)?)?.into_any(),
+        "sequence" => Py::new(py, PySequenceTask::from_run(run)?)?.into_any(),
+        "nav1d" => Py::new(py, PyNav1dTask::from_run(run)?)?.into_any(),
+        "landmark" => Py::new(py, PyLandmarkTask::from_run(run)?)?.into_any(),
         // The registry's own message names the built-in tasks.
         other => {
             return Err(match run.build_task() {

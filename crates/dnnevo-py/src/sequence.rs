@@ -5,6 +5,7 @@
 use numpy::{PyArray1, PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use tasks::sequence::{SequenceTask, TrialRecord};
+use tasks::RunConfig;
 
 use crate::arrays::{pairs, AnyInt};
 use crate::detach::detached;
@@ -20,9 +21,13 @@ pub struct PySequenceTask {
 }
 
 impl PySequenceTask {
-    pub(crate) fn from_params(params: &serde_json::Value) -> PyResult<Self> {
+    /// The task a run config names; an error in its `task_params` is named as the config
+    /// names it.
+    pub(crate) fn from_run(run: &RunConfig) -> PyResult<Self> {
         Ok(PySequenceTask {
-            inner: SequenceTask::from_params(params).py_err()?,
+            inner: SequenceTask::from_params(&run.task_params())
+                .map_err(|e| run.in_task_params(e))
+                .py_err()?,
         })
     }
 }

@@ -18,7 +18,7 @@ pub(crate) fn config_from_params<C: DeserializeOwned + Default>(
         serde_json::Value::Object(_) => serde_path_to_error::deserialize(params).map_err(|e| {
             // Name the field (`training.cone_deg`) unless the error is about the whole object.
             let path = e.path().to_string();
-            let inner = e.into_inner();
+            let inner = plain_types(&e.into_inner().to_string());
             if path == "." {
                 Error::Config(format!("{name}: {inner}"))
             } else {
@@ -29,6 +29,25 @@ pub(crate) fn config_from_params<C: DeserializeOwned + Default>(
             "{name}: the parameters must be a JSON object of config fields; got {other}"
         ))),
     }
+}
+
+/// serde's message with Rust's type names (`expected usize`) in the words of the config.
+fn plain_types(message: &str) -> String {
+    const WORDS: [(&str, &str); 10] = [
+        ("expected usize", "expected an integer >= 0"),
+        ("expected u64", "expected an integer >= 0"),
+        ("expected u32", "expected an integer >= 0"),
+        ("expected u16", "expected an integer >= 0"),
+        ("expected u8", "expected an integer >= 0"),
+        ("expected i64", "expected an integer"),
+        ("expected i32", "expected an integer"),
+        ("expected f64", "expected a number"),
+        ("expected f32", "expected a number"),
+        ("expected a boolean", "expected true or false"),
+    ];
+    WORDS.iter().fold(message.to_string(), |m, (rust, plain)| {
+        m.replace(rust, plain)
+    })
 }
 
 /// `$body` with `$E` naming the element type of `$precision` (`f64` or `f32`): the one place a

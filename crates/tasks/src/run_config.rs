@@ -144,6 +144,30 @@ impl RunConfig {
         Ok(())
     }
 
+    /// A task's error about one of its parameters, named as the config names it
+    /// (`sequence: task_params.triggers: ...`, `task_params.triggers is 0; ...`): the task sees
+    /// `task_params` beside the settings the run sets ([`SET_BY_RUN`]), and its errors start
+    /// with the field, after the task's name when the field could not be read.
+    pub fn in_task_params(&self, e: Error) -> Error {
+        let Error::Config(message) = &e else {
+            return e;
+        };
+        let head = format!("{}: ", self.task);
+        let (head, rest) = match message.strip_prefix(&head) {
+            Some(rest) => (head.as_str(), rest),
+            None => ("", message.as_str()),
+        };
+        let names_a_param = self.task_params.keys().any(|key| {
+            rest.strip_prefix(key.as_str())
+                .is_some_and(|after| after.starts_with([':', '.', ' ', '[']))
+        });
+        if names_a_param {
+            Error::Config(format!("{head}task_params.{rest}"))
+        } else {
+            e
+        }
+    }
+
     /// The step check's integrator: the run's, [`STEP_CHECK_FINER`] times finer.
     fn finer_integrator(&self) -> Result<Integrator> {
         self.integrator
@@ -195,7 +219,8 @@ impl RunConfig {
     /// Builds the built-in task this config names, paired with its finer copy when
     /// `champion_step_check` is on; a caller's own task name is an error.
     pub fn build_task(&self) -> Result<Box<dyn Task>> {
-        let task = crate::build(&self.task, &self.task_params())?;
+        let task =
+            crate::build(&self.task, &self.task_params()).map_err(|e| self.in_task_params(e))?;
         if !self.champion_step_check {
             return Ok(task);
         }

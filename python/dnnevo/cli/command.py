@@ -103,7 +103,7 @@ class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit status 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        sys.stderr.write(f"dnnevo: error: {message} (see 'dnnevo --help')\n")
+        sys.stderr.write(f"dnnevo: error: {message} (see '{self.prog} --help')\n")
         raise SystemExit(2)
 
 
@@ -155,10 +155,16 @@ def build_parser() -> argparse.ArgumentParser:
                         "(not below the generations done) ends it sooner; config.toml and the "
                         "checkpoint are updated to say so")
 
-    p = sub.add_parser("show", help="summarise a run and write fitness.png", epilog="example: dnnevo show runs/demo")
+    p = sub.add_parser("show", help="summarise a run and write fitness.png",
+                       description="Summarise a run folder (its champion, generations, success rule "
+                                   "and the next command) and write fitness.png into it.",
+                       epilog="example: dnnevo show runs/demo")
     p.add_argument("dir", type=Path)
 
-    sub.add_parser("presets", help="list the presets")
+    sub.add_parser("presets", help="list the presets",
+                   description="List the named experiments that 'dnnevo run PRESET' and "
+                               "'dnnevo sweep PRESET' take, with what each is.",
+                   epilog="example: dnnevo presets")
 
     trials_help = (f"trials per target (sequence, default {DEFAULT_TRIALS['sequence']}), per landmark "
                    f"(landmark, default {DEFAULT_TRIALS['landmark']}), chains of trials (nav1d, "
@@ -208,6 +214,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "run's champion in f64)")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
+                       description="Write the run's figures (its fitness and the paper's figures "
+                                   "for its task, drawn from fresh trials) as PNGs into its folder.",
                        epilog="example: dnnevo plot runs/demo")
     p.add_argument("dir", type=Path)
     p.add_argument("--seed", type=_nonnegative, default=0, help="seed of the trials shown")

@@ -160,3 +160,39 @@ fn the_step_check_needs_a_step_that_can_be_made_finer_and_candidates() {
     let e = error(r#"{"champion_step_check": true, "validation_candidates": 0}"#);
     assert!(e.contains("needs validation_candidates >= 1"), "{e}");
 }
+
+#[test]
+fn a_task_s_error_names_its_parameter_as_the_config_does() {
+    let task_error = |json: &str| {
+        let config = RunConfig::from_json(json).unwrap();
+        config.build_task().err().unwrap().to_string()
+    };
+    for (json, message) in [
+        (
+            r#"{"task": "sequence", "task_params": {"triggers": 0}}"#,
+            "task_params.triggers is 0; it must be >= 1",
+        ),
+        (
+            r#"{"task": "sequence", "task_params": {"trials_per_target": -1}}"#,
+            "sequence: task_params.trials_per_target: invalid value: integer `-1`, expected an \
+             integer >= 0",
+        ),
+        (
+            r#"{"task": "sequence", "task_params": {"perf_base": true}}"#,
+            "sequence: task_params.perf_base: ",
+        ),
+        (
+            r#"{"task": "landmark", "task_params": {"training": {"cone_deg": -1}}}"#,
+            "task_params.training.cone_deg is -1",
+        ),
+        (
+            r#"{"task": "nav1d", "task_params": {"max_stepz": 3}}"#,
+            "nav1d: task_params.max_stepz: unknown field `max_stepz`",
+        ),
+    ] {
+        let e = task_error(json);
+        let e = e.strip_prefix("invalid config: ").unwrap_or(&e);
+        assert!(e.starts_with(message), "{json}: {e}");
+        assert!(!e.contains("usize"), "{json}: {e}");
+    }
+}

@@ -93,11 +93,14 @@ def test_a_preset_meant_to_start_from_earlier_runs_warns_without_them(tmp_path: 
          "error: task_params.triggers is 0; it must be >= 1"),
         (["run", "sequence-1bit", "--quick", "--set", "task_params.triggers=1.5"],
          "sequence: task_params.triggers: invalid type: floating point `1.5`, expected an integer >= 0"),
+        # A preset that warns when unseeded still gives a bad setting as its one line.
+        (["run", "sequence-2bit", "--quick", "--set", "task_params.triggers=0"],
+         "error: task_params.triggers is 0; it must be >= 1"),
         # A nested table is reached through its dots, as in config.toml.
         (["run", "landmark-robust", "--quick", "--set", "task_params.training.cone_deg=-1"],
          "error: task_params.training.cone_deg is -1"),
         (["run", "landmark", "--quick", "--set", "task_params.trials_per_landmark.x=1"],
-         "task_params.trials_per_landmark.x cannot be set: trials_per_landmark is 3, not a table"),
+         "task_params.trials_per_landmark.x cannot be set: task_params.trials_per_landmark is 3, not a table"),
         (["run", "sequence-1bit", "--seed", "-1"], "-1 is negative"),
         (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
         (["resume", "/no/such/dir"], "/no/such/dir does not exist"),

@@ -309,14 +309,15 @@ def _with_key(table: dict[str, Any], path: list[str], value: Any, key: str) -> d
     >>> _with_key({"a": 1}, ["a", "c"], 3, "task_params.a.c")
     Traceback (most recent call last):
       ...
-    dnnevo.errors.ConfigError: task_params.a.c cannot be set: a is 1, not a table
+    dnnevo.errors.ConfigError: task_params.a.c cannot be set: task_params.a is 1, not a table
     """
     head, rest = path[0], path[1:]
     if not rest:
         return {**table, head: value}
     inner = table.get(head, {})
     if not isinstance(inner, dict):
-        raise ConfigError(f"{key} cannot be set: {head} is {inner!r}, not a table")
+        reached = key[: len(key) - len(".".join(rest)) - 1]
+        raise ConfigError(f"{key} cannot be set: {reached} is {inner!r}, not a table")
     return {**table, head: _with_key(inner, rest, value, key)}
 
 

@@ -31,23 +31,38 @@ pub(crate) fn config_from_params<C: DeserializeOwned + Default>(
     }
 }
 
-/// serde's message with Rust's type names (`expected usize`) in the words of the config.
+/// serde's message with Rust's type names (`expected usize`) in the words of the config, each
+/// with its range (a name is replaced only where it ends: `expected u8` is not `expected u80`).
 fn plain_types(message: &str) -> String {
     const WORDS: [(&str, &str); 10] = [
         ("expected usize", "expected an integer >= 0"),
         ("expected u64", "expected an integer >= 0"),
-        ("expected u32", "expected an integer >= 0"),
-        ("expected u16", "expected an integer >= 0"),
-        ("expected u8", "expected an integer >= 0"),
+        ("expected u32", "expected an integer in [0, 4294967295]"),
+        ("expected u16", "expected an integer in [0, 65535]"),
+        ("expected u8", "expected an integer in [0, 255]"),
         ("expected i64", "expected an integer"),
-        ("expected i32", "expected an integer"),
+        (
+            "expected i32",
+            "expected an integer in [-2147483648, 2147483647]",
+        ),
         ("expected f64", "expected a number"),
         ("expected f32", "expected a number"),
         ("expected a boolean", "expected true or false"),
     ];
-    WORDS.iter().fold(message.to_string(), |m, (rust, plain)| {
-        m.replace(rust, plain)
-    })
+    let mut out = message.to_string();
+    for (rust, plain) in WORDS {
+        let mut from = 0;
+        while let Some(at) = out[from..].find(rust).map(|i| i + from) {
+            let end = at + rust.len();
+            if out[end..].starts_with(|c: char| c.is_alphanumeric() || c == '_') {
+                from = end;
+                continue;
+            }
+            out.replace_range(at..end, plain);
+            from = at + plain.len();
+        }
+    }
+    out
 }
 
 /// `$body` with `$E` naming the element type of `$precision` (`f64` or `f32`): the one place a

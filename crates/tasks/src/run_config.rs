@@ -147,7 +147,8 @@ impl RunConfig {
     /// A task's error about one of its parameters, named as the config names it
     /// (`sequence: task_params.triggers: ...`, `task_params.triggers is 0; ...`): the task sees
     /// `task_params` beside the settings the run sets ([`SET_BY_RUN`]), and its errors start
-    /// with the field, after the task's name when the field could not be read.
+    /// with the field, after the task's name when the field could not be read. Only a field the
+    /// config sets is recognised: an error that starts with a default field is left as it is.
     pub fn in_task_params(&self, e: Error) -> Error {
         let Error::Config(message) = &e else {
             return e;
@@ -158,8 +159,10 @@ impl RunConfig {
             None => ("", message.as_str()),
         };
         let names_a_param = self.task_params.keys().any(|key| {
-            rest.strip_prefix(key.as_str())
-                .is_some_and(|after| after.starts_with([':', '.', ' ', '[']))
+            !key.is_empty()
+                && rest
+                    .strip_prefix(key.as_str())
+                    .is_some_and(|after| after.starts_with([':', '.', ' ', '[']))
         });
         if names_a_param {
             Error::Config(format!("{head}task_params.{rest}"))
@@ -228,7 +231,8 @@ impl RunConfig {
             integrator: self.finer_integrator()?,
             ..self.clone()
         };
-        let finer = crate::build(&self.task, &finer.task_params())?;
+        let finer =
+            crate::build(&self.task, &finer.task_params()).map_err(|e| self.in_task_params(e))?;
         Ok(Box::new(StepChecked::new(task, finer)))
     }
 }

@@ -142,7 +142,7 @@ def plot_bifurcation(
 
 
 def plot_lesions(table: LesionTable, ax: Axes | None = None, *, title: str | None = None) -> Axes:
-    """One bar per lesion: how much the score drops (intact score minus lesioned score); red
+    """One bar per lesion: how much the success rate drops (intact minus lesioned); red
     where the lesion changes the verdict."""
     ax = plot.axes(ax)
     names = [x.name for x in table.lesions]
@@ -153,7 +153,8 @@ def plot_lesions(table: LesionTable, ax: Axes | None = None, *, title: str | Non
     ax.set_yticks(y, names, fontsize=7)
     ax.invert_yaxis()
     ax.axvline(0.0, color="k", lw=0.6)
-    ax.set_xlabel(f"score drop (intact score {table.score:.3f}, {table.trials} fresh trials, seed {table.seed})")
+    ax.set_xlabel(f"drop in success rate (intact rate {table.score:.3f}, {table.trials} fresh trials, "
+                  f"seed {table.seed})")
     if title:
         ax.set_title(title, fontsize=10)
     return ax

@@ -71,7 +71,7 @@ class Lesion:
     score: float
     """The lesioned network's score (see :attr:`LesionTable.score`)."""
     drop: float
-    """The intact score minus this one: how much the part matters."""
+    """The intact network's score minus this one: how much the part matters."""
     verdict: str
 
 

@@ -343,9 +343,9 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
                          + ("; none: no stable equilibrium reached (a cycle, or one not found)"
                             if (which < 0).any() else ""))
     if table is not None:
-        # The lesions' score is the lowest judged success rate, not the run's fitness.
-        lines.append(f"lesions ({table.trials} fresh trials, seed {table.seed}): intact, lowest success "
-                     f"rate {table.score:.3f} ({table.verdict})")
+        # The lesions' score is a judged success rate (the weakest target's), not the fitness.
+        lines.append(f"lesions ({table.trials} fresh trials, seed {table.seed}): intact rate "
+                     f"{table.score:.3f} ({table.verdict})")
         for x in sorted(table.lesions, key=lambda x: -x.drop)[:8]:
             lines.append(f"    {x.name:<22} rate {x.score:.3f}  drop {x.drop:+.3f}  {x.verdict}")
     return lines

@@ -233,7 +233,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     stem = args.preset.removeprefix(PYTHON_TASK)
     out = args.out or Path("runs") / f"{stem}{'-quick' if args.quick else ''}-seed{args.seed}"
     how = seeding.Seeding.from_args(args)
-    _cli_sweep.warn_unseeded(args.preset, how)
+    _cli_sweep.warn_unseeded(args.preset, how, config)
     seeds = how.networks(config.size, args.seed) if how else None
     info = how.info() if how else None
     result = dnnevo.evolve(config.task, config, seed=args.seed, out=out, threads=args.threads,

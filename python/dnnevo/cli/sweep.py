@@ -60,10 +60,13 @@ whose workers see OUT and the --seed-from runs at the same paths (pip install "d
 The results are the same bits as in this process."""
 
 
-def warn_unseeded(preset: str, how: seeding.Seeding | None) -> None:
-    """Says on stderr, in one line, when a preset meant to start from earlier runs has none."""
+def warn_unseeded(preset: str, how: seeding.Seeding | None, config: EvolutionConfig) -> None:
+    """Says on stderr, in one line, when a preset meant to start from earlier runs has none.
+    Its task is built first, so that a bad setting is the command's one line of error, not a
+    warning and then an error."""
     warning = presets.unseeded_warning(preset, seeded=how is not None)
     if warning:
+        config.native.builtin()
         print(f"dnnevo: warning: {warning}", file=sys.stderr)
 
 
@@ -81,7 +84,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     if args.workers is not None or args.scheduler is not None:
         scheduler.check_options(workers=args.workers, scheduler=args.scheduler)
     how = seeding.Seeding.from_args(args)
-    warn_unseeded(args.preset, how)
+    warn_unseeded(args.preset, how, config)
     settings = {"preset": args.preset, "eval_seed": args.eval_seed, "eval_trials": trials,
                 "dt_check": args.dt_check, "seeding": how.info() if how else None,
                 "config": config.to_dict()}

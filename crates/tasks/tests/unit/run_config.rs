@@ -189,6 +189,11 @@ fn a_task_s_error_names_its_parameter_as_the_config_does() {
             r#"{"task": "nav1d", "task_params": {"max_stepz": 3}}"#,
             "nav1d: task_params.max_stepz: unknown field `max_stepz`",
         ),
+        (
+            r#"{"task": "landmark", "task_params": {"sim": {"sonars": [{"rays": 4294967296}]}}}"#,
+            "landmark: task_params.sim.sonars[0].rays: invalid value: integer `4294967296`, \
+             expected an integer in [0, 4294967295]",
+        ),
     ] {
         let e = task_error(json);
         let e = e.strip_prefix("invalid config: ").unwrap_or(&e);

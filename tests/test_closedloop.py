@@ -449,9 +449,19 @@ def test_a_bad_task_name_or_setting_is_one_line(tmp_path, task: str, settings: l
 
 def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:
     (tmp_path / "seeker_rule.py").write_text(SEEKER)
-    assert dnnevo_command(tmp_path, "run", "python:seeker_rule.Ruleless", *SETTINGS).returncode == 0
+    run = dnnevo_command(tmp_path, "run", "python:seeker_rule.Ruleless", *SETTINGS)
+    assert run.returncode == 0, run.stderr
+    # The run's last line points at what works for it: plot, not assess.
+    assert run.stdout.splitlines()[-1].startswith(
+        "next: dnnevo plot runs/seeker_rule.Ruleless-seed0   (draws the champion on fresh episodes; "
+        "dnnevo assess needs a success rule"), run.stdout
     r = dnnevo_command(tmp_path, "assess", "runs/seeker_rule.Ruleless-seed0")
     assert r.returncode == 2 and "has no success rule: give Ruleless a success_rate" in r.stderr
+    # From another folder the class cannot be imported, and the error says where to run from.
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    r = dnnevo_command(elsewhere, "assess", "../runs/seeker_rule.Ruleless-seed0")
+    assert r.returncode == 2 and "run the command from the folder that holds seeker_rule.py" in r.stderr, r.stderr
 
 
 def test_naming_the_task_or_passing_it_evolves_the_same(tmp_path, monkeypatch) -> None:

@@ -27,6 +27,8 @@ from dnnevo import plot
 from dnnevo.config import EvolutionConfig
 from dnnevo.closedloop import named
 from dnnevo.config import PYTHON_TASK
+from dnnevo.closedloop.fitness import success_rule
+from dnnevo.errors import DnnevoError
 from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure
 
@@ -65,16 +67,35 @@ def success_line(task: str, success: Sequence[float], *, closed_loop: bool = Fal
             "trials")
 
 
+def _has_success_rule(task: str) -> bool:
+    """Whether the task class that ``task`` names has a success rule (``success`` and
+    ``success_rate``); True when it cannot be imported here, where ``assess`` says why."""
+    try:
+        cls = named.environment_class(task)
+    except DnnevoError:
+        return True
+    try:
+        success_rule(cls, task)
+    except DnnevoError:
+        return False
+    return True
+
+
 def next_line(path: Path, config: EvolutionConfig, done: int, *, interrupted: bool = False) -> str | None:
     """The command to run next on the run folder ``path`` after ``done`` generations, or None
     for a Python fitness function's run, which the command line can neither resume nor judge
     (a Python task class's run it can)."""
     if config.task.startswith(PYTHON_TASK) and not named.is_closed_loop(config):
         return None
-    judge = f"dnnevo assess {path}"
+    judge, verb = f"dnnevo assess {path}", "judge"
+    if config.task.startswith(PYTHON_TASK) and not _has_success_rule(config.task):
+        judge, verb = f"dnnevo plot {path}", "draw"
     if interrupted or done < config.generations:
         return (f"next: dnnevo resume {path} to run the rest of its {config.generations} generations, "
-                f"or {judge} to judge the champion so far")
+                f"or {judge} to {verb} the champion so far")
+    if verb == "draw":
+        return (f"next: {judge}   (draws the champion on fresh episodes; dnnevo assess needs a "
+                "success rule: docs/closed-loop.md#a-success-rule)")
     return f"next: {judge}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
 
 

@@ -79,7 +79,9 @@ def _import(module_name: str, task: str) -> Any:
     except ModuleNotFoundError as e:
         here = os.getcwd()
         if e.name != module_name.split(".")[0] or here in sys.path:
-            raise ConfigError(f"task {task!r}: cannot import {module_name}: {e}") from None
+            hint = (f"; run the command from the folder that holds {e.name}.py, or put that folder "
+                    "on PYTHONPATH" if e.name == module_name.split(".")[0] else "")
+            raise ConfigError(f"task {task!r}: cannot import {module_name}: {e}{hint}") from None
         sys.path.append(here)  # after everything else, so that it shadows no other module
         return _import(module_name, task)
     except Exception as e:

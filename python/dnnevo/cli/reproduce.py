@@ -47,7 +47,7 @@ landmark --eval-trials, else 100, or 10 with --quick). The report, OUT/report.md
 covers the seeds and families of the command that wrote it."""
 
 EXAMPLE = """examples:
-  dnnevo reproduce --quick --seeds 0-1 --out runs/repro-quick     about a minute on 2 cores
+  dnnevo reproduce --quick --seeds 0-1 --out runs/repro-quick     2-3 minutes on 2 cores
   dnnevo reproduce --only sequence --seeds 0-4 --out runs/repro-seq
   dnnevo reproduce --only classic --quick --seeds 0 --out runs/repro-classic
   dnnevo reproduce --out reproduce --workers 4 --threads-per-worker 2

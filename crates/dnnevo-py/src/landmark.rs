@@ -29,9 +29,7 @@ impl PyLandmarkTask {
     /// names it.
     pub(crate) fn from_run(run: &RunConfig) -> PyResult<Self> {
         Ok(PyLandmarkTask {
-            inner: LandmarkTask::from_params(&run.task_params())
-                .map_err(|e| run.in_task_params(e))
-                .py_err()?,
+            inner: run.with_task_params(LandmarkTask::from_params).py_err()?,
         })
     }
 }

@@ -27,9 +27,7 @@ impl PyNav1dTask {
     /// names it.
     pub(crate) fn from_run(run: &RunConfig) -> PyResult<Self> {
         Ok(PyNav1dTask {
-            inner: Nav1dTask::from_params(&run.task_params())
-                .map_err(|e| run.in_task_params(e))
-                .py_err()?,
+            inner: run.with_task_params(Nav1dTask::from_params).py_err()?,
         })
     }
 }

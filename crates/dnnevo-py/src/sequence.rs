@@ -25,9 +25,7 @@ impl PySequenceTask {
     /// names it.
     pub(crate) fn from_run(run: &RunConfig) -> PyResult<Self> {
         Ok(PySequenceTask {
-            inner: SequenceTask::from_params(&run.task_params())
-                .map_err(|e| run.in_task_params(e))
-                .py_err()?,
+            inner: run.with_task_params(SequenceTask::from_params).py_err()?,
         })
     }
 }

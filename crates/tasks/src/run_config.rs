@@ -144,12 +144,21 @@ impl RunConfig {
         Ok(())
     }
 
+    /// `build(task_params())`: a task built from this config's parameters, its errors named as
+    /// the config names them (see [`RunConfig::task_params`]).
+    pub fn with_task_params<T>(
+        &self,
+        build: impl FnOnce(&serde_json::Value) -> Result<T>,
+    ) -> Result<T> {
+        build(&self.task_params()).map_err(|e| self.in_task_params(e))
+    }
+
     /// A task's error about one of its parameters, named as the config names it
     /// (`sequence: task_params.triggers: ...`, `task_params.triggers is 0; ...`): the task sees
     /// `task_params` beside the settings the run sets ([`SET_BY_RUN`]), and its errors start
     /// with the field, after the task's name when the field could not be read. Only a field the
     /// config sets is recognised: an error that starts with a default field is left as it is.
-    pub fn in_task_params(&self, e: Error) -> Error {
+    fn in_task_params(&self, e: Error) -> Error {
         let Error::Config(message) = &e else {
             return e;
         };
@@ -222,8 +231,7 @@ impl RunConfig {
     /// Builds the built-in task this config names, paired with its finer copy when
     /// `champion_step_check` is on; a caller's own task name is an error.
     pub fn build_task(&self) -> Result<Box<dyn Task>> {
-        let task =
-            crate::build(&self.task, &self.task_params()).map_err(|e| self.in_task_params(e))?;
+        let task = self.with_task_params(|params| crate::build(&self.task, params))?;
         if !self.champion_step_check {
             return Ok(task);
         }
@@ -231,8 +239,7 @@ impl RunConfig {
             integrator: self.finer_integrator()?,
             ..self.clone()
         };
-        let finer =
-            crate::build(&self.task, &finer.task_params()).map_err(|e| self.in_task_params(e))?;
+        let finer = finer.with_task_params(|params| crate::build(&self.task, params))?;
         Ok(Box::new(StepChecked::new(task, finer)))
     }
 }

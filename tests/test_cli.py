@@ -179,9 +179,16 @@ def test_non_empty_out_is_refused(tmp_path: Path) -> None:
     assert (tmp_path / "x" / "keep.txt").read_text() == "mine"
 
 
-def test_debug_shows_traceback(tmp_path: Path) -> None:
-    r = dnnevo("--debug", "run", "no-such-preset", cwd=tmp_path)
+@pytest.mark.parametrize("args", [("--debug", "run", "no-such-preset"), ("run", "no-such-preset", "--debug"),
+                                  ("show", "--debug", "no-such-folder")])
+def test_debug_shows_traceback_before_or_after_the_command(tmp_path: Path, args: tuple[str, ...]) -> None:
+    r = dnnevo(*args, cwd=tmp_path)
     assert r.returncode != 0 and "Traceback" in r.stderr
+
+
+def test_without_debug_an_error_is_one_line(tmp_path: Path) -> None:
+    r = dnnevo("run", "no-such-preset", cwd=tmp_path)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
 def test_console_script_is_installed() -> None:

@@ -16,6 +16,7 @@ import argparse
 import os
 import traceback
 from pathlib import Path
+from typing import Any
 
 from dnnevo import figures
 from dnnevo.cli import analyze as _cli_analyze
@@ -107,6 +108,17 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+class _CommandParser(_Parser):
+    """A subcommand's parser: it takes ``--debug`` too, so that the option works after the
+    command as well as before it. Its default is left out (``SUPPRESS``), so that a command
+    without it keeps the value the top-level parser set."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                          help="show tracebacks on errors")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``dnnevo`` command."""
     parser = _Parser(
@@ -117,7 +129,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"dnnevo {dnnevo.__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_CommandParser)
 
     def run_options(p: argparse.ArgumentParser) -> None:
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",

@@ -6,7 +6,7 @@ and 1 sensor (the GA's initial population of seed 0), 2 episodes each (goal left
 up to 10 000 integration steps of dt = 0.1 per episode, the world updated at every step.
   built-in  dnnevo.evaluate("nav1d-far", networks, generation=0, seed=0): the Rust task, blocks of
             16 networks on all cores.
-  protocol  dnnevo.closedloop.rollout(networks, FarSeeker(), episodes=2, max_steps=10_000):
+  protocol  dnnevo.closedloop.rollout(networks, FarSeeker(), episodes=2, max_steps=10_000, substeps=1):
             the same world in NumPy (python/dnnevo/closedloop/far_seeker.py), one dnnevo.Batch
             step and one environment step per time step, over all 2P episodes at once.
 Both must give the same fitness bit for bit (the script exits with 1 if not). Figures are
@@ -45,7 +45,7 @@ def main() -> int:
         return dnnevo.evaluate("nav1d-far", networks, generation=0, seed=0, config=config)
 
     def protocol():
-        return rollout(networks, FarSeeker(), episodes=2, max_steps=MAX_STEPS, dt=0.1)
+        return rollout(networks, FarSeeker(), episodes=2, max_steps=MAX_STEPS, dt=0.1, substeps=1)
 
     result = protocol()
     same = np.array_equal(built_in(), result.fitness)

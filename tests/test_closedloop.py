@@ -160,7 +160,7 @@ def test_the_numpy_far_seeker_gives_the_built_in_fitness_bit_for_bit() -> None:
     config = dnnevo.EvolutionConfig(**{**config.to_dict(), "population": 96})
     nets = dnnevo.GeneticAlgorithm(config, seed=5).ask().networks
     built_in = dnnevo.evaluate("nav1d-far", nets, generation=0, seed=5, config=config)
-    result = rollout(nets, FarSeeker(), episodes=2, max_steps=10_000, dt=0.1)
+    result = rollout(nets, FarSeeker(), episodes=2, max_steps=10_000, dt=0.1, substeps=1)
     assert np.array_equal(result.fitness, built_in)
     assert 0 < built_in.mean() < 1  # the population is neither all right nor all wrong
     assert result.returns.shape == result.lengths.shape == (96, 2)
@@ -189,6 +189,19 @@ class Drift:
         self.t += 1
         done = np.full(len(self.x), self.t >= self.length)
         return (self.target - self.x)[:, None], -np.abs(self.target - self.x), done
+
+
+def test_rollout_with_its_defaults_scores_as_closed_loop_with_its_defaults() -> None:
+    """A champion evolved by ClosedLoop with its defaults and judged by rollout with its
+    defaults meets the same time step (both are the run config's [integrator])."""
+    from dnnevo.closedloop import ClosedLoop
+
+    nets = networks(6, m=1)
+    by_rollout = rollout(nets, Drift(length=40), episodes=3, max_steps=40, seed=2, generation=1).fitness
+    by_loop = ClosedLoop(Drift(length=40), episodes=3, max_steps=40)(nets, generation=1, seed=2)
+    assert np.array_equal(by_rollout, by_loop)
+    coarse = rollout(nets, Drift(length=40), episodes=3, max_steps=40, seed=2, generation=1, substeps=1)
+    assert not np.array_equal(coarse.fitness, by_loop)  # the step matters for this world
 
 
 def test_conditions_are_common_to_every_network_and_follow_seed_and_generation() -> None:
@@ -421,7 +434,12 @@ def test_a_task_class_named_on_the_command_line_runs_resumes_and_is_judged(tmp_p
     drawn = dnnevo_command(tmp_path, "plot", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
     assert drawn.returncode == 0, drawn.stderr
     assert (folder / "episodes.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    # show reads the folder without importing the task: it works with the module gone.
+    # show runs no code of the task: the module's top level is not run, and show works with
+    # the module gone.
+    (tmp_path / "seeker_cli.py").write_text(SEEKER + "\nopen('imported.marker', 'w').close()\n")
+    shown = dnnevo_command(tmp_path, "show", "runs/seeker_cli.Seeker-seed0")
+    assert shown.returncode == 0 and "next: dnnevo assess" in shown.stdout, shown.stderr
+    assert not (tmp_path / "imported.marker").exists()
     (tmp_path / "seeker_cli.py").unlink()
     shown = dnnevo_command(tmp_path, "show", "runs/seeker_cli.Seeker-seed0")
     assert shown.returncode == 0 and "8/8 generations" in shown.stdout, shown.stderr
@@ -457,6 +475,11 @@ def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:
         "dnnevo assess needs a success rule"), run.stdout
     r = dnnevo_command(tmp_path, "assess", "runs/seeker_rule.Ruleless-seed0")
     assert r.returncode == 2 and "has no success rule: give Ruleless a success_rate" in r.stderr
+    # show says the same from log.csv alone, with the module gone.
+    (tmp_path / "seeker_rule.py").unlink()
+    shown = dnnevo_command(tmp_path, "show", "runs/seeker_rule.Ruleless-seed0")
+    assert shown.returncode == 0 and "next: dnnevo plot runs/seeker_rule.Ruleless-seed0" in shown.stdout, shown.stdout
+    (tmp_path / "seeker_rule.py").write_text(SEEKER)
     # From another folder the class cannot be imported, and the error says where to run from.
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()

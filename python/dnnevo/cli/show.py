@@ -27,8 +27,6 @@ from dnnevo import plot
 from dnnevo.config import EvolutionConfig
 from dnnevo.closedloop import named
 from dnnevo.config import PYTHON_TASK
-from dnnevo.closedloop.fitness import success_rule
-from dnnevo.errors import DnnevoError
 from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure
 
@@ -67,30 +65,22 @@ def success_line(task: str, success: Sequence[float], *, closed_loop: bool = Fal
             "trials")
 
 
-def _has_success_rule(task: str) -> bool:
-    """Whether the task class that ``task`` names has a success rule (``success`` and
-    ``success_rate``); True when it cannot be imported here, where ``assess`` says why."""
-    try:
-        cls = named.environment_class(task)
-    except DnnevoError:
-        return True
-    try:
-        success_rule(cls, task)
-    except DnnevoError:
-        return False
-    return True
+def next_line(path: Path, config: EvolutionConfig, success: Sequence[float], *,
+              interrupted: bool = False) -> str | None:
+    """The command to run next on the run folder ``path``, from log.csv's ``champion_success``
+    column ``success`` (one value per generation done); None for a Python fitness function's
+    run, which the command line can neither resume nor judge (a Python task class's run it can).
 
-
-def next_line(path: Path, config: EvolutionConfig, done: int, *, interrupted: bool = False) -> str | None:
-    """The command to run next on the run folder ``path`` after ``done`` generations, or None
-    for a Python fitness function's run, which the command line can neither resume nor judge
-    (a Python task class's run it can)."""
+    Whether a task class has a success rule is read from that column (a run checks its champion
+    every generation, and writes NaN when the class has no rule), never by importing the class:
+    ``show`` runs no code of the run's task."""
     if config.task.startswith(PYTHON_TASK) and not named.is_closed_loop(config):
         return None
     judge, verb = f"dnnevo assess {path}", "judge"
-    if config.task.startswith(PYTHON_TASK) and not _has_success_rule(config.task):
+    ruleless = bool(success) and all(math.isnan(s) for s in success)
+    if config.task.startswith(PYTHON_TASK) and ruleless:
         judge, verb = f"dnnevo plot {path}", "draw"
-    if interrupted or done < config.generations:
+    if interrupted or len(success) < config.generations:
         return (f"next: dnnevo resume {path} to run the rest of its {config.generations} generations, "
                 f"or {judge} to {verb} the champion so far")
     if verb == "draw":
@@ -111,7 +101,7 @@ def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
     lines = [champion_line(None if fitness is None else float(fitness),
                            None if generation is None else int(generation), validation),
              success_line(config.task, success, closed_loop=named.is_closed_loop(config))]
-    step = next_line(path, config, len(success), interrupted=interrupted)
+    step = next_line(path, config, success, interrupted=interrupted)
     return lines if step is None else [*lines, step]
 
 

@@ -2,8 +2,9 @@
 against the :class:`~dnnevo.closedloop.Environment` protocol, as a user would write a task.
 
 It reproduces the built-in task's world exactly, so it proves that the protocol loses nothing: on
-the same networks, ``rollout(nets, FarSeeker(), episodes=2, max_steps=10_000, dt=0.1)`` gives
-the fitness of ``dnnevo.evaluate("nav1d-far", nets, ...)`` bit for bit (tests/test_closedloop.py),
+the same networks, ``rollout(nets, FarSeeker(), episodes=2, max_steps=10_000, dt=0.1,
+substeps=1)`` (one world step per integration step, as nav1d's) gives the fitness of
+``dnnevo.evaluate("nav1d-far", nets, ...)`` bit for bit (tests/test_closedloop.py),
 and ``bench/closed_loop.py`` times the two.
 
 The world: an agent on the line ``[-20, 20]`` starts at 0; the goal is one end, and a landmark

@@ -26,9 +26,14 @@ import numpy.typing as npt
 from dnnevo import _core
 from dnnevo._checks import nonnegative
 from dnnevo.closedloop.environment import Environment
+from dnnevo.config import IntegratorConfig
 from dnnevo.errors import InvalidArgumentError, TaskError
 
 __all__ = ["Rollout", "observations", "read_only", "rollout"]
+
+#: The run config's integrator, whose settings are rollout's defaults: a champion judged with
+#: ``rollout``'s defaults meets the time step that evolution with the config's defaults used.
+_INTEGRATOR = IntegratorConfig()
 
 
 @dataclass(frozen=True)
@@ -52,9 +57,9 @@ def rollout(
     *,
     episodes: int = 1,
     max_steps: int,
-    dt: float = 0.1,
-    substeps: int = 1,
-    method: str = "euler",
+    dt: float = _INTEGRATOR.dt,
+    substeps: int = _INTEGRATOR.substeps,
+    method: str = _INTEGRATOR.method,
     seed: int = 0,
     generation: int = 0,
     purpose: str = "trial",
@@ -62,7 +67,10 @@ def rollout(
     precision: str = "f64",
 ) -> Rollout:
     """Runs ``episodes`` episodes of every network in ``env``, all at once, for at most
-    ``max_steps`` time steps of ``substeps`` integration steps of ``dt`` each.
+    ``max_steps`` time steps of ``substeps`` integration steps of ``dt`` each. ``dt``,
+    ``substeps`` and ``method`` default to the run config's ``[integrator]`` (10 Euler steps of
+    0.1 per time step), as :class:`~dnnevo.closedloop.ClosedLoop`'s do, so that a champion
+    evolved with the defaults is judged at the step it was evolved with.
 
     ``rows`` runs at most that many episodes at once (at least ``episodes``; more than all
     ``P * episodes`` runs them all): when an episode ends, the next waiting one starts in its

@@ -465,6 +465,21 @@ def test_a_bad_task_name_or_setting_is_one_line(tmp_path, task: str, settings: l
     assert not (tmp_path / "runs").exists() or not any((tmp_path / "runs").iterdir())
 
 
+def test_a_run_whose_task_failed_in_generation_0_is_replaced_by_the_next_run(tmp_path) -> None:
+    """Nothing was evolved, and resuming could only fail again or, once the code is fixed, be
+    refused by the digest: the fixed command simply runs. A run that scored a generation is
+    still refused."""
+    broken = SEEKER.replace("        self.x += self.speed", "        raise ValueError('my bug')\n        self.x += self.speed")
+    (tmp_path / "seeker_g0.py").write_text(broken)
+    failed = dnnevo_command(tmp_path, "run", "python:seeker_g0.Seeker", *SETTINGS)
+    assert failed.returncode == 2 and "my bug" in failed.stderr, failed.stderr
+    (tmp_path / "seeker_g0.py").write_text(SEEKER)
+    fixed = dnnevo_command(tmp_path, "run", "python:seeker_g0.Seeker", *SETTINGS)
+    assert fixed.returncode == 0, fixed.stderr
+    again = dnnevo_command(tmp_path, "run", "python:seeker_g0.Seeker", *SETTINGS)
+    assert again.returncode == 2 and "it holds a run: resume it" in again.stderr, again.stderr
+
+
 def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:
     (tmp_path / "seeker_rule.py").write_text(SEEKER)
     run = dnnevo_command(tmp_path, "run", "python:seeker_rule.Ruleless", *SETTINGS)

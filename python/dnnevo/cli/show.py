@@ -27,6 +27,7 @@ from dnnevo import plot
 from dnnevo.config import EvolutionConfig
 from dnnevo.closedloop import named
 from dnnevo.config import PYTHON_TASK
+from dnnevo.closedloop.fitness import SUCCESS_EPISODES
 from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure
 
@@ -52,17 +53,23 @@ def success_line(task: str, success: Sequence[float], *, closed_loop: bool = Fal
     if task.startswith(PYTHON_TASK) and not closed_loop:
         return "success rule: none (a Python fitness function has no success rule)"
     judged = [s for s in success if not math.isnan(s)]
+    if not judged and closed_loop and success:
+        # A run checks a task class's champion every generation; NaN means it has no rule.
+        return ("success rule: none (the task class has no success_rate and success method: "
+                "docs/closed-loop.md#a-success-rule)")
     if not judged:
         return "success rule: not checked in this run (champion_success is nan in log.csv)"
+    # A task class's champion is checked on a few episodes only: say so, as assess will differ.
+    fresh = f"{SUCCESS_EPISODES} fresh episodes" if closed_loop else "fresh trials"
     met = [g for g, s in enumerate(success) if s == 1.0]
     if not met:
         n = len(success)
         return (f"success rule: not met in {n} generation{'s' * (n != 1)} (the champion failed it "
-                "on fresh trials)")
+                f"on {fresh})")
     if success[-1] == 1.0:
-        return f"success rule: met at generation {met[0]} (the champion passed it on fresh trials)"
-    return (f"success rule: met at generation {met[0]}, but the final champion fails it on fresh "
-            "trials")
+        return (f"success rule: met at generation {met[0]} (the champion passed it on {fresh}"
+                f"{'; dnnevo assess judges it on more, with an interval' if closed_loop else ''})")
+    return (f"success rule: met at generation {met[0]}, but the final champion fails it on {fresh}")
 
 
 def next_line(path: Path, config: EvolutionConfig, success: Sequence[float], *,

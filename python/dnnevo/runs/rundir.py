@@ -137,13 +137,37 @@ class RunDir:
         """A file that holds no run: the lock file, or a temporary file of a killed write."""
         return p.name == LOCK_NAME or temporary_of(p) is not None
 
+    def _unstarted(self, contents: list[Path]) -> bool:
+        """Whether ``contents`` are a run that stopped before its first generation was scored
+        (its task raised, or it was stopped): only its config, an empty log and a checkpoint
+        whose history is empty. Nothing was evolved, so a new run may take the folder; resuming
+        would only run the same generation 0 again, and could not once the task's code is
+        fixed (its digest changed)."""
+        names = {p.name for p in contents}
+        if not names <= {"config.toml", "log.csv", "checkpoint.json"} or "checkpoint.json" not in names:
+            return False
+        try:
+            doc = json.loads(read_text(self.checkpoint))
+        except (OSError, ValueError, DnnevoError):
+            return False
+        return isinstance(doc, dict) and doc.get("history") == []
+
+    def _contents(self) -> list[Path]:
+        """What the folder holds that a new run must not overwrite without ``force``: everything
+        but a lock file, temporary files of killed writes, and a run that never scored a
+        generation (:meth:`_unstarted`)."""
+        contents = [p for p in self.path.iterdir() if not self._leftover(p)]
+        return [] if self._unstarted(contents) else contents
+
     def refuse_unless_new(self, *, force: bool) -> None:
         """Refuses, before anything is written (the lock file included), a folder that holds
         more than a lock file and temporary files, unless ``force``; the message says what the
-        folder holds and what to do with it. :meth:`create` checks again under the lock."""
+        folder holds and what to do with it. A run that stopped before its first generation was
+        scored does not count: a new run replaces it. :meth:`create` checks again under the
+        lock."""
         if force or not self.path.is_dir():
             return
-        contents = [p for p in self.path.iterdir() if not self._leftover(p)]
+        contents = self._contents()
         if contents:
             raise DnnevoError(self._occupied(contents))
 
@@ -166,7 +190,7 @@ class RunDir:
         temporary files is refused unless ``force``, which removes the old run's files, figures
         and ``extra`` files (other files are kept)."""
         assert self._lock_fd is not None, "create() needs the lock"
-        contents = [p for p in self.path.iterdir() if not self._leftover(p)]
+        contents = self._contents()
         if contents and not force:
             raise DnnevoError(self._occupied(contents))
         self.clear(extra)

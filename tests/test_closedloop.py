@@ -251,6 +251,8 @@ class Broken(Drift):
             obs = np.array([["a"]] * len(obs))
         if fault == "int done":
             done = done.astype(int)
+        if fault == "bool done":
+            done = bool(done[0])
         if fault == "pair":
             return obs, reward
         return obs, reward, done
@@ -265,8 +267,9 @@ class Broken(Drift):
     pytest.param("overflow", r"made row 0's return inf; .* below 1.8e308 \(scale the rewards down",
                  marks=pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")),
     ("text obs", r"observations from step of dtype <U1; expected numbers"),
-    ("int done", r"Broken.step returned done of type ndarray, dtype int64"),
-    ("pair", r"Broken.step returned tuple; expected a tuple \(observations, rewards, done\)"),
+    ("int done", r"Broken.step returned done as an array of dtype int64 and shape \(8,\); expected a bool array"),
+    ("bool done", r"Broken.step returned done as a bool \(bool, shape \(\)\); expected a bool array of shape \(B,\)"),
+    ("pair", r"Broken.step returned a tuple of 2; expected three values \(observations, rewards, done\)"),
     ("reset shape", r"Broken.reset returned observations of shape \(8,\); expected \(B, M\) = \(8, 1\)"),
 ])
 def test_a_broken_task_gets_a_task_error_naming_the_method(fault: str, message: str) -> None:
@@ -355,6 +358,11 @@ def test_a_run_started_as_a_script_resumes_from_a_module_that_imports_the_same_c
 
     done = dnnevo.resume(tmp_path / "run", ClosedLoop(light.Light(), max_steps=10), progress=False)
     assert len(done.history["best"]) == 3
+    # The command line cannot import a script's class, and says so instead of pointing at assess.
+    shown = dnnevo_command(tmp_path, "show", "run")
+    assert "next: python:__main__.Light was defined in a script" in shown.stdout, shown.stdout
+    judged = dnnevo_command(tmp_path, "assess", "run")
+    assert judged.returncode == 2 and "is a class defined in a script" in judged.stderr, judged.stderr
     with pytest.raises(dnnevo.ConfigError, match="was evolved with python:__main__.Light"):
         dnnevo.resume(tmp_path / "run", ClosedLoop(light.Light(), max_steps=11), progress=False,
                       generations=4)
@@ -395,6 +403,10 @@ class Seeker:
 
 class Ruleless(Seeker):
     success_rate = None
+
+
+class Sizeless(Seeker):
+    observation_size = None
 
 
 def not_a_class():
@@ -450,8 +462,11 @@ def test_a_task_class_named_on_the_command_line_runs_resumes_and_is_judged(tmp_p
 
 
 @pytest.mark.parametrize("task, settings, message", [
-    ("python:seeker_bad.Nope", SETTINGS, "module seeker_bad has no Nope"),
+    ("python:seeker_bad.Nope", SETTINGS, "has no Nope"),
+    ("python:seeker_bad.Seekr", SETTINGS, "seeker_bad.py) has no Seekr (did you mean 'Seeker'?)"),
+    ("python:code.Seeker", SETTINGS, "module code (/"),  # the standard library's, named by its file
     ("python:seeker_bad.not_a_class", SETTINGS, "is a function; a task is a class with observation_size"),
+    ("python:seeker_bad.Sizeless", SETTINGS, "Sizeless.observation_size is None; expected the number of observations"),
     ("python:seeker_bad_missing.Seeker", SETTINGS, "cannot import seeker_bad_missing"),
     ("python:seeker_bad.Seeker", ["--set", "n_inputs=1"], "needs task_params.max_steps"),
     ("python:seeker_bad.Seeker", SETTINGS + ["--set", "n_inputs=2"], "n_inputs is 2; Seeker.observation_size is 1"),
@@ -478,6 +493,30 @@ def test_a_run_whose_task_failed_in_generation_0_is_replaced_by_the_next_run(tmp
     assert fixed.returncode == 0, fixed.stderr
     again = dnnevo_command(tmp_path, "run", "python:seeker_g0.Seeker", *SETTINGS)
     assert again.returncode == 2 and "it holds a run: resume it" in again.stderr, again.stderr
+
+
+def test_a_class_edited_after_its_run_is_refused_by_every_command_that_runs_the_champion(tmp_path) -> None:
+    (tmp_path / "seeker_edit.py").write_text(SEEKER)
+    run = dnnevo_command(tmp_path, "run", "python:seeker_edit.Seeker", *SETTINGS)
+    assert run.returncode == 0, run.stderr
+    (tmp_path / "seeker_edit.py").write_text(SEEKER.replace("speed=0.1", "speed=0.25"))
+    for command in ("plot", "assess", "analyze"):
+        r = dnnevo_command(tmp_path, command, "runs/seeker_edit.Seeker-seed0")
+        assert r.returncode == 2 and "evolved with another version of python:seeker_edit.Seeker" in r.stderr, \
+            (command, r.stderr)
+
+
+def test_a_fitness_that_tells_no_networks_apart_is_warned_about(tmp_path) -> None:
+    flat = SEEKER.replace("return np.sign(self.light - self.x)[:, None], -distance, distance < 0.05",
+                          "return np.sign(self.light - self.x)[:, None], 0 * distance, distance < 0.05")
+    (tmp_path / "seeker_flat.py").write_text(flat)
+    run = dnnevo_command(tmp_path, "run", "python:seeker_flat.Seeker", *SETTINGS)
+    assert run.returncode == 0, run.stderr
+    warning = "warning: every network scored the same in every one of 6 generations (std 0 in log.csv)"
+    assert warning in run.stdout, run.stdout
+    assert warning in dnnevo_command(tmp_path, "show", "runs/seeker_flat.Seeker-seed0").stdout
+    (tmp_path / "seeker_ok.py").write_text(SEEKER)
+    assert "warning" not in dnnevo_command(tmp_path, "run", "python:seeker_ok.Seeker", *SETTINGS).stdout
 
 
 def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:

@@ -54,6 +54,15 @@ class TaskError(DnnevoError, ValueError):
     dtype or a value that is not finite. The message names the method and the problem."""
 
 
+def with_article(noun: str) -> str:
+    """``noun`` after its indefinite article, for messages that name a type.
+
+    >>> with_article("int"), with_article("function")
+    ('an int', 'a function')
+    """
+    return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"
+
+
 def did_you_mean(name: str, known: Iterable[str]) -> str:
     """The hint an "unknown name" message carries: `` (did you mean 'x'?)`` naming the closest
     of ``known`` (up to three when they are about as close), or ``""`` when none is close.

@@ -26,6 +26,7 @@ def draw_run(path: str | Path, *, seed: int = 0, animate: bool = False, fitness:
     history = run.read_log(config)
     task = tasks.find(config.task)
     if task is None and named.is_closed_loop(config):  # a Python task class: its episodes
+        named.check_own_task(config, table)
         task = UserTask(config.task)
     if task is not None:
         run.read_best(config, table)

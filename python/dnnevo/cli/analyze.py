@@ -14,6 +14,7 @@ import numpy as np
 
 from dnnevo import _core, analysis, plot
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
+from dnnevo.closedloop import named
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.cli.outputs import try_write
@@ -102,6 +103,7 @@ def analyze(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     run = RunDir(args.dir)
     config, raw = run.read_run_config()
+    named.check_own_task(config, raw)
     net = run.read_best(config, raw)
     m = net.n_inputs
     task = analysis.analysed_task(config)

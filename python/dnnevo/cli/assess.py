@@ -54,9 +54,7 @@ def assess(args: argparse.Namespace) -> int:
     if named.is_python_task(config.task) and not named.is_closed_loop(config):
         raise ConfigError(f"{args.dir} was evolved with a Python fitness function ({config.task}), "
                           "which has no success rule; a task class can have one (docs/closed-loop.md)")
-    if named.is_closed_loop(config):
-        # The task class must still be the run's own, before --dt changes the settings.
-        named.closed_loop(config, digest=table.get("fitness_sha256"))
+    named.check_own_task(config, table)  # before --dt changes the settings
     if args.robot_like and not task.ROBOT_LIKE:
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
     if args.dt is not None:

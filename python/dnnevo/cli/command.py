@@ -264,7 +264,8 @@ def _report(result: dnnevo.EvolutionResult) -> int:
         champion["validation_rate"], champion["validation_score"] = result.best_validation
     assert result.run_dir is not None, "the command line always writes a run folder"
     for line in _cli_show.outcome(result.run_dir, result.config, champion,
-                                  list(h.get("champion_success", [])), interrupted=result.interrupted):
+                                  list(h.get("champion_success", [])), interrupted=result.interrupted,
+                                  std=list(h.get("std", []))):
         print(line)
     return 130 if result.interrupted else 0
 

@@ -10,6 +10,7 @@ print, in the same words:
 - **gen best** and **gen mean**: the training fitness of one generation (log.csv's ``best`` and
   ``mean``); without elitism the best network is not kept, so gen best may drop while the
   champion stays;
+- a **warning** when every network scored the same in every generation;
 - the **next** command.
 """
 
@@ -31,7 +32,7 @@ from dnnevo.closedloop.fitness import SUCCESS_EPISODES
 from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure
 
-__all__ = ["champion_line", "next_line", "outcome", "show", "success_line"]
+__all__ = ["blind_line", "champion_line", "next_line", "outcome", "show", "success_line"]
 
 
 def champion_line(fitness: float | None, generation: int | None,
@@ -83,6 +84,10 @@ def next_line(path: Path, config: EvolutionConfig, success: Sequence[float], *,
     ``show`` runs no code of the run's task."""
     if config.task.startswith(PYTHON_TASK) and not named.is_closed_loop(config):
         return None
+    if config.task.startswith(f"{PYTHON_TASK}__main__."):
+        return (f"next: {config.task} was defined in a script, which the command line cannot "
+                "import: resume, judge or draw it from Python (dnnevo.resume, rollout with "
+                "purpose=\"evaluate\"), or move the class into a module (docs/closed-loop.md)")
     judge, verb = f"dnnevo assess {path}", "judge"
     ruleless = bool(success) and all(math.isnan(s) for s in success)
     if config.task.startswith(PYTHON_TASK) and ruleless:
@@ -96,11 +101,25 @@ def next_line(path: Path, config: EvolutionConfig, success: Sequence[float], *,
     return f"next: {judge}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
 
 
+def blind_line(std: Sequence[float]) -> str | None:
+    """A warning when every network scored the same in every generation (log.csv's ``std``
+    column all 0): selection then chose at random, which a task whose fitness cannot tell
+    networks apart (a reward that is always 0) gives without any error."""
+    if not std or any(s != 0.0 for s in std):
+        return None
+    n = len(std)
+    return (f"warning: every network scored the same in {'every one' if n > 1 else 'the one'} of "
+            f"{n} generation{'s' * (n != 1)} (std 0 in log.csv): the fitness does not tell "
+            "networks apart, so selection was blind")
+
+
 def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
-            success: Sequence[float], *, interrupted: bool = False) -> list[str]:
-    """The champion, the success rule and the next command, as ``run``, ``resume`` and ``show``
-    end. ``champion`` is best.json's meta (``fitness``, ``generation`` and, when validated,
-    ``validation_rate`` and ``validation_score``)."""
+            success: Sequence[float], *, interrupted: bool = False,
+            std: Sequence[float] = ()) -> list[str]:
+    """The champion, the success rule, a warning when the fitness told no networks apart
+    (:func:`blind_line`, from the generations' ``std``) and the next command, as ``run``,
+    ``resume`` and ``show`` end. ``champion`` is best.json's meta (``fitness``, ``generation``
+    and, when validated, ``validation_rate`` and ``validation_score``)."""
     validation = None
     if "validation_rate" in champion and "validation_score" in champion:
         validation = (float(champion["validation_rate"]), float(champion["validation_score"]))
@@ -108,8 +127,9 @@ def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
     lines = [champion_line(None if fitness is None else float(fitness),
                            None if generation is None else int(generation), validation),
              success_line(config.task, success, closed_loop=named.is_closed_loop(config))]
+    blind = blind_line(std)
     step = next_line(path, config, success, interrupted=interrupted)
-    return lines if step is None else [*lines, step]
+    return [*lines, *(x for x in (blind, step) if x is not None)]
 
 
 def show(args: argparse.Namespace) -> int:
@@ -122,7 +142,8 @@ def show(args: argparse.Namespace) -> int:
     last = history[-1]
     print(f"{args.dir}: task {config.task}, population {config.population}, "
           f"{len(history)}/{config.generations} generations, {last['elapsed_s']:.1f} s")
-    lines = outcome(args.dir, config, champion.meta, [r["champion_success"] for r in history])
+    lines = outcome(args.dir, config, champion.meta, [r["champion_success"] for r in history],
+                    std=[r["std"] for r in history])
     print("\n".join(lines[:2]))
     print(f"last generation ({int(last['generation'])}): gen best {last['best']:.4f}, "
           f"gen mean {last['mean']:.4f}")

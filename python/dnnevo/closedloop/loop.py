@@ -27,7 +27,7 @@ from dnnevo import _core
 from dnnevo._checks import nonnegative
 from dnnevo.closedloop.environment import Environment
 from dnnevo.config import IntegratorConfig
-from dnnevo.errors import InvalidArgumentError, TaskError
+from dnnevo.errors import InvalidArgumentError, TaskError, with_article
 
 __all__ = ["Rollout", "observations", "read_only", "rollout"]
 
@@ -265,7 +265,9 @@ def _outputs(out: Any, env: Any, rows: int, m: int, rates: npt.NDArray[np.float6
     try:
         obs, reward, done = out
     except (TypeError, ValueError):
-        raise TaskError(f"{_name(env)}.step returned {type(out).__name__}; expected a tuple "
+        what = (f"a {type(out).__name__} of {len(out)}" if isinstance(out, tuple | list)
+                else with_article(type(out).__name__))
+        raise TaskError(f"{_name(env)}.step returned {what}; expected three values "
                         "(observations, rewards, done)") from None
     if type(obs) is not np.ndarray or obs.shape != (rows, m) or obs.dtype.char not in "df":
         obs = observations(obs, env, "step", rows, m)
@@ -273,12 +275,14 @@ def _outputs(out: Any, env: Any, rows: int, m: int, rates: npt.NDArray[np.float6
         obs = obs.copy()  # the batch writes the rates while it reads the observations
     if type(reward) is not np.ndarray or reward.shape != (rows,) or reward.dtype.kind not in "biuf":
         reward = _row_values(reward, env, rows)
+    given = done
     if type(done) is not np.ndarray:
         done = np.asarray(done)
     if done.shape != (rows,) or done.dtype.char != "?":
-        raise TaskError(f"{_name(env)}.step returned done of type {type(done).__name__}, dtype "
-                        f"{getattr(done, 'dtype', '?')} and shape {np.shape(done)}; expected a "
-                        f"bool array of shape (B,) = ({rows},)")
+        what = (f"an array of dtype {done.dtype} and shape {done.shape}" if type(given) is np.ndarray
+                else f"{with_article(type(given).__name__)} ({np.asarray(given).dtype}, shape {np.shape(given)})")
+        raise TaskError(f"{_name(env)}.step returned done as {what}; expected a bool array of "
+                        f"shape (B,) = ({rows},), one flag per row")
     return obs, reward, done
 
 

@@ -28,15 +28,17 @@ folder.
 from __future__ import annotations
 
 import importlib
+import numbers
 import os
 import sys
 from typing import Any
 
 from dnnevo.closedloop.fitness import ROLLOUT_KEYS, ClosedLoop
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
-from dnnevo.errors import ConfigError, TaskError
+from dnnevo.errors import ConfigError, TaskError, did_you_mean, with_article
 
-__all__ = ["ROLLOUT_KEYS", "closed_loop", "environment_class", "is_closed_loop", "is_python_task"]
+__all__ = ["ROLLOUT_KEYS", "check_own_task", "closed_loop", "environment_class", "is_closed_loop",
+           "is_python_task"]
 
 #: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
 _MEMBERS = ("observation_size", "reset", "step")
@@ -60,14 +62,24 @@ def environment_class(task: str) -> type:
     module_name, _, attr = path.rpartition(".")
     if not module_name or not attr:
         raise ConfigError(f"task {task!r} names no class; expected python:module.Class")
+    if module_name == "__main__":
+        raise ConfigError(f"task {task!r} is a class defined in a script, which no other process "
+                          f"can import: move {attr} into a module of its own to run, judge or draw "
+                          "it from the command line, or do so from Python (docs/closed-loop.md)")
     module = _import(module_name, task)
     cls = getattr(module, attr, None)
     if cls is None:
-        raise ConfigError(f"task {task!r}: module {module_name} has no {attr}")
+        # Name the file: a module named like one of the standard library's (code, test, ...)
+        # is that one, not the user's.
+        where = getattr(module, "__file__", None)
+        classes = [k for k, v in vars(module).items() if isinstance(v, type) and not k.startswith("_")]
+        raise ConfigError(f"task {task!r}: module {module_name}"
+                          f"{f' ({where})' if where else ''} has no {attr}{did_you_mean(attr, classes)}")
     missing = [m for m in _MEMBERS if not hasattr(cls, m)]
     if not isinstance(cls, type) or missing:
-        what = type(cls).__name__ if not isinstance(cls, type) else f"class without {', '.join(missing)}"
-        raise ConfigError(f"task {task!r} is a {what}; a task is a class with observation_size, "
+        what = (with_article(type(cls).__name__) if not isinstance(cls, type)
+                else f"a class without {', '.join(missing)}")
+        raise ConfigError(f"task {task!r} is {what}; a task is a class with observation_size, "
                           "reset(episodes, rng) and step(rates, active) (docs/closed-loop.md)")
     return cls
 
@@ -104,7 +116,11 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> Closed
         raise ConfigError(f"{cls.__name__}(**task_params) failed: {e}") from None
     except Exception as e:
         raise TaskError(f"{cls.__name__}(**task_params) raised {type(e).__name__}: {e}") from e
-    if env.observation_size != config.n_inputs:
+    size = env.observation_size
+    if isinstance(size, bool) or not isinstance(size, numbers.Integral) or size < 1:
+        raise ConfigError(f"{cls.__name__}.observation_size is {size!r}; expected the number of "
+                          "observations the task gives at each step, a whole number >= 1")
+    if size != config.n_inputs:
         raise ConfigError(f"n_inputs is {config.n_inputs}; {cls.__name__}.observation_size is "
                           f"{env.observation_size} (set n_inputs = {env.observation_size})")
     i = config.integrator
@@ -115,3 +131,13 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> Closed
                           "the environment's attributes or the rollout's settings differ, or the run "
                           "began from Python with an environment made with other arguments)")
     return loop
+
+
+def check_own_task(config: EvolutionConfig, table: dict[str, Any]) -> None:
+    """Raises a :class:`~dnnevo.ConfigError` unless the task class that a run's ``config``
+    names is still the one it was evolved with (``table``, its ``[run]`` table, holds the
+    digest); nothing for a built-in task or a fitness function. What judges or draws a run's
+    champion (``assess``, ``plot``, ``analyze``) calls it first: an edited class would judge the
+    champion in another task."""
+    if is_closed_loop(config):
+        closed_loop(config, digest=table.get("fitness_sha256"))

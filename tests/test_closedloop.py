@@ -255,6 +255,8 @@ class Broken(Drift):
             done = bool(done[0])
         if fault == "pair":
             return obs, reward
+        if fault == "none":
+            return None
         return obs, reward, done
 
 
@@ -270,6 +272,7 @@ class Broken(Drift):
     ("int done", r"Broken.step returned done as an array of dtype int64 and shape \(8,\); expected a bool array"),
     ("bool done", r"Broken.step returned done as a bool \(bool, shape \(\)\); expected a bool array of shape \(B,\)"),
     ("pair", r"Broken.step returned a tuple of 2; expected three values \(observations, rewards, done\)"),
+    ("none", r"Broken.step returned None \(does it end with a return\?\); expected three values"),
     ("reset shape", r"Broken.reset returned observations of shape \(8,\); expected \(B, M\) = \(8, 1\)"),
 ])
 def test_a_broken_task_gets_a_task_error_naming_the_method(fault: str, message: str) -> None:
@@ -344,10 +347,13 @@ def test_a_run_started_as_a_script_resumes_from_a_module_that_imports_the_same_c
         "if __name__ == '__main__':\n"
         "    config = dnnevo.EvolutionConfig(population=8, generations=3, size=2, n_inputs=1)\n"
         "    dnnevo.evolve(ClosedLoop(Light(), max_steps=10), config, out='run', progress=False,\n"
-        "                  callback=lambda stats, ga: ga.generation >= 1)\n")
+        "                  callback=lambda stats, ga: ga.generation >= 1)\n"
+        "    from dnnevo.figures import draw_run\n"
+        "    print(draw_run('run'))  # the script that defined the class can draw its run\n")
     import subprocess
     import sys
-    subprocess.run([sys.executable, "light.py"], cwd=tmp_path, check=True)
+    drawn = subprocess.run([sys.executable, "light.py"], cwd=tmp_path, check=True, capture_output=True, text=True)
+    assert "episodes.png" in drawn.stdout, drawn.stdout + drawn.stderr
     assert 'task = "python:__main__.Light"' in (tmp_path / "run" / "config.toml").read_text()
     sys.path.insert(0, str(tmp_path))
     try:
@@ -507,12 +513,14 @@ def test_a_class_edited_after_its_run_is_refused_by_every_command_that_runs_the_
 
 
 def test_a_fitness_that_tells_no_networks_apart_is_warned_about(tmp_path) -> None:
+    # 0.1 at every step, no episode ending early: the std of equal returns is not exactly 0
+    # (about 1e-16), best = min is.
     flat = SEEKER.replace("return np.sign(self.light - self.x)[:, None], -distance, distance < 0.05",
-                          "return np.sign(self.light - self.x)[:, None], 0 * distance, distance < 0.05")
+                          "return np.sign(self.light - self.x)[:, None], 0 * distance + 0.1, distance < -1")
     (tmp_path / "seeker_flat.py").write_text(flat)
     run = dnnevo_command(tmp_path, "run", "python:seeker_flat.Seeker", *SETTINGS)
     assert run.returncode == 0, run.stderr
-    warning = "warning: every network scored the same in every one of 6 generations (std 0 in log.csv)"
+    warning = "warning: every network scored the same in every one of its 6 generations (best = min in log.csv)"
     assert warning in run.stdout, run.stdout
     assert warning in dnnevo_command(tmp_path, "show", "runs/seeker_flat.Seeker-seed0").stdout
     (tmp_path / "seeker_ok.py").write_text(SEEKER)

@@ -55,12 +55,14 @@ class TaskError(DnnevoError, ValueError):
 
 
 def with_article(noun: str) -> str:
-    """``noun`` after its indefinite article, for messages that name a type.
+    """``noun`` after its indefinite article, for messages that name a type (``ndarray`` is
+    read "en-dee-array").
 
-    >>> with_article("int"), with_article("function")
-    ('an int', 'a function')
+    >>> with_article("int"), with_article("function"), with_article("ndarray")
+    ('an int', 'a function', 'an ndarray')
     """
-    return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"
+    vowel = noun[:1].lower() in "aeiou" or noun.startswith("ndarray")
+    return f"{'an' if vowel else 'a'} {noun}"
 
 
 def did_you_mean(name: str, known: Iterable[str]) -> str:

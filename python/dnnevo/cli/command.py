@@ -265,7 +265,7 @@ def _report(result: dnnevo.EvolutionResult) -> int:
     assert result.run_dir is not None, "the command line always writes a run folder"
     for line in _cli_show.outcome(result.run_dir, result.config, champion,
                                   list(h.get("champion_success", [])), interrupted=result.interrupted,
-                                  std=list(h.get("std", []))):
+                                  best=list(h.get("best", [])), worst=list(h.get("min", []))):
         print(line)
     return 130 if result.interrupted else 0
 

@@ -68,8 +68,9 @@ def success_line(task: str, success: Sequence[float], *, closed_loop: bool = Fal
         return (f"success rule: not met in {n} generation{'s' * (n != 1)} (the champion failed it "
                 f"on {fresh})")
     if success[-1] == 1.0:
+        more = closed_loop and not task.startswith(f"{PYTHON_TASK}__main__.")  # assess can import it
         return (f"success rule: met at generation {met[0]} (the champion passed it on {fresh}"
-                f"{'; dnnevo assess judges it on more, with an interval' if closed_loop else ''})")
+                f"{'; dnnevo assess judges it on more, with an interval' if more else ''})")
     return (f"success rule: met at generation {met[0]}, but the final champion fails it on {fresh}")
 
 
@@ -101,23 +102,25 @@ def next_line(path: Path, config: EvolutionConfig, success: Sequence[float], *,
     return f"next: {judge}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
 
 
-def blind_line(std: Sequence[float]) -> str | None:
-    """A warning when every network scored the same in every generation (log.csv's ``std``
-    column all 0): selection then chose at random, which a task whose fitness cannot tell
-    networks apart (a reward that is always 0) gives without any error."""
-    if not std or any(s != 0.0 for s in std):
+def blind_line(best: Sequence[float], worst: Sequence[float]) -> str | None:
+    """A warning when every network scored the same in every generation (log.csv's ``best``
+    and ``min`` equal in every row; its ``std`` of equal values need not be exactly 0):
+    selection then chose at random, which a task whose fitness cannot tell networks apart (a
+    reward that never changes) gives without any error."""
+    if not best or any(b != w for b, w in zip(best, worst, strict=True)):
         return None
-    n = len(std)
-    return (f"warning: every network scored the same in {'every one' if n > 1 else 'the one'} of "
-            f"{n} generation{'s' * (n != 1)} (std 0 in log.csv): the fitness does not tell "
-            "networks apart, so selection was blind")
+    n = len(best)
+    when = f"every one of its {n} generations" if n > 1 else "its only generation"
+    return (f"warning: every network scored the same in {when} (best = min in log.csv): the "
+            "fitness does not tell networks apart, so selection was blind")
 
 
 def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
             success: Sequence[float], *, interrupted: bool = False,
-            std: Sequence[float] = ()) -> list[str]:
+            best: Sequence[float] = (), worst: Sequence[float] = ()) -> list[str]:
     """The champion, the success rule, a warning when the fitness told no networks apart
-    (:func:`blind_line`, from the generations' ``std``) and the next command, as ``run``,
+    (:func:`blind_line`, from the generations' ``best`` and ``worst`` fitness) and the next
+    command, as ``run``,
     ``resume`` and ``show`` end. ``champion`` is best.json's meta (``fitness``, ``generation``
     and, when validated, ``validation_rate`` and ``validation_score``)."""
     validation = None
@@ -127,7 +130,7 @@ def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
     lines = [champion_line(None if fitness is None else float(fitness),
                            None if generation is None else int(generation), validation),
              success_line(config.task, success, closed_loop=named.is_closed_loop(config))]
-    blind = blind_line(std)
+    blind = blind_line(best, worst)
     step = next_line(path, config, success, interrupted=interrupted)
     return [*lines, *(x for x in (blind, step) if x is not None)]
 
@@ -143,7 +146,7 @@ def show(args: argparse.Namespace) -> int:
     print(f"{args.dir}: task {config.task}, population {config.population}, "
           f"{len(history)}/{config.generations} generations, {last['elapsed_s']:.1f} s")
     lines = outcome(args.dir, config, champion.meta, [r["champion_success"] for r in history],
-                    std=[r["std"] for r in history])
+                    best=[r["best"] for r in history], worst=[r["min"] for r in history])
     print("\n".join(lines[:2]))
     print(f"last generation ({int(last['generation'])}): gen best {last['best']:.4f}, "
           f"gen mean {last['mean']:.4f}")

@@ -24,7 +24,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo.closedloop.environment import Environment
-from dnnevo.closedloop.loop import Rollout, rollout
+from dnnevo.closedloop.loop import DEFAULT_INTEGRATOR, Rollout, rollout
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
 from dnnevo.errors import ConfigError, TaskError
 
@@ -35,7 +35,6 @@ __all__ = ["ROLLOUT_KEYS", "ClosedLoop"]
 ROLLOUT_KEYS = ("episodes", "max_steps", "validation_episodes", "rows")
 
 
-_INTEGRATOR = IntegratorConfig()
 
 #: Fresh episodes on which a run checks, at each change of champion, whether it meets the task
 #: class's success rule (``dnnevo assess`` judges on as many as asked, 200 by default).
@@ -80,8 +79,8 @@ class ClosedLoop:
     """
 
     def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int,
-                 dt: float = _INTEGRATOR.dt, substeps: int = _INTEGRATOR.substeps,
-                 method: str = _INTEGRATOR.method, name: str | None = None,
+                 dt: float = DEFAULT_INTEGRATOR.dt, substeps: int = DEFAULT_INTEGRATOR.substeps,
+                 method: str = DEFAULT_INTEGRATOR.method, name: str | None = None,
                  validation_episodes: int = VALIDATION_EPISODES, rows: int | None = None,
                  precision: str = "f64") -> None:
         if isinstance(validation_episodes, bool) or not isinstance(validation_episodes, int | np.integer) \

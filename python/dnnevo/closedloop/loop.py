@@ -31,9 +31,9 @@ from dnnevo.errors import InvalidArgumentError, TaskError, with_article
 
 __all__ = ["Rollout", "observations", "read_only", "rollout"]
 
-#: The run config's integrator, whose settings are rollout's defaults: a champion judged with
-#: ``rollout``'s defaults meets the time step that evolution with the config's defaults used.
-_INTEGRATOR = IntegratorConfig()
+#: The run config's default integrator, whose settings are rollout's and ClosedLoop's defaults:
+#: a champion judged with ``rollout``'s defaults meets the step that evolution used.
+DEFAULT_INTEGRATOR = IntegratorConfig()
 
 
 @dataclass(frozen=True)
@@ -57,9 +57,9 @@ def rollout(
     *,
     episodes: int = 1,
     max_steps: int,
-    dt: float = _INTEGRATOR.dt,
-    substeps: int = _INTEGRATOR.substeps,
-    method: str = _INTEGRATOR.method,
+    dt: float = DEFAULT_INTEGRATOR.dt,
+    substeps: int = DEFAULT_INTEGRATOR.substeps,
+    method: str = DEFAULT_INTEGRATOR.method,
     seed: int = 0,
     generation: int = 0,
     purpose: str = "trial",
@@ -265,6 +265,9 @@ def _outputs(out: Any, env: Any, rows: int, m: int, rates: npt.NDArray[np.float6
     try:
         obs, reward, done = out
     except (TypeError, ValueError):
+        if out is None:
+            raise TaskError(f"{_name(env)}.step returned None (does it end with a return?); "
+                            "expected three values (observations, rewards, done)") from None
         what = (f"a {type(out).__name__} of {len(out)}" if isinstance(out, tuple | list)
                 else with_article(type(out).__name__))
         raise TaskError(f"{_name(env)}.step returned {what}; expected three values "

@@ -62,10 +62,11 @@ def environment_class(task: str) -> type:
     module_name, _, attr = path.rpartition(".")
     if not module_name or not attr:
         raise ConfigError(f"task {task!r} names no class; expected python:module.Class")
-    if module_name == "__main__":
+    if module_name == "__main__" and not hasattr(sys.modules.get("__main__"), attr):
+        # The script that defined the class has it; any other process (the dnnevo command) not.
         raise ConfigError(f"task {task!r} is a class defined in a script, which no other process "
                           f"can import: move {attr} into a module of its own to run, judge or draw "
-                          "it from the command line, or do so from Python (docs/closed-loop.md)")
+                          "it from the command line, or do so from that script (docs/closed-loop.md)")
     module = _import(module_name, task)
     cls = getattr(module, attr, None)
     if cls is None:

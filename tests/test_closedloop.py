@@ -527,6 +527,19 @@ def test_a_fitness_that_tells_no_networks_apart_is_warned_about(tmp_path) -> Non
     assert "warning" not in dnnevo_command(tmp_path, "run", "python:seeker_ok.Seeker", *SETTINGS).stdout
 
 
+def test_n_inputs_defaults_to_the_class_s_observation_size_on_the_command_line(tmp_path) -> None:
+    (tmp_path / "seeker_size.py").write_text(SEEKER)
+    without = [a for a in SETTINGS if a != "n_inputs=1"]
+    without.remove("--set")  # the one that went with n_inputs=1
+    run = dnnevo_command(tmp_path, "run", "python:seeker_size.Seeker", *without)
+    assert run.returncode == 0, run.stderr
+    assert "n_inputs = 1" in (tmp_path / "runs" / "seeker_size.Seeker-seed0" / "config.toml").read_text()
+    # An explicit setting is kept, and a wrong one is still named.
+    wrong = dnnevo_command(tmp_path, "run", "python:seeker_size.Seeker", *without, "--set", "n_inputs=2",
+                           "--out", "runs/wrong")
+    assert wrong.returncode == 2 and "n_inputs is 2; Seeker.observation_size is 1" in wrong.stderr
+
+
 def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:
     (tmp_path / "seeker_rule.py").write_text(SEEKER)
     run = dnnevo_command(tmp_path, "run", "python:seeker_rule.Ruleless", *SETTINGS)

@@ -140,7 +140,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="run a preset, or a task written in Python",
                        epilog="examples:\n  dnnevo run sequence-1bit --quick --out runs/demo\n"
-                              "  dnnevo run python:light.Light --set n_inputs=1 --set size=3 --set selection=rank "
+                              "  dnnevo run python:light.Light --set size=3 --set selection=rank "
                               "--set task_params.max_steps=300 --set task_params.episodes=4\n"
                               "    (the class Light of light.py in this folder: docs/closed-loop.md)",
                        formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -38,7 +38,7 @@ from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, TaskError, did_you_mean, with_article
 
 __all__ = ["ROLLOUT_KEYS", "check_own_task", "closed_loop", "environment_class", "is_closed_loop",
-           "is_python_task"]
+           "is_python_task", "observation_size"]
 
 #: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
 _MEMBERS = ("observation_size", "reset", "step")
@@ -100,6 +100,16 @@ def _import(module_name: str, task: str) -> Any:
     except Exception as e:
         raise ConfigError(f"task {task!r}: importing {module_name} raised "
                           f"{type(e).__name__}: {e}") from e
+
+
+def observation_size(task: str) -> int | None:
+    """The ``observation_size`` of the class that ``task`` names (importing its module), the
+    ``n_inputs`` its networks need; None when it is not a whole number >= 1 (an instance
+    attribute, or a mistake that :func:`closed_loop` then names)."""
+    size = getattr(environment_class(task), "observation_size", None)
+    if isinstance(size, bool) or not isinstance(size, numbers.Integral) or size < 1:
+        return None
+    return int(size)
 
 
 def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> ClosedLoop:

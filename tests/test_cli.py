@@ -140,7 +140,8 @@ def test_run_show_and_the_progress_bar_name_the_same_champion(tmp_path: Path) ->
     assert r.stdout.splitlines() == [r.stdout.splitlines()[0], champion, success, after], r.stdout
     assert r.stdout.startswith("2 generations in "), r.stdout
     bar = r.stderr.strip().splitlines()[-1]  # not a terminal: one line at the end
-    assert f"gen 2/2  champion {meta['fitness']:.4f}  gen best " in bar and " gen mean " in bar, bar
+    assert (f"gen 2/2  champion {meta['fitness']:.4f} (validation rate {meta['validation_rate']:.3f})  "
+            "gen best ") in bar and " gen mean " in bar, bar
     assert " best " not in bar.replace("gen best", ""), bar
     r = dnnevo("show", str(out))
     assert r.returncode == 0, r.stderr

@@ -524,7 +524,8 @@ def _loop(
                 if bar is not None:
                     row = history[-1]
                     bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"],
-                               champion=ga.best_fitness)
+                               champion=ga.best_fitness,
+                               validation_rate=None if ga.best_validation is None else ga.best_validation[0])
                 if callback is not None and callback(stats, ga) is True:
                     break
             interrupted = stop.requested

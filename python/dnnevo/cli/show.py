@@ -120,8 +120,7 @@ def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
             best: Sequence[float] = (), worst: Sequence[float] = ()) -> list[str]:
     """The champion, the success rule, a warning when the fitness told no networks apart
     (:func:`blind_line`, from the generations' ``best`` and ``worst`` fitness) and the next
-    command, as ``run``,
-    ``resume`` and ``show`` end. ``champion`` is best.json's meta (``fitness``, ``generation``
+    command, as ``run``, ``resume`` and ``show`` end. ``champion`` is best.json's meta (``fitness``, ``generation``
     and, when validated, ``validation_rate`` and ``validation_score``)."""
     validation = None
     if "validation_rate" in champion and "validation_score" in champion:

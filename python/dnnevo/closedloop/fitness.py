@@ -34,8 +34,6 @@ __all__ = ["ROLLOUT_KEYS", "ClosedLoop"]
 #: environment's class), as :meth:`ClosedLoop.configured` records them.
 ROLLOUT_KEYS = ("episodes", "max_steps", "validation_episodes", "rows")
 
-
-
 #: Fresh episodes on which a run checks, at each change of champion, whether it meets the task
 #: class's success rule (``dnnevo assess`` judges on as many as asked, 200 by default).
 SUCCESS_EPISODES = 40

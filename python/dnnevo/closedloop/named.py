@@ -106,7 +106,11 @@ def observation_size(task: str) -> int | None:
     """The ``observation_size`` of the class that ``task`` names (importing its module), the
     ``n_inputs`` its networks need; None when it is not a whole number >= 1 (an instance
     attribute, or a mistake that :func:`closed_loop` then names)."""
-    size = getattr(environment_class(task), "observation_size", None)
+    return _whole_size(getattr(environment_class(task), "observation_size", None))
+
+
+def _whole_size(size: Any) -> int | None:
+    """``size`` as an int when it is a whole number >= 1 (a bool is not), else None."""
     if isinstance(size, bool) or not isinstance(size, numbers.Integral) or size < 1:
         return None
     return int(size)
@@ -128,7 +132,7 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> Closed
     except Exception as e:
         raise TaskError(f"{cls.__name__}(**task_params) raised {type(e).__name__}: {e}") from e
     size = env.observation_size
-    if isinstance(size, bool) or not isinstance(size, numbers.Integral) or size < 1:
+    if _whole_size(size) is None:
         raise ConfigError(f"{cls.__name__}.observation_size is {size!r}; expected the number of "
                           "observations the task gives at each step, a whole number >= 1")
     if size != config.n_inputs:

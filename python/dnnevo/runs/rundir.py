@@ -144,7 +144,7 @@ class RunDir:
         would only run the same generation 0 again, and could not once the task's code is
         fixed (its digest changed)."""
         names = {p.name for p in contents}
-        if not names <= {"config.toml", "log.csv", "checkpoint.json"} or "checkpoint.json" not in names:
+        if not names <= {self.config.name, self.log.name, self.checkpoint.name} or self.checkpoint.name not in names:
             return False
         try:
             doc = json.loads(read_text(self.checkpoint))

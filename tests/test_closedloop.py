@@ -249,8 +249,10 @@ class Broken(Drift):
             reward[:] = 1e308  # every return finite, though their sum is not
         if fault == "text obs":
             obs = np.array([["a"]] * len(obs))
-        if fault == "int done":
-            done = done.astype(int)
+        if fault == "float done":
+            done = done.astype(float)
+        if fault == "two done":
+            done = done.astype(int) * 2
         if fault == "bool done":
             done = bool(done[0])
         if fault == "pair":
@@ -269,8 +271,12 @@ class Broken(Drift):
     pytest.param("overflow", r"made row 0's return inf; .* below 1.8e308 \(scale the rewards down",
                  marks=pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")),
     ("text obs", r"observations from step of dtype <U1; expected numbers"),
-    ("int done", r"Broken.step returned done as an array of dtype int64 and shape \(8,\); expected a bool array"),
-    ("bool done", r"Broken.step returned done as a bool \(bool, shape \(\)\); expected a bool array of shape \(B,\)"),
+    ("float done", r"Broken.step returned done as an array of dtype float64 and shape \(8,\); expected "
+                   r"booleans \(or integers 0 and 1\) of shape \(B,\) = \(8,\)"),
+    # 2 is not a flag: guessing that it means True would hide a mistake
+    ("two done", r"Broken.step returned done as an array of dtype int64 and shape \(8,\); expected booleans"),
+    ("bool done", r"Broken.step returned done as a bool \(bool, shape \(\)\); expected booleans \(or integers "
+                  r"0 and 1\) of shape \(B,\)"),
     ("pair", r"Broken.step returned a tuple of 2; expected three values \(observations, rewards, done\)"),
     ("none", r"Broken.step returned None \(does it end with a return\?\); expected three values"),
     ("reset shape", r"Broken.reset returned observations of shape \(8,\); expected \(B, M\) = \(8, 1\)"),
@@ -278,6 +284,48 @@ class Broken(Drift):
 def test_a_broken_task_gets_a_task_error_naming_the_method(fault: str, message: str) -> None:
     with pytest.raises(TaskError, match=message):
         rollout(networks(4, m=1), Broken(fault), episodes=2, max_steps=10)
+
+
+class IntegerFlags(Drift):
+    """Drift with done, and a success rule, given as integers 0 and 1."""
+    success_rate = 0.3
+
+    def step(self, rates, active):
+        obs, reward, done = super().step(rates, active)
+        return obs, reward, done.astype(np.int8)
+
+    def success(self, returns, lengths):
+        return (returns > -2).astype(int)
+
+
+def test_integers_0_and_1_are_flags_as_booleans_are() -> None:
+    from dnnevo.closedloop import ClosedLoop
+
+    class BoolFlags(IntegerFlags):
+        def step(self, rates, active):
+            return Drift.step(self, rates, active)
+
+        def success(self, returns, lengths):
+            return returns > -2
+
+    nets = networks(6, m=1)
+    ints, bools = (rollout(nets, env, episodes=3, max_steps=20, seed=1) for env in (IntegerFlags(), BoolFlags()))
+    assert np.array_equal(ints.returns, bools.returns) and np.array_equal(ints.lengths, bools.lengths)
+    judged = [[ClosedLoop(env, episodes=3, max_steps=20).succeeds(n, seed=3) for n in nets]
+              for env in (IntegerFlags(), BoolFlags())]
+    assert judged[0] == judged[1] and set(judged[0]) == {0.0, 1.0}
+
+
+def test_a_success_rule_that_returns_no_flags_is_named() -> None:
+    from dnnevo.closedloop import ClosedLoop
+
+    class Scores(IntegerFlags):
+        def success(self, returns, lengths):
+            return returns  # floats: no flags
+
+    with pytest.raises(TaskError, match=r"Scores.success returned float64 of shape \(40,\); expected booleans "
+                                        r"\(or integers 0 and 1\) of shape \(40,\), one per episode"):
+        ClosedLoop(Scores(), episodes=3, max_steps=20).succeeds(networks(1, m=1)[0], seed=3)
 
 
 def test_observation_size_must_match_the_networks() -> None:
@@ -544,6 +592,9 @@ def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:
     (tmp_path / "seeker_rule.py").write_text(SEEKER)
     run = dnnevo_command(tmp_path, "run", "python:seeker_rule.Ruleless", *SETTINGS)
     assert run.returncode == 0, run.stderr
+    # Every network's validation rate is 0 without a rule: the bar gives the score that chose.
+    bar = run.stderr.strip().splitlines()[-1]
+    assert " (validation score " in bar and "validation rate" not in bar, bar
     # The run's last line points at what works for it: plot, not assess.
     assert run.stdout.splitlines()[-1].startswith(
         "next: dnnevo plot runs/seeker_rule.Ruleless-seed0   (draws the champion on fresh episodes; "

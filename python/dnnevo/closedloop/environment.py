@@ -45,8 +45,8 @@ class Environment(Protocol):
         ``rates`` (``B x N``) are the networks' firing rates after they integrated the last
         observations; ``active[r]`` is False once row ``r``'s episode has ended, and what
         :meth:`step` returns for such rows is ignored. ``observations`` has shape ``(B, M)``,
-        ``rewards`` ``(B,)`` (summed into each episode's return) and ``done`` ``(B,)`` booleans,
-        True where the episode ended at this step.
+        ``rewards`` ``(B,)`` (summed into each episode's return) and ``done`` ``(B,)`` booleans
+        (or integers 0 and 1), True where the episode ended at this step.
         """
 
 

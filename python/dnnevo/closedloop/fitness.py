@@ -24,7 +24,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo.closedloop.environment import Environment
-from dnnevo.closedloop.loop import DEFAULT_INTEGRATOR, Rollout, rollout
+from dnnevo.closedloop.loop import DEFAULT_INTEGRATOR, FLAGS, Rollout, as_flags, rollout
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
 from dnnevo.errors import ConfigError, TaskError
 
@@ -197,10 +197,11 @@ class ClosedLoop:
             ok = np.asarray(rule(returns, lengths))
         except Exception as e:
             raise TaskError(f"{kind}.success raised {type(e).__name__}: {e}") from e
-        if ok.dtype != np.bool_ or ok.shape != returns.shape:
+        flags = as_flags(ok) if ok.shape == returns.shape else None
+        if flags is None:
             raise TaskError(f"{kind}.success returned {ok.dtype} of shape {ok.shape}; expected "
-                            f"booleans of shape {returns.shape}, one per episode")
-        return ok
+                            f"{FLAGS} of shape {returns.shape}, one per episode")
+        return flags
 
     def succeeds(self, network: _core.Network, seed: int) -> float:
         """1.0 when ``network`` meets the environment's success rule on

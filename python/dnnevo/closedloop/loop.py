@@ -282,11 +282,29 @@ def _outputs(out: Any, env: Any, rows: int, m: int, rates: npt.NDArray[np.float6
     if type(done) is not np.ndarray:
         done = np.asarray(done)
     if done.shape != (rows,) or done.dtype.char != "?":
-        what = (f"an array of dtype {done.dtype} and shape {done.shape}" if type(given) is np.ndarray
-                else f"{with_article(type(given).__name__)} ({np.asarray(given).dtype}, shape {np.shape(given)})")
-        raise TaskError(f"{_name(env)}.step returned done as {what}; expected a bool array of "
-                        f"shape (B,) = ({rows},), one flag per row")
+        flags = as_flags(done) if done.shape == (rows,) else None
+        if flags is None:
+            what = (f"an array of dtype {done.dtype} and shape {done.shape}" if type(given) is np.ndarray
+                    else f"{with_article(type(given).__name__)} ({done.dtype}, shape {done.shape})")
+            raise TaskError(f"{_name(env)}.step returned done as {what}; expected {FLAGS} of "
+                            f"shape (B,) = ({rows},), one per row")
+        done = flags
     return obs, reward, done
+
+
+FLAGS = "booleans (or integers 0 and 1)"
+"""What :func:`as_flags` takes, for messages."""
+
+
+def as_flags(values: npt.NDArray[Any]) -> npt.NDArray[np.bool_] | None:
+    """``values`` as booleans: a bool array as it is, an integer array holding only 0 and 1 as
+    the flags it means; None for anything else (a float, or an integer such as 2, is not a
+    flag, and guessing its meaning would hide a mistake)."""
+    if values.dtype == np.bool_:
+        return values
+    if values.dtype.kind in "iu" and bool(((values == 0) | (values == 1)).all()):
+        return values.astype(np.bool_)
+    return None
 
 
 def _running(reward: npt.NDArray[Any], active: npt.NDArray[np.bool_]) -> npt.NDArray[Any]:

@@ -523,9 +523,14 @@ def _loop(
                     last_log = now
                 if bar is not None:
                     row = history[-1]
+                    # A task without a success rule (champion_success NaN) gives every network
+                    # the rate 0 and chooses by the score.
+                    validated = ga.best_validation is not None
+                    ruled = validated and not np.isnan(success)
                     bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"],
                                champion=ga.best_fitness,
-                               validation_rate=None if ga.best_validation is None else ga.best_validation[0])
+                               validation_rate=validation[0] if ruled else None,
+                               validation_score=validation[1] if validated and not ruled else None)
                 if callback is not None and callback(stats, ga) is True:
                     break
             interrupted = stop.requested

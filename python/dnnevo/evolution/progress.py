@@ -3,8 +3,8 @@ best and mean fitness, evaluations per second and the ETA.
 
 The words are those of ``dnnevo run`` and ``dnnevo show``: the *champion* is the run's best
 network so far, the one best.json holds, with its training fitness and, when it was chosen on
-the task's validation trials, its validation rate (which never falls, while a new champion's
-training fitness may be lower than the last one's); *gen best* and *gen mean* are the training
+the task's validation trials, its validation rate, or score for a task without a success rule
+(which never falls, while a new champion's training fitness may be lower than the last one's); *gen best* and *gen mean* are the training
 fitness of the generation just scored. Without elitism (the paper's GA) the best network is not
 kept, so gen best may drop while the champion stays.
 """
@@ -30,11 +30,13 @@ class Progress:
         self.t0 = time.perf_counter()
 
     def update(self, generation: int, best: float, mean: float, evals_per_s: float,
-               champion: float | None = None, validation_rate: float | None = None) -> None:
+               champion: float | None = None, validation_rate: float | None = None,
+               validation_score: float | None = None) -> None:
         """Shows that ``generation`` (0-based) has been scored: its ``best`` and ``mean`` fitness,
         the ``champion``'s fitness and, when it was chosen on validation trials, its
-        ``validation_rate``. That rate never falls, while the training fitness of a new champion
-        may be below the last one's: the rate is why it was chosen."""
+        ``validation_rate``, or its ``validation_score`` for a task without a success rule (whose
+        rate is 0 for every network). Rate or score never falls, while the training fitness of a
+        new champion may be below the last one's: the validation is why it was chosen."""
         done = generation + 1
         elapsed = time.perf_counter() - self.t0
         rate = (done - self.start) / elapsed if elapsed > 0 else 0.0
@@ -45,6 +47,8 @@ class Progress:
         held = f"  champion {champion:.4f}" if champion is not None else ""
         if held and validation_rate is not None:
             held += f" (validation rate {validation_rate:.3f})"
+        elif held and validation_score is not None:
+            held += f" (validation score {validation_score:.4f})"
         line = (
             f"[{bar}] gen {done}/{self.total}{held}  gen best {best:.4f}  gen mean {mean:.4f}  "
             f"{evals_per_s:,.0f} evals/s  ETA {clock(eta)}"

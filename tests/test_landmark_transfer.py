@@ -43,6 +43,18 @@ def test_each_world_changes_its_stated_factors_and_builds(name: str) -> None:
     assert params["training"]["cone_deg"] == 0.0 and params["trials_per_landmark"] == 3
 
 
+@pytest.mark.parametrize("name", sorted(landmark_worlds.WORLDS))
+def test_a_world_taken_apart_changes_each_of_its_factors_in_one_part(name: str) -> None:
+    world = landmark_worlds.WORLDS[name]
+    parts = [landmark_worlds.factors(w) for w in landmark_worlds.single_factors(world)]
+    assert all(parts), "a part that changes nothing"
+    changed = [k for part in parts for k in part]
+    assert len(changed) == len(set(changed)), "a factor in two parts"
+    whole = landmark_worlds.factors(world)
+    assert {k: v for part in parts for k, v in part.items()} == whole
+    assert (len(parts) > 1) == bool(world.parts)
+
+
 def test_the_worlds_go_beyond_what_training_varies() -> None:
     """Each factor the robust preset's training varies goes further in the world that changes it."""
     t = presets.get("landmark-robust").task_params["training"]
@@ -165,6 +177,14 @@ def test_a_tiny_run_makes_a_record_that_renders(tmp_path: Path, capsys: pytest.C
     assert results.render(tmp_path, results_dir=tmp_path / "results", files=[page]) == [page]
     assert "| room (held out) | tiny |" in page.read_text() and "STALE TABLE" not in page.read_text()
     assert "tiny seed-0: training" in capsys.readouterr().out
+    # --factors: one row per factor of the follower and sonar worlds, and the room world whole.
+    factors = tmp_path / "results" / "examples" / "landmark-factors.json"
+    landmark_transfer.main([str(runs), "--trials", "3", "--fit-trials", "4", "--factors", "--record", str(factors)])
+    rows = examples.read(factors)["rows"]
+    assert [row[0] for row in rows] == ["follower: speed", "follower: wall distance", "follower: turn rate",
+                                        "sonar: beam", "sonar: axis", "sonar: range noise", "sonar: specular misses",
+                                        "sonar: range", "room"]
+    assert "champions failing each factor: follower: speed " in examples.read(factors)["summary"][1]
 
 
 def test_help_names_an_example_and_a_missing_folder_is_named(capsys: pytest.CaptureFixture[str],

@@ -100,8 +100,8 @@ def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,
            places: Sequence[Place] | None = None) -> dict[str, dict[str, Any]]:
     """Each place's threshold rule and observer (of ``places``, default :data:`PLACES`), fitted
     on ``fit`` trials per landmark from FIT_SEED and judged on ``test`` from TEST_SEED; held-out
-    worlds also get the observer fitted on the other held-out worlds (all three must be among
-    ``places`` then)."""
+    worlds also get the observer fitted on the other held-out worlds when all three are among
+    ``places``."""
     data = {}
     for p in PLACES if places is None else places:
         cfg = landmark_worlds.config(base, p.world)
@@ -114,7 +114,7 @@ def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,
         result = {"threshold": int(np.sum(rule.predict(xt) == yt)), "observer": int(np.sum(model.predict(xt) == yt)),
                   "n": len(yt), "rule": f"{observer.FEATURES[rule.feature]} {'>' if rule.sign > 0 else '<'} "
                                         f"{rule.threshold:.3g} says landmark 2"}
-        if name in HELD_OUT:
+        if name in HELD_OUT and set(HELD_OUT) <= set(data):
             others = [data[o][0] for o in HELD_OUT if o != name]
             lowo = observer.fit_logistic(np.vstack([x for x, _ in others]), np.concatenate([y for _, y in others]))
             result["observer, other worlds"] = int(np.sum(lowo.predict(xt) == yt))

@@ -31,7 +31,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.tasks import landmark
 
-__all__ = ["TRAINING", "WORLDS", "World", "config", "factors"]
+__all__ = ["TRAINING", "WORLDS", "World", "config", "factors", "single_factors"]
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,10 @@ class World:
     """What differs from the training world, in words."""
     params: dict[str, Any]
     """The ``task_params`` of the world (the paper's defaults for everything it leaves out)."""
+    parts: dict[str, dict[str, Any]] = dataclasses.field(default_factory=dict)
+    """The factors it changes, each alone: name to the ``task_params`` that change only that
+    factor (empty for a world that changes one thing); :func:`single_factors` makes worlds of
+    them."""
 
 
 def _sim(*, follower: dict[str, float] | None = None, sonar: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -75,22 +79,50 @@ def _room(width: float, height: float, centre: tuple[float, float]) -> dict[str,
 TRAINING = World("training", "the paper's ideal world, unvaried (what every trial starts from)", {})
 """The training world itself, for reference: the defaults, no variation."""
 
+_FOLLOWER = {"speed": {"speed": 0.45}, "wall distance": {"wall_distance": 0.80},
+             "turn rate": {"max_turn_rate": 1.2}}
+_SONAR = {"beam": {"cone_deg": 40.0, "rays": 11},  # as many rays per degree as training's
+          "axis": {"mount_angle_deg": 75.0}, "range noise": {"noise_sd": 0.05},
+          "specular misses": {"specular_max_incidence_deg": 45.0}, "range": {"max_range": 4.0}}
+
+
+def _all(parts: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    return {k: v for part in parts.values() for k, v in part.items()}
+
+
 WORLDS: dict[str, World] = {w.name: w for w in [
     World("follower",
           "another wall follower: 0.45 m/s (-25%), 0.80 m from the wall (+0.25 m), corners turned at "
           "1.2 rad/s at most (2.0)",
-          {"sim": _sim(follower={"speed": 0.45, "wall_distance": 0.80, "max_turn_rate": 1.2})}),
+          {"sim": _sim(follower=_all(_FOLLOWER))},
+          {name: {"sim": _sim(follower=part)} for name, part in _FOLLOWER.items()}),
     World("sonar",
           "another sonar: a 40 deg cone (25) of 11 rays, its axis 15 deg forward of the side (75 deg), "
           "range noise sd 0.05 m, specular misses beyond 45 deg incidence, 4 m range",
-          {"sim": _sim(sonar={"cone_deg": 40.0, "rays": 11, "mount_angle_deg": 75.0, "noise_sd": 0.05,
-                              "specular_max_incidence_deg": 45.0, "max_range": 4.0})}),
+          {"sim": _sim(sonar=_all(_SONAR))},
+          {name: {"sim": _sim(sonar=part)} for name, part in _SONAR.items()}),
     World("room",
           "a bigger room, 8 m x 6.5 m (6 x 5), the landmark off-centre at (3.2, 2.6): 2.3-2.6 m from the "
           "left and bottom walls, 3.6-4.2 m from the others (2.1-2.4 m from every wall in training)",
           _room(8.0, 6.5, (3.2, 2.6))),
 ]}
 """The held-out worlds by name."""
+
+
+def single_factors(world: World) -> list[World]:
+    """``world`` taken apart: one world per factor it changes, named ``"WORLD: FACTOR"``, with only
+    that factor changed; ``[world]`` for a world that changes one thing. Judging a champion in
+    each says which factor it fails on.
+
+    >>> [w.name for w in single_factors(WORLDS["follower"])]
+    ['follower: speed', 'follower: wall distance', 'follower: turn rate']
+    >>> [w.name for w in single_factors(WORLDS["room"])]
+    ['room']
+    """
+    if not world.parts:
+        return [world]
+    return [World(f"{world.name}: {name}", f"{world.name}'s {name} alone", params)
+            for name, params in world.parts.items()]
 
 
 def config(base: EvolutionConfig, world: World) -> EvolutionConfig:

@@ -10,10 +10,15 @@
 //!   through 0. Its input value is refined by bisection, following the equilibrium by Newton's
 //!   method while it keeps the sign of `det(dG/dv)` (a fold's two equilibria have opposite signs).
 //! - a linked pair whose count of complex eigenvalues with positive real part differs, with
-//!   complex eigenvalues on both sides: a **Hopf point**, where a complex pair crosses the
-//!   imaginary axis. Its input value is refined by bisection along the linked equilibrium.
+//!   complex eigenvalues on both sides, or with a real pair on one side and a different count
+//!   of eigenvalues with positive real part (a stable node on one side and an unstable focus on
+//!   the other: the pair turned complex and crossed between the two values): a **Hopf point**,
+//!   where a complex pair crosses the imaginary axis. Its input value is refined by bisection
+//!   along the linked equilibrium. (An unstable node that turns into an unstable focus keeps
+//!   its count and is no event.)
 //!
-//! Linking is by continuation: Newton's method at the next value from each equilibrium, and back.
+//! Linking is by continuation: Newton's method in a few steps to the next value from each
+//! equilibrium, and back.
 //! A value where the search finds an even number of equilibria is searched again with
 //! [`EquilibriumSearch::retry_starts`] starts, by the same rule as a single search; the values
 //! where that happened are listed in [`Bifurcation::retried`].
@@ -31,7 +36,7 @@ use serde::Serialize;
 use super::branches::{cycles_at, locate, CycleBranch};
 use super::cycles::{Cycle, CycleSearch};
 use super::equilibria::{max_abs, search, Equilibrium, EquilibriumSearch};
-use super::events::{distance, has_complex, unstable_complex, At, Event};
+use super::events::{distance, has_complex, unstable, unstable_complex, At, Event};
 use super::field::Field;
 use crate::error::{Error, Result};
 use crate::Network;
@@ -199,15 +204,14 @@ pub fn bifurcation(
     for s in 0..sweep.steps - 1 {
         let (here, next) = (&equilibria[s], &equilibria[s + 1]);
         let (a, b) = (values[s], values[s + 1]);
-        let forward = at.link(b, here, next)?;
-        let backward = at.link(a, next, here)?;
+        let forward = at.link(a, b, here, next)?;
+        let backward = at.link(b, a, next, here)?;
         for (i, e) in here.iter().enumerate() {
             match forward[i] {
                 Some(j) if backward[j] == Some(i) => {
                     let f = &next[j];
                     if unstable_complex(e) != unstable_complex(f)
-                        && has_complex(e)
-                        && has_complex(f)
+                        && ((has_complex(e) && has_complex(f)) || unstable(e) != unstable(f))
                     {
                         events.extend(at.hopf(a, b, e)?);
                     }

@@ -63,6 +63,11 @@ pub(super) fn unstable_complex(e: &Equilibrium) -> usize {
         .count()
 }
 
+/// Eigenvalues with positive real part, real or complex.
+pub(super) fn unstable(e: &Equilibrium) -> usize {
+    e.eigenvalues.iter().filter(|[re, _]| *re > 0.0).count()
+}
+
 pub(super) fn has_complex(e: &Equilibrium) -> bool {
     e.eigenvalues.iter().any(|[_, im]| *im != 0.0)
 }
@@ -96,24 +101,27 @@ impl<'a> At<'a> {
         Field::new(self.net, &input)
     }
 
-    /// For each of `from`, the one of `to` (the equilibria at input `value`) that Newton's method
-    /// reaches from it, if any.
+    /// For each of `from` (equilibria at input `start`), the one of `to` (the equilibria at
+    /// input `value`) that Newton's method reaches from it in [`WALK`] continuation steps, if
+    /// any. One step from `start` to `value` lost equilibria that move fast (a half-centre's
+    /// moved by 1 in state between two values of a 101-value sweep, where its Hopf point is).
     pub(super) fn link(
         &self,
+        start: f64,
         value: f64,
         from: &[Equilibrium],
         to: &[Equilibrium],
     ) -> Result<Vec<Option<usize>>> {
-        let field = self.field(value)?;
+        let fields = (1..=WALK)
+            .map(|k| self.field(start + (value - start) * k as f64 / WALK as f64))
+            .collect::<Result<Vec<_>>>()?;
         Ok(from
             .iter()
             .map(|e| {
-                let r = newton(
-                    &field,
-                    e.state.clone(),
-                    self.search.tolerance,
-                    self.search.max_iterations,
-                )?;
+                let mut r = e.state.clone();
+                for field in &fields {
+                    r = newton(field, r, self.search.tolerance, self.search.max_iterations)?;
+                }
                 let k = nearest(&r, to)?;
                 (distance(&r, &to[k].state) < self.search.distinct).then_some(k)
             })

@@ -240,6 +240,45 @@ fn hopf_points_have_a_pair_on_the_imaginary_axis() {
     }
 }
 
+#[test]
+fn a_hopf_point_between_a_stable_node_and_an_unstable_focus_is_found() {
+    // A half-centre whose equilibrium is a stable node at one sweep value and an unstable focus
+    // at the next (input -0.30 and -0.24): the pair turns complex and crosses in one step, and
+    // was missed when both sides had to be complex. A finer sweep sees the same two points.
+    let net = Network::new(
+        vec![1.0, 1.0],
+        vec![2.75, 1.75],
+        vec![4.5, 1.0, -1.0, 4.5],
+        vec![1.0, 0.0, 0.0, 1.0],
+        None,
+    )
+    .unwrap();
+    let hopf = |steps: usize| -> Vec<f64> {
+        let sweep = Sweep {
+            from: -3.0,
+            to: 3.0,
+            steps,
+            ..Sweep::default()
+        };
+        let b = bifurcation(&net, &[0.0, 0.0], &sweep, None).unwrap();
+        b.events
+            .iter()
+            .filter(|e| e.kind == EventKind::Hopf)
+            .map(|e| e.value)
+            .collect()
+    };
+    let (coarse, fine) = (hopf(101), hopf(201));
+    assert_eq!(coarse.len(), 2, "{coarse:?}");
+    assert_eq!(fine.len(), 2, "{fine:?}");
+    for (c, f) in coarse.iter().zip(&fine) {
+        assert!((c - f).abs() < 1e-9, "{coarse:?} {fine:?}");
+    }
+    assert!(
+        (coarse[1] - 0.2516).abs() < 1e-3 && (coarse[0] + 0.2516).abs() < 1e-3,
+        "{coarse:?}"
+    );
+}
+
 fn random_net(n: usize, seed: u64) -> Network {
     let mut d = draws(seed);
     let mut u = |lo: f64, hi: f64| lo + (hi - lo) * d();

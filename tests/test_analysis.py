@@ -173,6 +173,18 @@ def test_clamp_is_exact() -> None:
     assert cut.weights[3, 1] == 0 and np.count_nonzero(cut.weights != net.weights) == 1
 
 
+def test_a_lesion_mid_run_goes_on_from_the_network_s_state_and_takes_numpy_indices() -> None:
+    net = dnnevo.Network.random(4, 2, seed=5)
+    net.run(np.random.default_rng(1).uniform(0, 1, (50, 2)), dt=0.1)
+    clamped, cut = analysis.clamp(net, np.int64(2), 0.3), analysis.cut(net, np.int32(1), np.int64(3))
+    assert np.array_equal(cut.state, net.state)
+    assert np.array_equal(clamped.state[[0, 1, 3]], net.state[[0, 1, 3]]) and clamped.state[2] == 0.0
+    assert clamped.outputs[2] == pytest.approx(0.3, abs=1e-15)
+    for bad in (np.bool_(True), 2.0, np.float64(1), 4, -1):
+        with pytest.raises(InvalidArgumentError, match="it must be an integer in 0..3"):
+            analysis.clamp(net, bad, 0.3)
+
+
 def without_outgoing(net: dnnevo.Network, k: int) -> dnnevo.Network:
     w = net.weights.copy()
     w[:, k] = 0.0

@@ -13,8 +13,9 @@ them (Beer 1995, "On the dynamics of small continuous-time recurrent neural netw
   task's own views (``dnnevo.robots.pursuit``: a pursuer appearing);
 - :mod:`.figures`: phase portraits, bifurcation diagrams, lesion tables and basins.
 
-The numerical work is in Rust (``ctrnn::analysis``); these modules turn its results into
-dataclasses. ``dnnevo analyze`` runs it all on a run's champion.
+The numerical work is in Rust (``ctrnn::analysis``), whose results come back as read-only
+objects (:class:`Equilibrium`, :class:`Cycle`, :class:`Bifurcation`, ...); these modules add the
+Python-side records (``Attractors``, ``LesionTable``, ...) as dataclasses. ``dnnevo analyze`` runs it all on a run's champion.
 
 >>> import dnnevo
 >>> from dnnevo import analysis

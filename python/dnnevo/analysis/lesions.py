@@ -6,6 +6,7 @@ which parts its success needs.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -29,33 +30,41 @@ CLAMP_LIMIT = 1e-9
 def clamp(net: _core.Network, neuron: int, output: float) -> _core.Network:
     """``net`` with ``neuron``'s firing rate held at ``output`` for every trial.
 
-    This is exact for the tasks, which start every trial from ``v = 0``: the neuron's incoming
-    weights, self-weight and sensor weights become 0, so ``tau dv/dt = -v`` keeps ``v = 0``, and its
-    threshold becomes ``-logit(output)``, so ``f(0 - theta) = output``. Every other neuron then
-    receives ``w_ij * output`` from it, as the clamp means. ``output`` is moved
-    :data:`CLAMP_LIMIT` inside (0, 1) if it lies closer to 0 or 1."""
-    n = net.size
-    if not isinstance(neuron, int) or isinstance(neuron, bool) or not 0 <= neuron < n:
-        raise InvalidArgumentError(f"neuron is {neuron!r}; it must be an integer in 0..{n - 1}")
+    The neuron's incoming weights, self-weight and sensor weights become 0, so ``tau dv/dt = -v``
+    keeps its state at ``v = 0``, where it is set (the tasks start every trial there), and its
+    threshold becomes ``-logit(output)``, so ``f(0 - theta) = output``. Every other neuron ``j``
+    then receives ``w_j,neuron * output`` from it (``weights[j, neuron]``), as the clamp means.
+    ``output`` is moved :data:`CLAMP_LIMIT` inside (0, 1) if it lies closer to 0 or 1. The other
+    neurons keep their state, so a network lesioned in the middle of a run goes on from where it
+    was; ``meta`` (the intact network's task, seed and fitness) is not carried over."""
+    i = _neuron(net, "neuron", neuron)
     if not math.isfinite(output) or not 0.0 <= output <= 1.0:
         raise InvalidArgumentError(f"output is {output!r}; a firing rate must be in [0, 1]")
     o = min(max(output, CLAMP_LIMIT), 1.0 - CLAMP_LIMIT)
-    weights, sensors, theta = net.weights.copy(), net.sensor_weights.copy(), net.theta.copy()
-    weights[neuron, :] = 0.0
-    sensors[neuron, :] = 0.0
-    theta[neuron] = -math.log(o / (1.0 - o))
-    return _core.Network(net.tau, theta, weights, sensors)
+    weights, sensors, theta, state = net.weights.copy(), net.sensor_weights.copy(), net.theta.copy(), net.state.copy()
+    weights[i, :] = 0.0
+    sensors[i, :] = 0.0
+    theta[i] = -math.log(o / (1.0 - o))
+    state[i] = 0.0
+    return _core.Network(net.tau, theta, weights, sensors, state)
 
 
 def cut(net: _core.Network, source: int, target: int) -> _core.Network:
-    """``net`` without the connection from neuron ``source`` to neuron ``target``."""
-    n = net.size
-    for name, k in (("source", source), ("target", target)):
-        if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k < n:
-            raise InvalidArgumentError(f"{name} is {k!r}; it must be an integer in 0..{n - 1}")
+    """``net`` without the connection from neuron ``source`` to neuron ``target``
+    (``weights[target, source]`` set to 0). Every neuron keeps its state; ``meta`` is not
+    carried over."""
+    s, t = _neuron(net, "source", source), _neuron(net, "target", target)
     weights = net.weights.copy()
-    weights[target, source] = 0.0
-    return _core.Network(net.tau, net.theta, weights, net.sensor_weights)
+    weights[t, s] = 0.0
+    return _core.Network(net.tau, net.theta, weights, net.sensor_weights, net.state)
+
+
+def _neuron(net: _core.Network, name: str, k: Any) -> int:
+    """``k`` as a neuron index of ``net``: an integer (Python's or NumPy's) in 0..N-1."""
+    n = net.size
+    if isinstance(k, bool | np.bool_) or not isinstance(k, numbers.Integral) or not 0 <= int(k) < n:
+        raise InvalidArgumentError(f"{name} is {k!r}; it must be an integer in 0..{n - 1}")
+    return int(k)
 
 
 @dataclass(frozen=True)

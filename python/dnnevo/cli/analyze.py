@@ -165,10 +165,16 @@ def analyze(args: argparse.Namespace) -> int:
             if try_write(lambda: save_figure(fig, run.path / file)):
                 written.append(file)
             plot.close(fig)
+    # A figure of an earlier analysis that this one did not draw (--no-lesions, a view gone)
+    # would sit beside an analysis.json that does not describe it.
+    stale = sorted(p.name for p in run.path.glob("analysis-*.png") if p.name not in written)
+    for file in stale:
+        (run.path / file).unlink(missing_ok=True)
     print("\n".join(summary(found, bif, table, name, basins, output=output)
                     + [line for v in seen for line in v.lines]))
     wrote = ", ".join(str(run.path / w) for w in written) if written else "nothing"
-    print(f"analysed in {elapsed:.1f} s; wrote {wrote}")
+    print(f"analysed in {elapsed:.1f} s; wrote {wrote}"
+          + (f"; removed the earlier analysis's {', '.join(stale)}" if stale else ""))
     return 0
 
 

@@ -235,6 +235,10 @@ class RunDir:
         in a config written by hand; its seed, if any, checked)."""
         path = self.config
         if not path.exists() and not path.is_symlink():
+            if not self.path.exists():
+                raise RunFileError(f"{self.path} does not exist; give a run folder (one that holds config.toml)")
+            if not self.path.is_dir():
+                raise RunFileError(f"{self.path} is a file, not a run folder (a folder that holds config.toml)")
             raise RunFileError(f"{self.path} has no config.toml; is it a dnnevo run folder?")
         with checked(path):
             text = read_text(path)

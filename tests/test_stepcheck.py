@@ -74,3 +74,22 @@ def test_a_champion_that_depends_on_the_step_is_flagged() -> None:
     assert check.artefacts == ["dt/10: overall", "rk4: overall"]
     assert all(a.judged[0].rate <= 0.1 for a in check.checks.values())
     assert check.max_change >= 0.85
+
+
+def test_the_report_marks_every_failing_rate_and_says_what_the_mark_means() -> None:
+    from dnnevo.cli.assess import step_lines
+
+    integrators = {"run": {"method": "euler", "dt": 0.1}, "dt/10": {"method": "euler", "dt": 0.01},
+                   "rk4": {"method": "rk4", "dt": 0.1}}
+    failing = stepcheck.StepCheck(base=assessment(200, 0), checks={"dt/10": assessment(200, 0),
+                                                                   "rk4": assessment(200, 0)},
+                                  integrators=integrators)
+    lines = step_lines(failing)
+    # A rate failing at the run's step is marked there too, and the mark is explained although
+    # there is no artefact.
+    assert lines[-2].split() == ["1*", "0.0%!", "0.0%!", "0.0%!"], lines
+    assert lines[-1] == "step check: no artefact (largest change 0.0 points) (! marks a failing rate)"
+    passing = stepcheck.StepCheck(base=assessment(200, 200), checks={"dt/10": assessment(200, 200),
+                                                                     "rk4": assessment(200, 200)},
+                                  integrators=integrators)
+    assert "!" not in "".join(step_lines(passing))

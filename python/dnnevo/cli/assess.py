@@ -33,7 +33,8 @@ task's threshold (sequence: 90% of trials per target; landmark and nav1d: 95%), 
 below, undecided when it straddles it; then the output says how many trials would decide.
 A sequence run passes when every target passes and fails when any fails. nav1d trials within one
 chain share the network's state: with several scored trials per chain the interval counts chains.
---dt integrates the champion with a finer (or coarser) Euler step, each time step kept as long:
+--dt integrates the champion with a finer (or coarser) step of the run's method (Euler or RK4),
+each time step of the task kept as long:
 a behaviour that vanishes at a finer step is an artefact of the integrator, not a result.
 --dt-check judges the champion again on the same trials at a 10x finer step and with RK4 (with
 Euler runs), and calls it a step artefact when a rate that does not fail at the run's step fails
@@ -107,17 +108,21 @@ def step_lines(check: StepCheck) -> list[str]:
     lines = [f"time-step check, same trials (run: {run['method']}, dt {run['dt']:g}; "
              f"dt/10: dt {check.integrators[names[0]]['dt']:g})",
              f"{'':>{width}} {'run step':>10}" + "".join(f" {n:>10}" for n in names)]
+    def cell(rate: float, verdict: str | None) -> str:
+        return percent(rate, 1) + ("!" if verdict == "fail" else "")
+
+    marked = False
     for r in judged:
-        cells = [next(c for c in check.checks[n].rates if c.name == r.name) for n in names]
-        lines.append(f"{r.name:>{width}} {percent(r.rate, 1):>10}"
-                     + "".join(f" {percent(c.rate, 1) + ('!' if c.verdict == 'fail' else ''):>10}"
-                               for c in cells))
+        cells = [cell(r.rate, r.verdict)] + [cell(c.rate, c.verdict) for n in names
+                                             for c in check.checks[n].rates if c.name == r.name]
+        marked = marked or any(c.endswith("!") for c in cells)
+        lines.append(f"{r.name:>{width}}" + "".join(f" {c:>10}" for c in cells))
     change = f"largest change {100 * check.max_change:.1f} points"
+    legend = " (! marks a failing rate)" if marked else ""
     if check.artefact:
-        lines.append(f"step artefact ({change}): fails only at a finer step: {'; '.join(check.artefacts)} "
-                     "(! marks a failing rate)")
+        lines.append(f"step artefact ({change}): fails only at a finer step: {'; '.join(check.artefacts)}{legend}")
     else:
-        lines.append(f"step check: no artefact ({change})")
+        lines.append(f"step check: no artefact ({change}){legend}")
     return lines
 
 

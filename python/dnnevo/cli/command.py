@@ -216,7 +216,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true",
                    help="print the whole assessment as JSON on stdout instead of text")
     p.add_argument("--dt", type=float, default=None,
-                   help="integrate with this Euler step instead of the run's, each time step kept "
+                   help="integrate with this step (of the run's method, Euler or RK4) instead of the run's, each time step kept "
                         "as long (e.g. 0.01 for 10x finer): tells a behaviour from a step artefact")
     p.add_argument("--dt-check", action="store_true",
                    help="also judge the champion on the same trials at a 10x finer step and with "

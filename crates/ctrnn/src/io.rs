@@ -102,8 +102,7 @@ pub fn to_json(file: &NetworkFile) -> String {
 
 /// Parses and validates a network document. Every failure is [`Error::Format`], naming the field.
 pub fn from_json(text: &str) -> Result<NetworkFile> {
-    let value: Value =
-        serde_json::from_str(text).map_err(|e| Error::Format(format!("not valid JSON: {e}")))?;
+    let value: Value = serde_json::from_str(text).map_err(|e| json_error(text, &e))?;
     let obj = value
         .as_object()
         .ok_or_else(|| Error::Format("the document is not a JSON object".into()))?;
@@ -166,6 +165,7 @@ pub fn from_json(text: &str) -> Result<NetworkFile> {
             .validate()
             .map_err(|e| Error::Format(format!("integrator: {}", strip(e))))?;
     }
+    check_meta(&doc.meta)?;
     let network = Network::new(doc.tau, doc.theta, weights, sensor_weights, doc.state)
         .map_err(|e| Error::Format(strip(e)))?;
     Ok(NetworkFile {
@@ -173,6 +173,59 @@ pub fn from_json(text: &str) -> Result<NetworkFile> {
         integrator: doc.integrator,
         meta: doc.meta,
     })
+}
+
+/// `not valid JSON: ...`, saying so when the text there is a NaN or an infinity, which JSON has
+/// no words for (Python's `json` writes them, and every value of a network must be finite).
+fn json_error(text: &str, e: &serde_json::Error) -> Error {
+    let line = text.lines().nth(e.line().saturating_sub(1)).unwrap_or("");
+    let column = e.column().saturating_sub(1);
+    let at = line.get(column..).unwrap_or("");
+    // The error stands after the sign of `-Infinity`.
+    let signed = column > 0 && line.get(column - 1..column) == Some("-");
+    let word = ["NaN", "Infinity"]
+        .into_iter()
+        .find(|w| at.starts_with(w))
+        .map(|w| {
+            if signed {
+                format!("-{w}")
+            } else {
+                w.to_string()
+            }
+        });
+    Error::Format(match word {
+        Some(w) => format!(
+            "not valid JSON: {w} at line {} column {}; a network's numbers must be finite, and JSON has no NaN or Infinity",
+            e.line(),
+            e.column()
+        ),
+        None => format!("not valid JSON: {e}"),
+    })
+}
+
+/// The conventional keys of `meta` (docs/network-format.md), checked for their type when
+/// present, as the schema checks them; any other key may hold anything.
+fn check_meta(meta: &Map<String, Value>) -> Result<()> {
+    type Check = fn(&Value) -> bool;
+    let whole: Check = |v| v.as_u64().is_some();
+    let strings: Check = |v| v.as_array().is_some_and(|a| a.iter().all(Value::is_string));
+    let rules: [(&str, &str, Check); 7] = [
+        ("task", "a string", Value::is_string),
+        ("seed", "an integer >= 0", whole),
+        ("generation", "an integer >= 0", whole),
+        ("fitness", "a number", Value::is_number),
+        ("dnnevo_version", "a string", Value::is_string),
+        ("input_labels", "a list of strings", strings),
+        ("output_labels", "a list of strings", strings),
+    ];
+    for (key, what, ok) in rules {
+        if let Some(v) = meta.get(key) {
+            if !ok(v) {
+                return Err(Error::Format(format!("meta.{key} is {v}; expected {what}")));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The message of an error without its category prefix.

@@ -119,3 +119,50 @@ fn bad_documents_name_the_problem() {
     let ragged = minimal.replace("[[0]]", "[[0, 1]]");
     assert!(err(&ragged).contains("weights[0] has 2 values; expected 1"));
 }
+
+#[test]
+fn nan_and_infinity_are_named_and_meta_s_conventional_keys_are_checked() {
+    let minimal = r#"{"format": "dnnevo-network", "version": 1, "tau": [1],
+        "theta": [0], "weights": [[0]], "sensor_weights": [[]]}"#;
+    for word in ["NaN", "Infinity", "-Infinity"] {
+        let e = err(&minimal.replace(r#""theta": [0]"#, &format!(r#""theta": [{word}]"#)));
+        assert!(
+            e.starts_with(&format!("not valid JSON: {word} at line 2 column")),
+            "{e}"
+        );
+        assert!(e.ends_with("JSON has no NaN or Infinity"), "{e}");
+    }
+    let with_meta = |meta: &str| minimal.replace(r#""tau""#, &format!(r#""meta": {meta}, "tau""#));
+    for (meta, message) in [
+        (
+            r#"{"seed": -1}"#,
+            "meta.seed is -1; expected an integer >= 0",
+        ),
+        (
+            r#"{"seed": 1.5}"#,
+            "meta.seed is 1.5; expected an integer >= 0",
+        ),
+        (
+            r#"{"generation": "3"}"#,
+            "meta.generation is \"3\"; expected an integer >= 0",
+        ),
+        (r#"{"task": 3}"#, "meta.task is 3; expected a string"),
+        (
+            r#"{"fitness": "high"}"#,
+            "meta.fitness is \"high\"; expected a number",
+        ),
+        (
+            r#"{"input_labels": [1, 2]}"#,
+            "meta.input_labels is [1,2]; expected a list of strings",
+        ),
+        (
+            r#"{"output_labels": "x"}"#,
+            "meta.output_labels is \"x\"; expected a list of strings",
+        ),
+    ] {
+        assert_eq!(err(&with_meta(meta)), message);
+    }
+    let fine = r#"{"seed": 3, "generation": 0, "fitness": -0.5, "task": "x", "input_labels": ["a"],
+        "anything": [1, {"b": null}]}"#;
+    assert_eq!(from_json(&with_meta(fine)).unwrap().meta["seed"], 3);
+}

@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import json
 import pickle
+import re
 from pathlib import Path
 
 import numpy as np
@@ -106,6 +107,13 @@ def test_bad_run_arguments(inputs: np.ndarray, kwargs: dict, fragment: str) -> N
     with pytest.raises(InvalidArgumentError) as info:
         make().run(inputs, **kwargs)
     assert fragment in str(info.value)
+
+
+@pytest.mark.parametrize("substeps", [1.5, True, "2"])
+def test_a_count_that_is_no_integer_is_a_type_error_naming_the_argument(substeps: object) -> None:
+    with pytest.raises(TypeError, match=rf"^substeps is {re.escape(repr(substeps))}; it must be an integer in"):
+        make().run(np.ones((5, 2)), substeps=substeps)
+    assert make().run(np.ones((5, 2)), substeps=np.int64(2)).states.shape == (5, 3)
 
 
 def test_divergent_euler_is_an_error_not_infinities() -> None:

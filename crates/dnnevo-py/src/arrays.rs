@@ -110,10 +110,13 @@ pub fn uint<T: TryFrom<i128>>(obj: &Bound<'_, PyAny>, name: &str, max: &str) -> 
 /// An integer argument of any size, for parameters with a literal default: the value when it
 /// fits in an `i128`, else only its `repr`, so that [`AnyInt::to`] can raise an
 /// `InvalidArgumentError` naming the argument where pyo3 would raise `OverflowError`.
+/// A value that is not an integer at all (a float, a bool, a string) is kept too, so that
+/// [`AnyInt::to`] raises a `TypeError` that names the argument.
 #[derive(Clone, Debug)]
 pub struct AnyInt {
     value: Option<i128>,
     repr: String,
+    integer: bool,
 }
 
 impl From<i128> for AnyInt {
@@ -121,6 +124,7 @@ impl From<i128> for AnyInt {
         AnyInt {
             value: Some(value),
             repr: value.to_string(),
+            integer: true,
         }
     }
 }
@@ -130,15 +134,16 @@ impl<'a, 'py> FromPyObject<'a, 'py> for AnyInt {
 
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
         let is_bool = obj.is_instance_of::<pyo3::types::PyBool>();
-        if is_bool || !(obj.is_instance_of::<pyo3::types::PyInt>() || obj.hasattr("__index__")?) {
-            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-                "{} is not an integer",
-                obj.repr()?
-            )));
-        }
+        let integer =
+            !is_bool && (obj.is_instance_of::<pyo3::types::PyInt>() || obj.hasattr("__index__")?);
         Ok(AnyInt {
-            value: obj.extract::<i128>().ok(),
+            value: if integer {
+                obj.extract::<i128>().ok()
+            } else {
+                None
+            },
             repr: obj.repr()?.to_string(),
+            integer,
         })
     }
 }
@@ -147,12 +152,13 @@ impl AnyInt {
     /// The value as `T`, or an `InvalidArgumentError` saying `name` must be an integer in
     /// `range` (e.g. `"[1, 2**64)"`).
     pub fn to<T: TryFrom<i128>>(&self, name: &str, range: &str) -> PyResult<T> {
-        self.value.and_then(|v| T::try_from(v).ok()).ok_or_else(|| {
-            arg_err(format!(
-                "{name} is {}; it must be an integer in {range}",
-                self.repr
-            ))
-        })
+        let message = format!("{name} is {}; it must be an integer in {range}", self.repr);
+        if !self.integer {
+            return Err(pyo3::exceptions::PyTypeError::new_err(message));
+        }
+        self.value
+            .and_then(|v| T::try_from(v).ok())
+            .ok_or_else(|| arg_err(message))
     }
 }
 

@@ -198,7 +198,7 @@ pub(crate) fn newton(
     field.residual(&v, &mut g);
     let norm = |x: &[f64]| x.iter().map(|a| a * a).sum::<f64>();
     for _ in 0..max_iterations {
-        if max_abs(&g) <= tolerance {
+        if within(&g, tolerance) {
             return Some(v);
         }
         let rhs = nalgebra::DVector::from_iterator(n, g.iter().map(|x| -x));
@@ -210,7 +210,7 @@ pub(crate) fn newton(
                 trial[i] = v[i] + scale * step[i];
             }
             field.residual(&trial, &mut g_trial);
-            if norm(&g_trial) < before || max_abs(&g_trial) <= tolerance {
+            if norm(&g_trial) < before || within(&g_trial, tolerance) {
                 break;
             }
             scale *= 0.5;
@@ -221,7 +221,13 @@ pub(crate) fn newton(
         std::mem::swap(&mut v, &mut trial);
         std::mem::swap(&mut g, &mut g_trial);
     }
-    (max_abs(&g) <= tolerance).then_some(v)
+    within(&g, tolerance).then_some(v)
+}
+
+/// Whether every residual is within `tolerance` of 0; a NaN never is (a network whose sums
+/// overflow has none, and `max_abs`, built on `f64::max`, would pass over it).
+fn within(g: &[f64], tolerance: f64) -> bool {
+    g.iter().all(|x| x.abs() <= tolerance)
 }
 
 /// Adds `v` to `found` unless an equilibrium within `distinct` (max norm) is already there.

@@ -760,3 +760,22 @@ fn two_branches_reaching_one_cycle_leave_it_to_the_closer() {
     }
     assert!(!continues(&c, &far));
 }
+
+#[test]
+fn a_network_whose_sums_overflow_has_no_nan_equilibria() {
+    // Finite weights whose sums overflow: the residual is NaN or infinite everywhere it is
+    // large, and a NaN residual once passed for a converged one.
+    let net = Network::new(
+        vec![1.0, 1.0],
+        vec![0.0, 0.0],
+        vec![1e308, 1e308, 1.0, 1.0],
+        vec![0.0, 0.0],
+        None,
+    )
+    .unwrap();
+    let found = equilibria(&net, &[0.0], &EquilibriumSearch::default()).unwrap();
+    assert!(
+        found.iter().all(|e| e.state.iter().all(|v| v.is_finite())),
+        "{found:?}"
+    );
+}

@@ -88,7 +88,13 @@ class Trace:
 
 @final
 class Network:
-    """A continuous-time recurrent neural network of N neurons and M sensors."""
+    """A continuous-time recurrent neural network of N neurons and M sensors::
+
+        tau_i dv_i/dt = -v_i + sum_j weights[i][j] f(v_j - theta_j) + sum_k sensor_weights[i][k] I_k
+
+    with the firing rate ``f(x) = 1 / (1 + exp(-x))`` (mind the sign: ``f(v - theta)``, where
+    Beer-lab code often writes ``sigma(v + bias)``). The attributes are read-only copies: to
+    change a weight, build a new network."""
 
     def __new__(
         cls,

@@ -14,7 +14,16 @@ use crate::detach::detached;
 use crate::errors::{ConfigError, FormatError, IntoPy, InvalidNetworkError};
 use crate::pyjson::{dict_to_map, json_to_py};
 
-/// A continuous-time recurrent neural network (see the module docs of `dnnevo`).
+/// A continuous-time recurrent neural network of N neurons and M sensors:
+///
+///     tau_i dv_i/dt = -v_i + sum_j weights[i][j] f(v_j - theta_j) + sum_k sensor_weights[i][k] I_k
+///
+/// with the firing rate f(x) = 1 / (1 + exp(-x)) (mind the sign: f(v - theta), where Beer-lab
+/// code often writes sigma(v + bias)). Build one with `Network(tau, theta, weights,
+/// sensor_weights, state=None)`, `Network.random(size, n_inputs, seed=...)` or
+/// `Network.load(path)` (docs/network-format.md). `run` integrates it with Euler or RK4 and keeps
+/// the final state; `dnnevo.analysis` finds its equilibria, cycles and bifurcations. The
+/// attributes are read-only copies: to change a weight, build a new network.
 #[pyclass(module = "dnnevo._core", name = "Network")]
 #[derive(Clone)]
 pub struct PyNetwork {
@@ -248,8 +257,10 @@ impl PyNetwork {
             .py_err()
     }
 
-    /// Integrates through the rows of `inputs` (T, M), each held for `substeps` steps of `dt`,
-    /// in `precision` ("f64" or "f32": see `run_population`).
+    /// Integrates through the rows of `inputs` (T, M), each held for `substeps` steps of `dt`
+    /// with `method` ("euler" or "rk4"), in `precision` ("f64" or "f32": see
+    /// `run_population`), and keeps the final state (the next call goes on from it; `reset`
+    /// starts again). Returns a `Trace`: the states and firing rates after every input row.
     #[pyo3(signature = (inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", precision="f64"), text_signature = "($self, inputs, *, dt=0.1, substeps=1, method='euler', precision='f64')")]
     fn run(
         &mut self,

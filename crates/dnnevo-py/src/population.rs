@@ -134,7 +134,13 @@ fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
         .collect()
 }
 
-/// Integrates P networks of the same shape together; see `dnnevo.run_population`.
+/// Integrates P networks of the same N and M together, each through the same `inputs` (T, M)
+/// (or its own, (P, T, M)): the states after every input row (P, T, N) with `record`, else the
+/// final states (P, N). `networks` is a list of `Network`s or a dict of stacked arrays (`tau`
+/// (P, N), `theta` (P, N), `weights` (P, N, N), `sensor_weights` (P, N, M), optionally `state`
+/// (P, N)). `precision="f32"` computes in single precision (parameters and inputs rounded to
+/// float32 once, states float32 throughout, returned widened to float64); "f64", the default,
+/// is the reference. Every kernel (AVX-512, AVX2, portable, NEON) gives the same bits.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments
 #[pyo3(signature = (networks, inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", record=true, precision="f64"), text_signature = "(networks, inputs, *, dt=0.1, substeps=1, method='euler', record=True, precision='f64')")]

@@ -250,6 +250,10 @@ def test_replay_reproduces_a_recorded_trial_and_settles_to_names_attractors() ->
     which = analysis.settles_to(net, states[::50], stable)
     assert set(which.tolist()) <= {0, 1}
     assert analysis.settles_to(net, [stable[0].state], stable[1:]).tolist() == [-1]
+    with pytest.raises(InvalidArgumentError, match=rf"states have shape \(1, 3\); expected finite values with the last axis N = {net.size}"):
+        analysis.settles_to(net, np.zeros((1, 3)), stable)
+    with pytest.raises(InvalidArgumentError, match="duration is -1; expected a time > 0"):
+        analysis.settles_to(net, [stable[0].state], stable, duration=-1)
 
 
 def test_a_sweep_with_cycles_brackets_them_by_its_hopf_points() -> None:

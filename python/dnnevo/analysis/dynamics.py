@@ -175,7 +175,13 @@ def settles_to(
     time constants), integrated by RK4 at a step of a fifth of the smallest time constant; -1
     when it ends farther than ``tolerance`` (in firing rate) from every target. With ``input`` off
     and the stable equilibria as ``targets``, this says which attractor holds the state."""
-    v = np.asarray(states, dtype=float).reshape(-1, net.size)
+    v = np.asarray(states, dtype=float)
+    if v.shape[-1:] != (net.size,) or not np.all(np.isfinite(v)):
+        raise InvalidArgumentError(f"states have shape {v.shape}; expected finite values with the last axis "
+                                   f"N = {net.size}")
+    v = v.reshape(-1, net.size)
+    if duration is not None and not (math.isfinite(duration) and duration > 0):
+        raise InvalidArgumentError(f"duration is {duration!r}; expected a time > 0")
     dt = float(np.min(net.tau)) / 5
     steps = int(math.ceil((duration if duration is not None else 30 * float(np.max(net.tau))) / dt))
     u = np.tile(np.asarray(_input(net, input)), (steps, 1))

@@ -4,6 +4,7 @@ the Axes, as :mod:`dnnevo.plot`'s do."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
@@ -61,18 +62,28 @@ def plot_phase_portrait(
         ax.contour(x, y, rate[..., i], levels=[0.0], colors="tab:green", linewidths=0.9)
         ax.contour(x, y, rate[..., j], levels=[0.0], colors="tab:purple", linewidths=0.9, linestyles="--")
     handles = []
+    if net.size == 2 and attractors:
+        first = _condition(attractors[0].label)
+        handles += [Line2D([], [], color="tab:green", lw=0.9, label=f"neuron {i}'s nullcline ({first})"),
+                    Line2D([], [], color="tab:purple", lw=0.9, ls="--", label=f"neuron {j}'s nullcline ({first})")]
     for k, a in enumerate(attractors):
         marker = _MARKERS[k % len(_MARKERS)]
+        # Later conditions' markers are smaller, so that an equilibrium two conditions share
+        # shows both markers, one inside the other.
+        size = max(3.0, 11.0 - 4.0 * k)
         for c in a.cycles:
             out = _sigmoid(c.orbit - theta)
             ax.plot(np.append(out[:, i], out[0, i]), np.append(out[:, j], out[0, j]), color="k", lw=1.2,
                     zorder=3)
         for e in a.equilibria:
             color = STABILITY_COLORS[e.stability]
-            ax.plot(e.outputs[i], e.outputs[j], marker=marker, ms=8, ls="none", zorder=4,
+            if k:  # a white ring parts it from an earlier condition's marker beneath
+                ax.plot(e.outputs[i], e.outputs[j], marker=marker, ms=size + 1.5, ls="none", zorder=4 + k,
+                        color="white")
+            ax.plot(e.outputs[i], e.outputs[j], marker=marker, ms=size, ls="none", zorder=4 + k,
                     markeredgecolor=color, markerfacecolor=color if e.stable else "white", markeredgewidth=1.6)
         cyc = f", {len(a.cycles)} cycle{'s' * (len(a.cycles) != 1)}" if a.cycles else ""
-        handles.append(Line2D([], [], marker=marker, ls="none", color="0.3", label=f"input {a.label}{cyc}"))
+        handles.append(Line2D([], [], marker=marker, ls="none", color="0.3", label=f"{_condition(a.label)}{cyc}"))
     seen = {e.stability for a in attractors for e in a.equilibria}
     handles += [Line2D([], [], marker="o", ls="none", color=STABILITY_COLORS[s], label=s.replace("_", " "))
                 for s in STABILITY_COLORS if s in seen]
@@ -84,6 +95,12 @@ def plot_phase_portrait(
     if title:
         ax.set_title(title, fontsize=10)
     return ax
+
+
+def _condition(label: str) -> str:
+    """A condition's name for a legend: ``input 0,1`` for a label made of the input values (as
+    :func:`attractors` makes it), the label itself otherwise (``no input``)."""
+    return f"input {label}" if re.fullmatch(r"[-+0-9.e, ]+", label) else label
 
 
 _CYCLE_COLORS = ["k", "tab:purple", "tab:brown", "tab:olive", "tab:cyan", "tab:pink"]

@@ -217,3 +217,15 @@ def test_a_lone_surrogate_escape_is_refused_naming_the_file() -> None:
     assert "\\ud800{" in damaged
     with pytest.raises(RunFileError, match=r"checkpoint.json: holds a \\u escape of a lone surrogate"):
         readers.read(readers.READERS["checkpoint"], damaged.encode())
+
+
+@pytest.mark.parametrize(("kind", "seed"), [("checkpoint", "seed-checkpoint.json"), ("network", "seed-best.json"),
+                                            ("results", "seed-landmark-0.json")])
+def test_a_key_given_twice_is_refused_naming_the_file(kind: str, seed: str) -> None:
+    # json.loads, and serde_json's Value, keep the last of two equal keys: a file edited by hand
+    # could hold two values of one setting, and the one read would be a guess.
+    text = (readers.CORPUS / kind / seed).read_text()
+    first = next(iter(json.loads(text)))  # the document's first key, given again before it
+    damaged = text.replace("{", f'{{"{first}": "twice", ', 1)
+    with pytest.raises(DnnevoError, match=rf'the key "{first}" appears twice in one object'):
+        readers.read(readers.READERS[kind], damaged.encode())

@@ -140,9 +140,19 @@ def read_text(path: Path) -> str:
 _SURROGATE_ESCAPE = re.compile(r"\\u[dD][89a-fA-F][0-9a-fA-F]{2}")
 
 
+def _distinct_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """An object's keys, each once: ``json.loads`` alone keeps the last of two equal keys."""
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"the key {json.dumps(key)} appears twice in one object")
+        out[key] = value
+    return out
+
+
 def load_json(path: Path, text: str) -> Any:
     try:
-        doc = json.loads(text)
+        doc = json.loads(text, object_pairs_hook=_distinct_keys)
     except RecursionError:
         raise fail(path, "JSON nested too deeply") from None
     except ValueError as e:

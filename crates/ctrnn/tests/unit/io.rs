@@ -162,6 +162,14 @@ fn nan_and_infinity_are_named_and_meta_s_conventional_keys_are_checked() {
     ] {
         assert_eq!(err(&with_meta(meta)), message);
     }
+    let twice = minimal.replace(r#""tau": [1]"#, r#""tau": [1], "tau": [2]"#);
+    assert!(
+        err(&twice).starts_with("not valid JSON: the key \"tau\" appears twice in one object"),
+        "{}",
+        err(&twice)
+    );
+    let nested = with_meta(r#"{"a": {"b": 1, "b": 2}}"#);
+    assert!(err(&nested).contains("the key \"b\" appears twice"));
     let fine = r#"{"seed": 3, "generation": 0, "fitness": -0.5, "task": "x", "input_labels": ["a"],
         "anything": [1, {"b": null}]}"#;
     assert_eq!(from_json(&with_meta(fine)).unwrap().meta["seed"], 3);

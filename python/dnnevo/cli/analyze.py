@@ -36,9 +36,12 @@ judged by the class's success rule.
 
 With the sensors held at each --input vector (default: the task's own conditions; for the
 built-in tasks all off, then each input on alone), the champion is an autonomous dynamical system: its equilibria (stable node or focus,
-saddle, unstable) and attracting limit cycles are found and printed. --sweep varies one input
+saddle, unstable) and attracting limit cycles are found and printed (an equilibrium's time scale is
+1 / min |Re lambda| over its eigenvalues, in the units of tau: how slowly its slowest direction
+moves). --sweep varies one input
 (default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
-points (H: a cycle is born); --sweep-cycles also follows the attracting cycles along it,
+points (H: a complex pair of eigenvalues crosses the imaginary axis, where a cycle appears or
+vanishes); --sweep-cycles also follows the attracting cycles along it,
 each branch from where it appears to where it vanishes. Lesions clamp each
 neuron at its mean firing rate over real trials, and cut the N strongest connections, then judge
 the champion on the same fresh trials as 'dnnevo assess'. See docs/analysis.md. Written into the run folder: analysis.json, analysis-phase.png (firing rates of
@@ -282,7 +285,7 @@ def _end_text(end: analysis.CycleEnd | None, edge: str, events: list[analysis.Ev
     folds = [e.value for e in events if e.kind == "fold" and lo <= e.value <= hi]
     there = f"; fold{'s' * (len(folds) > 1)} at {', '.join(f'{v:.4g}' for v in folds)} there" if folds else ""
     was = f", {period:.3g} at {end.with_cycle:g}" if period is not None else ""
-    return (f"{end.value:.4g} (lost between {end.with_cycle:g} and {end.without_cycle:g}{there}; "
+    return (f"{end.value:.4g} (found at {end.with_cycle:g}, gone at {end.without_cycle:g}{there}; "
             f"period {end.period:.3g} there{was})")
 
 
@@ -316,9 +319,9 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
         if len(a.equilibria) > 12:
             lines.append(f"    ... {len(a.equilibria) - 12} more in analysis.json")
         for c in a.cycles:
-            lines.append(f"    cycle: period {c.period:.3g}, output 0 between "
-                         f"{np.min(c.orbit[:, 0]):.3g} and {np.max(c.orbit[:, 0]):.3g} (state), "
-                         f"largest multiplier {c.max_multiplier:.3g}")
+            lines.append(f"    cycle: period {c.period:.3g}, neuron 0's state between "
+                         f"{np.min(c.orbit[:, 0]):.3g} and {np.max(c.orbit[:, 0]):.3g}, "
+                         f"largest Floquet multiplier {c.max_multiplier:.3g}")
     events = ", ".join(event_texts(bif.events)) or "none"
     lines.append(f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}")
     if bif.retried:

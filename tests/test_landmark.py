@@ -372,6 +372,10 @@ def test_plots_draw_what_the_record_holds():
     plot_traces({"sonar": rec.input}, rec.outputs, ax, highlight=0)
     assert len(ax.lines) >= 9  # the input and 8 neurons
     np.testing.assert_array_equal(ax.lines[0].get_ydata(), (9 - 1) * 1.3 + rec.input)
+    for inputs, kwargs, message in [({"sonar": rec.input[1:]}, {}, r"inputs\['sonar'\] has shape"),
+                                    ({"sonar": rec.input}, {"labels": ["a"]}, "labels has 1 names; expected N = 8")]:
+        with pytest.raises(dnnevo.InvalidArgumentError, match=message):
+            plot_traces(inputs, rec.outputs, Figure().subplots(), **kwargs)
 
 
 # -- fitness and assessment --------------------------------------------------------------------

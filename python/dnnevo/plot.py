@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from dnnevo.errors import InvalidArgumentError
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
@@ -100,9 +102,17 @@ def plot_traces(
     """Stacked traces in the style of the paper's Figs. 1 and 3: each input, then each neuron's
     firing rate (columns of the (T, N) ``outputs``), one band per trace, all on [0, 1]. The band of
     neuron ``highlight`` gets a 0.5 line."""
-    ax = axes(ax)
     out = np.asarray(outputs, dtype=float)
+    if out.ndim != 2:
+        raise InvalidArgumentError(f"outputs has shape {out.shape}; expected (T, N)")
     series = [(name, np.asarray(v, dtype=float), "tab:green") for name, v in inputs.items()]
+    for name, v, _ in series:
+        if v.shape != (out.shape[0],):
+            raise InvalidArgumentError(f"inputs[{name!r}] has shape {v.shape}; expected ({out.shape[0]},), one "
+                                       "value per row of outputs")
+    if labels is not None and len(labels) != out.shape[1]:
+        raise InvalidArgumentError(f"labels has {len(labels)} names; expected N = {out.shape[1]}, one per neuron")
+    ax = axes(ax)
     names = labels or [f"neuron {i}" for i in range(out.shape[1])]
     series += [(names[i], out[:, i], "tab:red" if i == highlight else "tab:blue")
                for i in range(out.shape[1])]

@@ -384,3 +384,18 @@ def test_dir_lists_only_the_public_names() -> None:
     for module in ("dynamics", "lesions", "trials", "figures"):
         names = importlib.import_module(f"dnnevo.analysis.{module}").__all__
         assert set(names) <= set(analysis.__all__), (module, set(names) - set(analysis.__all__))
+
+
+def test_a_sweep_neither_walks_past_a_fold_nor_misses_a_hopf_point_beside_a_node() -> None:
+    # A hysteresis loop inside one sweep interval: linking the lower branch to the upper one by a
+    # walk past the fold hid both folds; a finer sweep finds the same two.
+    loop = dnnevo.Network.random(3, 1, seed=26)
+    folds = [round(e.value, 4) for e in analysis.bifurcation(loop, 0, 0.84, 0.90, steps=2).events]
+    assert folds == [round(e.value, 4) for e in analysis.bifurcation(loop, 0, 0.84, 0.90, steps=7).events]
+    assert folds == [0.8618, 0.8705]
+    # An unstable node at one value, a stable focus between, a stable node at the next: the
+    # count of unstable eigenvalues changes with det's sign, so a complex pair crossed.
+    node = dnnevo.Network.random(2, 1, seed=89)
+    for steps in (3, 5):
+        events = analysis.bifurcation(node, 0, 0.24, 0.30, steps=steps).events
+        assert [(e.kind, round(e.value, 4)) for e in events] == [("hopf", 0.269)]

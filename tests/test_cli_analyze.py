@@ -69,6 +69,7 @@ def test_analyze_writes_json_and_figures(runs: dict[str, Path], preset: str) -> 
 def test_analyze_options_and_a_two_neuron_portrait(tmp_path: Path, runs: dict[str, Path]) -> None:
     run = runs["sequence-1bit"]
     (run / "analysis-lesions.png").write_bytes(b"an earlier analysis's figure")
+    (run / "analysis-notes.png").write_bytes(b"the user's own file")
     r = run_cli("analyze", run, "--input", "0,0", "--input", "0,0.5", "--neurons", "0,2", "--no-lesions",
                 "--sweep", "0:2", "--sweep-input", "0", "--steps", "5", "--sweep-cycles")
     assert r.returncode == 0, r.stderr
@@ -77,6 +78,7 @@ def test_analyze_options_and_a_two_neuron_portrait(tmp_path: Path, runs: dict[st
     assert doc["neurons"] == [0, 2] and doc["lesions"] is None
     # No figure of an earlier analysis is left beside an analysis.json that does not describe it.
     assert not (run / "analysis-lesions.png").exists()
+    assert (run / "analysis-notes.png").read_bytes() == b"the user's own file"
     assert r.stdout.rstrip().endswith("; removed the earlier analysis's analysis-lesions.png"), r.stdout
     assert doc["bifurcation"]["index"] == 0 and doc["bifurcation"]["values"][-1] == 2.0
     assert len(doc["bifurcation"]["cycles"]) == 5

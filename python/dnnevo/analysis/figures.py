@@ -70,7 +70,7 @@ def plot_phase_portrait(
         marker = _MARKERS[k % len(_MARKERS)]
         # Later conditions' markers are smaller, so that an equilibrium two conditions share
         # shows both markers, one inside the other.
-        size = max(3.0, 11.0 - 4.0 * k)
+        size = 11.0 * 0.72**k
         for c in a.cycles:
             out = _sigmoid(c.orbit - theta)
             ax.plot(np.append(out[:, i], out[0, i]), np.append(out[:, j], out[0, j]), color="k", lw=1.2,

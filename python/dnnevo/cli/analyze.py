@@ -5,6 +5,7 @@ atomically, and prints a summary."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import time
 from pathlib import Path
@@ -49,7 +50,11 @@ two neurons, those that vary most unless --neurons, with a real trial, equilibri
 and nullclines for 2 neurons), analysis-bifurcation.png (the firing rate of the neuron whose
 equilibria move most), analysis-basins.png (the recorded trials over time, on a background that
 says which attractor of the first --input the state would settle in if that input were held
-from then on) and analysis-lesions.png."""
+from then on) and analysis-lesions.png; one of these that an earlier analysis drew and this one
+does not (--no-lesions) is removed."""
+
+FIGURES = ("analysis-phase.png", "analysis-bifurcation.png", "analysis-lesions.png", "analysis-basins.png")
+"""The figures ``analyze`` itself draws (a task's views add their own)."""
 
 DEFAULT_LESION_TRIALS = 200
 
@@ -168,11 +173,12 @@ def analyze(args: argparse.Namespace) -> int:
             if try_write(lambda: save_figure(fig, run.path / file)):
                 written.append(file)
             plot.close(fig)
-    # A figure of an earlier analysis that this one did not draw (--no-lesions, a view gone)
-    # would sit beside an analysis.json that does not describe it.
-    stale = sorted(p.name for p in run.path.glob("analysis-*.png") if p.name not in written)
+    # A figure of an earlier analysis that this one did not draw (--no-lesions) would sit beside
+    # an analysis.json that does not describe it. Only analyze's own names are removed.
+    stale = [f for f in FIGURES if f not in written and (run.path / f).is_file()]
     for file in stale:
-        (run.path / file).unlink(missing_ok=True)
+        with contextlib.suppress(OSError):
+            (run.path / file).unlink()
     print("\n".join(summary(found, bif, table, name, basins, output=output)
                     + [line for v in seen for line in v.lines]))
     wrote = ", ".join(str(run.path / w) for w in written) if written else "nothing"
@@ -321,7 +327,7 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
         for c in a.cycles:
             lines.append(f"    cycle: period {c.period:.3g}, neuron 0's state between "
                          f"{np.min(c.orbit[:, 0]):.3g} and {np.max(c.orbit[:, 0]):.3g}, "
-                         f"largest Floquet multiplier {c.max_multiplier:.3g}")
+                         f"largest Floquet multiplier besides the trivial 1: {c.max_multiplier:.3g}")
     events = ", ".join(event_texts(bif.events)) or "none"
     lines.append(f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}")
     if bif.retried:

@@ -9,16 +9,16 @@
 //!   the previous value appeared: a **fold** (saddle-node), where a real eigenvalue passes
 //!   through 0. Its input value is refined by bisection, following the equilibrium by Newton's
 //!   method while it keeps the sign of `det(dG/dv)` (a fold's two equilibria have opposite signs).
-//! - a linked pair whose count of complex eigenvalues with positive real part differs, with
-//!   complex eigenvalues on both sides, or with a real pair on one side and a different count
-//!   of eigenvalues with positive real part (a stable node on one side and an unstable focus on
-//!   the other: the pair turned complex and crossed between the two values): a **Hopf point**,
-//!   where a complex pair crosses the imaginary axis. Its input value is refined by bisection
-//!   along the linked equilibrium. (An unstable node that turns into an unstable focus keeps
-//!   its count and is no event.)
+//! - a linked pair whose count of eigenvalues with positive real part differs while the sign of
+//!   `det(dG/dv)` stays (no real eigenvalue passed through 0): a **Hopf point**, where a complex
+//!   pair crosses the imaginary axis, also when the pair is real on one side (a stable node at
+//!   one value, an unstable focus at the next: it turned complex and crossed in between). Its
+//!   input value is refined by bisection along the linked equilibrium, on that count. (A node
+//!   that turns into a focus keeps its count and is no event.)
 //!
 //! Linking is by continuation: Newton's method in a few steps to the next value from each
-//! equilibrium, and back.
+//! equilibrium, and back, each step keeping the sign of `det` and moving less than half the
+//! distance to any other equilibrium (as a fold's bisection does).
 //! A value where the search finds an even number of equilibria is searched again with
 //! [`EquilibriumSearch::retry_starts`] starts, by the same rule as a single search; the values
 //! where that happened are listed in [`Bifurcation::retried`].
@@ -36,7 +36,7 @@ use serde::Serialize;
 use super::branches::{cycles_at, locate, CycleBranch};
 use super::cycles::{Cycle, CycleSearch};
 use super::equilibria::{max_abs, search, Equilibrium, EquilibriumSearch};
-use super::events::{distance, has_complex, unstable, unstable_complex, At, Event};
+use super::events::{det_positive, distance, unstable, At, Event};
 use super::field::Field;
 use crate::error::{Error, Result};
 use crate::Network;
@@ -210,9 +210,7 @@ pub fn bifurcation(
             match forward[i] {
                 Some(j) if backward[j] == Some(i) => {
                     let f = &next[j];
-                    if unstable_complex(e) != unstable_complex(f)
-                        && ((has_complex(e) && has_complex(f)) || unstable(e) != unstable(f))
-                    {
+                    if unstable(e) != unstable(f) && det_positive(e) == det_positive(f) {
                         events.extend(at.hopf(a, b, e)?);
                     }
                 }

@@ -344,7 +344,8 @@ fn from_start(
             for p in 1..=4.min(sections.len()) {
                 let (t0, x0) = &sections[sections.len() - p];
                 let gap: Vec<f64> = x.iter().zip(x0).map(|(a, b)| a - b).collect();
-                if max_abs(&gap) < settings.tolerance {
+                // Every coordinate, so that a NaN (which max_abs passes over) never closes a cycle.
+                if gap.iter().all(|g| g.abs() < settings.tolerance) {
                     return describe(field, &x, t - t0, p, k, dt, settings);
                 }
             }

@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use super::equilibria::{newton, Equilibrium, EquilibriumSearch};
+use super::equilibria::{max_abs, newton, Equilibrium, EquilibriumSearch};
 use super::field::Field;
 use super::stability::eigenvalues;
 use crate::error::Result;
@@ -13,8 +13,13 @@ use crate::Network;
 
 /// Bisection steps that locate an event between two input values.
 const BISECTIONS: usize = 40;
-/// Newton continuation steps from the last good input value to each bisection trial value.
+/// Newton continuation steps from the last good input value to each bisection trial value,
+/// and from one swept value to the next when linking their equilibria.
 const WALK: usize = 4;
+/// How often a linking step may be halved when its root is not a smooth continuation.
+const HALVINGS: u32 = 6;
+/// The most a linking step may move the state, relative to `1 + max |v|`.
+const SMOOTH: f64 = 0.1;
 /// An event is kept only if its critical eigenvalue's real part is within this of 0, relative to
 /// the largest eigenvalue modulus (at least 1): a link between input values that was wrong, or a
 /// search that missed an equilibrium at one value, then reports nothing instead of a false event.
@@ -56,11 +61,15 @@ fn nearest(x: &[f64], among: &[Equilibrium]) -> Option<usize> {
         .min_by(|&a, &b| distance(x, &among[a].state).total_cmp(&distance(x, &among[b].state)))
 }
 
-pub(super) fn unstable_complex(e: &Equilibrium) -> usize {
-    e.eigenvalues
+/// Half the distance from `e` to the nearest other of `others` (at least 1e-3): how far one
+/// continuation step from `e` may move before it may have reached another equilibrium.
+fn reach(e: &Equilibrium, others: &[Equilibrium]) -> f64 {
+    let nearest = others
         .iter()
-        .filter(|[re, im]| *re > 0.0 && *im != 0.0)
-        .count()
+        .map(|o| distance(&o.state, &e.state))
+        .filter(|d| *d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    (nearest / 2.0).max(1e-3)
 }
 
 /// Eigenvalues with positive real part, real or complex.
@@ -68,8 +77,16 @@ pub(super) fn unstable(e: &Equilibrium) -> usize {
     e.eigenvalues.iter().filter(|[re, _]| *re > 0.0).count()
 }
 
-pub(super) fn has_complex(e: &Equilibrium) -> bool {
-    e.eigenvalues.iter().any(|[_, im]| *im != 0.0)
+/// Whether `det(J)`, the product of the eigenvalues, is positive: an even count of negative
+/// real eigenvalues (a complex pair's product is positive). A real eigenvalue through 0 (a
+/// fold) changes it; a complex pair through the imaginary axis (a Hopf point) does not.
+pub(super) fn det_positive(e: &Equilibrium) -> bool {
+    e.eigenvalues
+        .iter()
+        .filter(|[re, im]| *im == 0.0 && *re < 0.0)
+        .count()
+        % 2
+        == 0
 }
 
 fn det_sign(field: &Field<'_>, v: &[f64]) -> f64 {
@@ -102,9 +119,10 @@ impl<'a> At<'a> {
     }
 
     /// For each of `from` (equilibria at input `start`), the one of `to` (the equilibria at
-    /// input `value`) that Newton's method reaches from it in [`WALK`] continuation steps, if
-    /// any. One step from `start` to `value` lost equilibria that move fast (a half-centre's
-    /// moved by 1 in state between two values of a 101-value sweep, where its Hopf point is).
+    /// input `value`) that [`At::walk`] reaches from it, if any. One Newton step from `start`
+    /// to `value` lost equilibria that move fast (a half-centre's moved by 1 in state between
+    /// two values of a 101-value sweep, where its Hopf point is); an unguarded walk in a few
+    /// steps went past a fold onto the other branch of a hysteresis loop and hid both folds.
     pub(super) fn link(
         &self,
         start: f64,
@@ -112,20 +130,61 @@ impl<'a> At<'a> {
         from: &[Equilibrium],
         to: &[Equilibrium],
     ) -> Result<Vec<Option<usize>>> {
-        let fields = (1..=WALK)
-            .map(|k| self.field(start + (value - start) * k as f64 / WALK as f64))
-            .collect::<Result<Vec<_>>>()?;
-        Ok(from
-            .iter()
+        let here = self.field(start)?;
+        from.iter()
             .map(|e| {
-                let mut r = e.state.clone();
-                for field in &fields {
-                    r = newton(field, r, self.search.tolerance, self.search.max_iterations)?;
-                }
-                let k = nearest(&r, to)?;
-                (distance(&r, &to[k].state) < self.search.distinct).then_some(k)
+                let sign = det_sign(&here, &e.state);
+                let Some(r) = self.walk(start, value, &e.state, sign, reach(e, from))? else {
+                    return Ok(None);
+                };
+                Ok(nearest(&r, to)
+                    .and_then(|k| (distance(&r, &to[k].state) < self.search.distinct).then_some(k)))
             })
-            .collect())
+            .collect()
+    }
+
+    /// Follows the equilibrium `v` at input `start` to input `end` by Newton continuation in
+    /// [`WALK`] steps, halving a step (at most [`HALVINGS`] times) whose root changes the sign of
+    /// `det`, moves `reach` or more (towards another equilibrium), or moves more than [`SMOOTH`]
+    /// relative to the state: a branch moves less the shorter the step, a jump to another
+    /// branch past a fold does not. None when the walk cannot go on: the equilibrium vanished.
+    fn walk(
+        &self,
+        start: f64,
+        end: f64,
+        v: &[f64],
+        sign: f64,
+        reach: f64,
+    ) -> Result<Option<Vec<f64>>> {
+        let mut state = v.to_vec();
+        let (mut at, mut step) = (start, (end - start) / WALK as f64);
+        let shortest = (end - start).abs() / (WALK as f64 * f64::from(1u32 << HALVINGS));
+        while at != end {
+            let p = if (end - at).abs() <= step.abs() * (1.0 + 1e-9) {
+                end
+            } else {
+                at + step
+            };
+            let field = self.field(p)?;
+            let root = newton(
+                &field,
+                state.clone(),
+                self.search.tolerance,
+                self.search.max_iterations,
+            )
+            .filter(|r| {
+                let moved = distance(r, &state);
+                det_sign(&field, r) == sign
+                    && moved < reach
+                    && moved <= SMOOTH * (1.0 + max_abs(&state))
+            });
+            match root {
+                Some(r) => (state, at) = (r, p),
+                None if step.abs() > shortest * (1.0 + 1e-9) => step /= 2.0,
+                None => return Ok(None),
+            }
+        }
+        Ok(Some(state))
     }
 
     /// Follows the equilibrium at `v` (input `a`) towards input `b` while `alive` holds;
@@ -210,14 +269,9 @@ impl<'a> At<'a> {
         // Newton may not jump to a different equilibrium: each continuation step must move less
         // than half the distance from `e` to any other equilibrium at `a`, and keep the sign of
         // det (a fold's partner has the other sign).
-        let reach = others
-            .iter()
-            .map(|o| distance(&o.state, &e.state))
-            .filter(|d| *d > 0.0)
-            .fold(f64::INFINITY, f64::min)
-            / 2.0;
+        let reach = reach(e, others);
         let found = self.bisect(a, b, &e.state, |field, r, previous| {
-            Ok(det_sign(field, r) == sign && distance(r, previous) < reach.max(1e-3))
+            Ok(det_sign(field, r) == sign && distance(r, previous) < reach)
         })?;
         match found {
             Some((value, state)) => self.event(EventKind::Fold, value, state),
@@ -225,12 +279,14 @@ impl<'a> At<'a> {
         }
     }
 
-    /// The Hopf point between `e` (at input `a`) and its partner at input `b`.
+    /// The Hopf point between `e` (at input `a`) and its partner at input `b`: where its count
+    /// of eigenvalues with positive real part changes (a real pair turning complex on the way
+    /// keeps the count).
     pub(super) fn hopf(&self, a: f64, b: f64, e: &Equilibrium) -> Result<Option<Event>> {
-        let count = unstable_complex(e);
+        let count = unstable(e);
         let found = self.bisect(a, b, &e.state, |field, r, _| {
             let eq = Equilibrium::at(field, r.to_vec())?;
-            Ok(unstable_complex(&eq) == count)
+            Ok(unstable(&eq) == count)
         })?;
         match found {
             Some((value, state)) => self.event(EventKind::Hopf, value, state),

@@ -255,3 +255,14 @@ def test_bad_population_arguments(networks, inputs, error, fragment) -> None:  #
     with pytest.raises(error) as info:
         dnnevo.run_population(networks, inputs)
     assert fragment in str(info.value)
+
+
+def test_save_refuses_meta_that_load_would_refuse(tmp_path: Path) -> None:
+    path = tmp_path / "m.json"
+    for meta, message in [({"seed": -1}, "meta.seed is -1"), ({"input_labels": [1]}, "meta.input_labels is [1]"),
+                          ({"task": None}, "meta.task is null")]:
+        with pytest.raises(InvalidArgumentError, match=re.escape(message)):
+            make().save(path, meta=meta)
+        assert not path.exists()
+    make().save(path, meta={"seed": 2.0, "notes": [None, {"x": 1}]})  # the schema's integer; free keys
+    assert dnnevo.Network.load(path).meta["notes"] == [None, {"x": 1}]

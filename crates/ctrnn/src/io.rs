@@ -167,7 +167,9 @@ pub fn from_json(text: &str) -> Result<NetworkFile> {
             .validate()
             .map_err(|e| Error::Format(format!("integrator: {}", strip(e))))?;
     }
-    check_meta(&doc.meta)?;
+    if let Some(problem) = meta_problem(&doc.meta) {
+        return Err(Error::Format(problem));
+    }
     let network = Network::new(doc.tau, doc.theta, weights, sensor_weights, doc.state)
         .map_err(|e| Error::Format(strip(e)))?;
     Ok(NetworkFile {
@@ -273,10 +275,12 @@ fn json_error(text: &str, e: &serde_json::Error) -> Error {
 }
 
 /// The conventional keys of `meta` (docs/network-format.md), checked for their type when
-/// present, as the schema checks them; any other key may hold anything.
-fn check_meta(meta: &Map<String, Value>) -> Result<()> {
+/// present, as the schema checks them; any other key may hold anything. The problem, if any.
+fn meta_problem(meta: &Map<String, Value>) -> Option<String> {
     type Check = fn(&Value) -> bool;
-    let whole: Check = |v| v.as_u64().is_some();
+    // JSON Schema's integer: a number with no fraction, so 3.0 counts.
+    let whole: Check =
+        |v| v.as_u64().is_some() || v.as_f64().is_some_and(|x| x >= 0.0 && x.fract() == 0.0);
     let strings: Check = |v| v.as_array().is_some_and(|a| a.iter().all(Value::is_string));
     let rules: [(&str, &str, Check); 7] = [
         ("task", "a string", Value::is_string),
@@ -290,11 +294,11 @@ fn check_meta(meta: &Map<String, Value>) -> Result<()> {
     for (key, what, ok) in rules {
         if let Some(v) = meta.get(key) {
             if !ok(v) {
-                return Err(Error::Format(format!("meta.{key} is {v}; expected {what}")));
+                return Some(format!("meta.{key} is {v}; expected {what}"));
             }
         }
     }
-    Ok(())
+    None
 }
 
 /// The message of an error without its category prefix.
@@ -307,6 +311,10 @@ pub(crate) fn strip(e: Error) -> String {
 
 /// Writes `file` to `path` atomically.
 pub fn save(path: &Path, file: &NetworkFile) -> Result<()> {
+    // A file that `load` would refuse is not written: meta's conventional keys are checked here.
+    if let Some(problem) = meta_problem(&file.meta) {
+        return Err(Error::InvalidArgument(problem));
+    }
     let mut text = to_json(file);
     text.push('\n');
     write_atomic(path, text.as_bytes())

@@ -145,7 +145,7 @@ def _distinct_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for key, value in pairs:
         if key in out:
-            raise ValueError(f"the key {json.dumps(key)} appears twice in one object")
+            raise ValueError(f"the key {json.dumps(key, ensure_ascii=False)} appears twice in one object")
         out[key] = value
     return out
 

@@ -42,7 +42,7 @@ from dnnevo._core import Network
 from dnnevo.config import EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FormatError, WriteError
 from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
-from dnnevo.runs.files import (FILE_MODE, RunFileError, checked, fail, read_json, read_text,
+from dnnevo.runs.files import (FILE_MODE, RunFileError, checked, fail, load_json, read_json, read_text,
                                remove_temporaries, short, temporary_of, write_atomic, write_failure)
 from dnnevo.runs.history import LOG_COLUMNS, OPTIONAL_COLUMNS, check_history, history_rows, log_cell, read_cell
 from dnnevo.runs.settings import MAX_CONFIG_DEPTH, config_digest, depth, first_difference
@@ -147,7 +147,7 @@ class RunDir:
         if not names <= {self.config.name, self.log.name, self.checkpoint.name} or self.checkpoint.name not in names:
             return False
         try:
-            doc = json.loads(read_text(self.checkpoint))
+            doc = load_json(self.checkpoint, read_text(self.checkpoint))
         except (OSError, ValueError, DnnevoError):
             return False
         return isinstance(doc, dict) and doc.get("history") == []

@@ -173,4 +173,17 @@ fn nan_and_infinity_are_named_and_meta_s_conventional_keys_are_checked() {
     let fine = r#"{"seed": 3, "generation": 0, "fitness": -0.5, "task": "x", "input_labels": ["a"],
         "anything": [1, {"b": null}]}"#;
     assert_eq!(from_json(&with_meta(fine)).unwrap().meta["seed"], 3);
+    assert!(from_json(&with_meta(r#"{"seed": 3.0}"#)).is_ok()); // the schema's integer
+    assert!(err(&with_meta(r#"{"seed": -2.0}"#)).starts_with("meta.seed is -2.0"));
+    // What load would refuse, save does not write.
+    let mut file = from_json(minimal).unwrap();
+    file.meta.insert("seed".into(), (-1).into());
+    let path = std::env::temp_dir().join(format!("dnnevo-meta-{}.json", std::process::id()));
+    match save(&path, &file) {
+        Err(Error::InvalidArgument(m)) => {
+            assert_eq!(m, "meta.seed is -1; expected an integer >= 0")
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(!path.exists());
 }

@@ -157,10 +157,9 @@ def factor_table(families: dict[str, dict[str, dict[str, int]]], base: dict[str,
     for family, seeds in families.items():
         fails = {p.name: sum(not meets(r[p.name], n) for r in seeds.values()) for p in FACTORS}
         worst = max(fails.values())
-        summary.append(f"{family}: the factor that the most champions fail on: "
-                       + ", ".join(name for name, k in fails.items() if k == worst)
-                       + f" ({worst}/{len(seeds)}); champions failing each factor: "
-                       + ", ".join(f"{name} {k}" for name, k in fails.items()) + ".")
+        most = ", ".join(name for name, k in fails.items() if k == worst) if worst else "none (every champion meets the goal in every one)"
+        summary.append(f"{family}: the factor that the most champions fail on: {most} ({worst}/{len(seeds)}); "
+                       "champions failing each factor: " + ", ".join(f"{name} {k}" for name, k in fails.items()) + ".")
     return columns, rows, summary
 
 

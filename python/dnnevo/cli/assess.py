@@ -113,8 +113,9 @@ def step_lines(check: StepCheck) -> list[str]:
 
     marked = False
     for r in judged:
-        cells = [cell(r.rate, r.verdict)] + [cell(c.rate, c.verdict) for n in names
-                                             for c in check.checks[n].rates if c.name == r.name]
+        cells = [cell(r.rate, r.verdict)] + [cell(c.rate, c.verdict) for c in
+                                             (next(c for c in check.checks[n].rates if c.name == r.name)
+                                              for n in names)]
         marked = marked or any(c.endswith("!") for c in cells)
         lines.append(f"{r.name:>{width}}" + "".join(f" {c:>10}" for c in cells))
     change = f"largest change {100 * check.max_change:.1f} points"

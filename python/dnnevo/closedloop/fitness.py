@@ -203,11 +203,17 @@ class ClosedLoop:
                             f"{FLAGS} of shape {returns.shape}, one per episode")
         return flags
 
+    @property
+    def has_success_rule(self) -> bool:
+        """Whether the environment has a success rule (``success`` and ``success_rate``); without
+        one every network's validation rate is 0, and the validation score chooses."""
+        return getattr(self.env, "success", None) is not None and getattr(self.env, "success_rate", None) is not None
+
     def succeeds(self, network: _core.Network, seed: int) -> float:
         """1.0 when ``network`` meets the environment's success rule on
         :data:`SUCCESS_EPISODES` fresh episodes drawn from ``seed``, 0.0 when not, NaN when the
         environment has no rule."""
-        if getattr(self.env, "success", None) is None or getattr(self.env, "success_rate", None) is None:
+        if not self.has_success_rule:
             return float("nan")
         ok, threshold, _ = self.judged(network, SUCCESS_EPISODES, seed, "validate")
         return float(ok.mean() >= threshold)

@@ -523,10 +523,11 @@ def _loop(
                     last_log = now
                 if bar is not None:
                     row = history[-1]
-                    # A task without a success rule (champion_success NaN) gives every network
-                    # the rate 0 and chooses by the score.
+                    # A task class without a success rule gives every network the rate 0 and
+                    # chooses by the score (ClosedLoop.has_success_rule; other fitness objects
+                    # that validate are taken to have a rate).
                     validated = ga.best_validation is not None
-                    ruled = validated and not np.isnan(success)
+                    ruled = validated and getattr(task, "has_success_rule", True)
                     bar.update(int(row["generation"]), row["best"], row["mean"], row["evals_per_s"],
                                champion=ga.best_fitness,
                                validation_rate=validation[0] if ruled else None,

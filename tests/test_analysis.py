@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -136,8 +137,11 @@ def test_bad_arguments() -> None:
         analysis.equilibria(net, starts=0)
     with pytest.raises(InvalidArgumentError, match="seed is -1"):
         analysis.limit_cycles(net, seed=-1)
-    with pytest.raises(InvalidArgumentError, match="input is 3"):
-        analysis.bifurcation(net, 3, 0.0, 1.0)
+    # The argument is named as Python calls it, and NumPy integers are integers.
+    for index in (3, np.int64(3), 1.0, True):
+        with pytest.raises(InvalidArgumentError, match=rf"^index is {re.escape(repr(index))}; this network has 1 sensors"):
+            analysis.bifurcation(net, index, 0.0, 1.0)
+    assert len(analysis.bifurcation(net, np.int64(0), 0.0, 1.0, steps=3).values) == 3
     with pytest.raises(InvalidArgumentError, match="different"):
         analysis.bifurcation(net, 0, 1.0, 1.0)
     with pytest.raises(InvalidArgumentError, match="neuron is 1"):

@@ -27,6 +27,7 @@ objects. The analysis is of the continuous-time system; tasks integrate it with 
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -123,7 +124,11 @@ def bifurcation(
     disappears; that costs about as much as 100 equilibrium searches per value. A value whose
     count of equilibria is even is searched again with ``retry_starts`` starts (as
     :func:`equilibria`); those values are in ``retried``, and those still even in ``even``."""
-    return _core.analysis_bifurcation(net, _input(net, input), index, start, stop, steps=steps, starts=starts,
+    if isinstance(index, bool | np.bool_) or not isinstance(index, numbers.Integral) \
+            or not 0 <= int(index) < net.n_inputs:
+        raise InvalidArgumentError(f"index is {index!r}; this network has {net.n_inputs} sensors, so it must be an "
+                                   f"integer in 0..{net.n_inputs - 1}")
+    return _core.analysis_bifurcation(net, _input(net, input), int(index), start, stop, steps=steps, starts=starts,
                                       seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts)
 
 

@@ -95,6 +95,14 @@ def pct(k: int, n: int) -> str:
     return f"{100 * k / n:.1f}"
 
 
+def rates(ks: list[int], n: int) -> list[str]:
+    """A row's cells for champions right in ``ks`` of ``n`` trials each: how many meet the goal,
+    each one's % right, and the pooled % with its 95% Wilson interval."""
+    lo, hi = wilson(sum(ks), n * len(ks))
+    return [f"{sum(meets(k, n) for k in ks)}/{len(ks)}", " ".join(pct(k, n) for k in ks),
+            f"{pct(sum(ks), n * len(ks))} ({100 * lo:.1f}-{100 * hi:.1f})"]
+
+
 def table(families: dict[str, dict[str, dict[str, int]]], base: dict[str, dict[str, Any]],
           trials: int) -> tuple[list[str], list[list[str]], list[str]]:
     """The record's columns, one row per place and family, and the summary lines."""
@@ -105,12 +113,9 @@ def table(families: dict[str, dict[str, dict[str, int]]], base: dict[str, dict[s
     for place in PLACES:
         b = base[place.name]
         for family, seeds in families.items():
-            ks = [r[place.name] for r in seeds.values()]
-            lo, hi = wilson(sum(ks), n * len(ks))
             lowo = b.get("observer, other worlds")
             rows.append([place.name + (" (held out)" if place.name in HELD_OUT else ""), family,
-                         f"{sum(meets(k, n) for k in ks)}/{len(ks)}", " ".join(pct(k, n) for k in ks),
-                         f"{pct(sum(ks), n * len(ks))} ({100 * lo:.1f}-{100 * hi:.1f})",
+                         *rates([r[place.name] for r in seeds.values()], n),
                          pct(b["threshold"], b["n"]), pct(b["observer"], b["n"]),
                          "-" if lowo is None else pct(lowo, b["n"])])
     summary = [f"{trials} fresh trials per landmark per champion and world (seed {TEST_SEED}); the bounds are "
@@ -143,11 +148,9 @@ def factor_table(families: dict[str, dict[str, dict[str, int]]], base: dict[str,
     for place in FACTORS:
         b = base[place.name]
         for family, seeds in families.items():
-            ks = [r[place.name] for r in seeds.values()]
-            lo, hi = wilson(sum(ks), n * len(ks))
             stuck = sum(r[f"{place.name} one answer"] >= 0.95 * n for r in seeds.values())
-            rows.append([place.name, family, f"{sum(meets(k, n) for k in ks)}/{len(ks)}", " ".join(pct(k, n) for k in ks),
-                         f"{pct(sum(ks), n * len(ks))} ({100 * lo:.1f}-{100 * hi:.1f})", f"{stuck}/{len(ks)}",
+            rows.append([place.name, family, *rates([r[place.name] for r in seeds.values()], n),
+                         f"{stuck}/{len(seeds)}",
                          pct(b["threshold"], b["n"]), pct(b["observer"], b["n"])])
     summary = [f"{trials} fresh trials per landmark per champion and world (seed {TEST_SEED}), as in the "
                f"held-out worlds' table; the bounds are fitted on others (seed {FIT_SEED}). Each follower and "

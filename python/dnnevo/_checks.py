@@ -1,8 +1,11 @@
-"""Argument checks shared by the task modules (``sequence``, ``nav1d``, ``landmark``)."""
+"""Argument checks shared by the task and analysis modules."""
 
 from __future__ import annotations
 
+import numbers
 from typing import TypeVar
+
+import numpy as np
 
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
@@ -17,6 +20,16 @@ def nonnegative(name: str, value: int) -> int:
     if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value < 2**64:
         raise InvalidArgumentError(f"{name} is {value!r}; it must be an integer in [0, 2**64)")
     return value
+
+
+def index(name: str, value: object, size: int, of: str) -> int:
+    """``value`` as an index in 0..size-1 (an integer, Python's or NumPy's, not a bool), else an
+    :class:`InvalidArgumentError` naming it and saying what it indexes (``of``, e.g. "this
+    network has 3 sensors")."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral) \
+            or not 0 <= int(value) < size:
+        raise InvalidArgumentError(f"{name} is {value!r}; {of}, so it must be an integer in 0..{size - 1}")
+    return int(value)
 
 
 def bounded_count(name: str, value: int) -> int:

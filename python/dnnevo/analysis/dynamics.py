@@ -27,7 +27,6 @@ objects. The analysis is of the continuous-time system; tasks integrate it with 
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -36,6 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
+from dnnevo._checks import index as checked_index
 from dnnevo.errors import InvalidArgumentError
 
 __all__ = ["RETRY_STARTS", "STABILITIES", "Attractors", "Bifurcation", "Cycle", "CycleBranch", "CycleEnd",
@@ -124,11 +124,8 @@ def bifurcation(
     disappears; that costs about as much as 100 equilibrium searches per value. A value whose
     count of equilibria is even is searched again with ``retry_starts`` starts (as
     :func:`equilibria`); those values are in ``retried``, and those still even in ``even``."""
-    if isinstance(index, bool | np.bool_) or not isinstance(index, numbers.Integral) \
-            or not 0 <= int(index) < net.n_inputs:
-        raise InvalidArgumentError(f"index is {index!r}; this network has {net.n_inputs} sensors, so it must be an "
-                                   f"integer in 0..{net.n_inputs - 1}")
-    return _core.analysis_bifurcation(net, _input(net, input), int(index), start, stop, steps=steps, starts=starts,
+    k = checked_index("index", index, net.n_inputs, f"this network has {net.n_inputs} sensors")
+    return _core.analysis_bifurcation(net, _input(net, input), k, start, stop, steps=steps, starts=starts,
                                       seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts)
 
 

@@ -6,7 +6,6 @@ which parts its success needs.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -14,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core, tasks
-from dnnevo._checks import nonnegative
+from dnnevo._checks import index, nonnegative
 from dnnevo.config import EvolutionConfig
 from dnnevo.analysis.trials import trial_outputs
 from dnnevo.errors import InvalidArgumentError
@@ -61,10 +60,7 @@ def cut(net: _core.Network, source: int, target: int) -> _core.Network:
 
 def _neuron(net: _core.Network, name: str, k: Any) -> int:
     """``k`` as a neuron index of ``net``: an integer (Python's or NumPy's) in 0..N-1."""
-    n = net.size
-    if isinstance(k, bool | np.bool_) or not isinstance(k, numbers.Integral) or not 0 <= int(k) < n:
-        raise InvalidArgumentError(f"{name} is {k!r}; it must be an integer in 0..{n - 1}")
-    return int(k)
+    return index(name, k, net.size, f"this network has {net.size} neurons")
 
 
 @dataclass(frozen=True)

@@ -5,8 +5,10 @@ trivial classifier and an observer fitted on each world?
 Every champion (the ``best.json`` of each run folder given) is judged on ``--trials`` fresh
 trials per landmark, drawn from ``TEST_SEED``, in five worlds: the training world (the paper's
 ideal world, unvaried), the robot-like test (``dnnevo assess --robot-like``), and the three
-held-out worlds of :mod:`dnnevo.tasks.landmark_worlds` (another wall follower, another sonar, a
-bigger room with the landmark off-centre). In each world, on the same test trials:
+held-out worlds of a set of :mod:`dnnevo.tasks.landmark_worlds` (``--worlds first``, the default:
+another wall follower, another sonar, a bigger room with the landmark off-centre; ``--worlds
+second``: a weaving wall follower, a lobed sonar that loses readings, other boxes). In each world,
+on the same test trials:
 
 - **constant**: always one answer: 50% by construction (as many trials of each landmark);
 - **threshold**: the best single-threshold rule on the sonar input's mean or the fraction of
@@ -15,7 +17,7 @@ bigger room with the landmark off-centre). In each world, on the same test trial
 - **observer**: logistic regression (:mod:`dnnevo.evaluation.observer`) on seven features of the
   input stream (mean, sd, max, fraction near, near episodes, longest and mean near run), fitted
   on the same ``FIT_SEED`` trials; for a held-out world also fitted on the other two held-out
-  worlds' trials only (leave one world out), which says whether the features themselves
+  worlds of its set only (leave one world out), which says whether the features themselves
   transfer.
 
 The judging is :mod:`dnnevo.tasks.landmark_transfer`'s, which the reproduction's
@@ -27,9 +29,9 @@ the 95% Wilson interval's lower end is above 80%::
         /root/dnnevo-reference/landmark-robust --record docs/results/examples/landmark-transfer.json
 
 With ``--factors`` the held-out worlds are taken apart (:func:`landmark_worlds.single_factors`):
-each champion is judged in one world per factor of the follower and sonar worlds, with only that
-factor changed, and in the room world (one change), beside each such world's threshold rule
-and observer. That says which factor a champion fails on::
+each champion is judged in one world per factor of each held-out world of the set, with only that
+factor changed (a world that changes one thing is judged as it is), beside each such world's
+threshold rule and observer. That says which factor a champion fails on::
 
     python examples/landmark_transfer.py /root/dnnevo-reference/landmark \\
         /root/dnnevo-reference/landmark-robust --factors --record docs/results/examples/landmark-factors.json
@@ -56,7 +58,7 @@ from dnnevo.experiments import examples
 from dnnevo.runs import RunDir
 from dnnevo.tasks import landmark_transfer as transfer
 from dnnevo.tasks import landmark_worlds
-from dnnevo.tasks.landmark_transfer import FIT_SEED, HELD_OUT, PLACES, TEST_SEED, Place, meets
+from dnnevo.tasks.landmark_transfer import FIT_SEED, TEST_SEED, Place, held_out, meets, place
 
 REFERENCE = [Path("/root/dnnevo-reference/landmark"), Path("/root/dnnevo-reference/landmark-robust")]
 """The champions judged by default: the reference reproduction's ``landmark`` and
@@ -80,9 +82,15 @@ def load(run: Path) -> tuple[EvolutionConfig, _core.Network]:
     return config, rd.read_best(config, table)
 
 
-FACTORS = [Place(w.name, w) for world in landmark_worlds.WORLDS.values()
-           for w in landmark_worlds.single_factors(world)]
-"""The places of ``--factors``: each held-out world's factors, one world each."""
+def places(world_set: str) -> list[Place]:
+    """The five places champions are judged in with ``--worlds world_set``."""
+    return [place(name) for name in ("training", "robot-like", *held_out(world_set))]
+
+
+def factors(world_set: str) -> list[Place]:
+    """The places of ``--factors``: each held-out world's factors, one world each."""
+    return [Place(w.name, w) for world in landmark_worlds.SETS[world_set].values()
+            for w in landmark_worlds.single_factors(world)]
 
 
 def judge(run: Path, trials: int, places: Sequence[Place]) -> dict[str, int]:
@@ -104,18 +112,19 @@ def rates(ks: list[int], n: int) -> list[str]:
 
 
 def table(families: dict[str, dict[str, dict[str, int]]], base: dict[str, dict[str, Any]],
-          trials: int) -> tuple[list[str], list[list[str]], list[str]]:
+          trials: int, world_set: str) -> tuple[list[str], list[list[str]], list[str]]:
     """The record's columns, one row per place and family, and the summary lines."""
     n = 2 * trials
+    held = held_out(world_set)
     columns = ["world", "champions", "meet the goal", "% right, seed by seed", "pooled % (95% interval)",
                "threshold rule %", "observer %", "observer fitted on the other two worlds %"]
     rows = []
-    for place in PLACES:
-        b = base[place.name]
+    for where in places(world_set):
+        b = base[where.name]
         for family, seeds in families.items():
             lowo = b.get("observer, other worlds")
-            rows.append([place.name + (" (held out)" if place.name in HELD_OUT else ""), family,
-                         *rates([r[place.name] for r in seeds.values()], n),
+            rows.append([where.name + (" (held out)" if where.name in held else ""), family,
+                         *rates([r[where.name] for r in seeds.values()], n),
                          pct(b["threshold"], b["n"]), pct(b["observer"], b["n"]),
                          "-" if lowo is None else pct(lowo, b["n"])])
     summary = [f"{trials} fresh trials per landmark per champion and world (seed {TEST_SEED}); the bounds are "
@@ -123,42 +132,43 @@ def table(families: dict[str, dict[str, dict[str, int]]], base: dict[str, dict[s
                "right in 50% of them by construction. The goal (issue 47): more than 85% right with the 95% "
                "Wilson interval's lower end above 80%."]
     for family, seeds in families.items():
-        every = [s for s, r in seeds.items() if all(meets(r[w], n) for w in HELD_OUT)]
-        worst = [min(r[w] for w in HELD_OUT) for r in seeds.values()]
+        every = [s for s, r in seeds.items() if all(meets(r[w], n) for w in held)]
+        worst = [min(r[w] for w in held) for r in seeds.values()]
         summary.append(f"{family}: {len(every)}/{len(seeds)} champions meet the goal in all three held-out worlds"
                        f"{' (' + ', '.join(every) + ')' if every else ''}; worst held-out world per champion, "
                        f"% right: {' '.join(pct(k, n) for k in worst)}.")
-    stuck = {f: {w: sum(r[f"{w} one answer"] >= 0.95 * n for r in seeds.values()) for w in HELD_OUT}
+    stuck = {f: {w: sum(r[f"{w} one answer"] >= 0.95 * n for r in seeds.values()) for w in held}
              for f, seeds in families.items()}
     summary.append("Champions that give one answer in at least 95% of a held-out world's trials, as the constant "
                    "classifier does: " + "; ".join(f"{f}: " + ", ".join(f"{w} {k}/{len(families[f])}"
                                                                       for w, k in by.items())
                                                    for f, by in stuck.items()) + ".")
-    summary.append("Threshold rules: " + "; ".join(f"{p.name}: {base[p.name]['rule']}" for p in PLACES) + ".")
+    summary.append("Threshold rules: " + "; ".join(f"{p.name}: {base[p.name]['rule']}" for p in places(world_set))
+                   + ".")
     return columns, rows, summary
 
 
 def factor_table(families: dict[str, dict[str, dict[str, int]]], base: dict[str, dict[str, Any]],
-                 trials: int) -> tuple[list[str], list[list[str]], list[str]]:
+                 trials: int, world_set: str) -> tuple[list[str], list[list[str]], list[str]]:
     """``--factors``' columns, one row per single-factor world and family, and the summary."""
     n = 2 * trials
     columns = ["world, one factor changed", "champions", "meet the goal", "% right, seed by seed",
                "pooled % (95% interval)", "one answer in >= 95% of trials", "threshold rule %", "observer %"]
     rows = []
-    for place in FACTORS:
-        b = base[place.name]
+    for where in factors(world_set):
+        b = base[where.name]
         for family, seeds in families.items():
-            stuck = sum(r[f"{place.name} one answer"] >= 0.95 * n for r in seeds.values())
-            rows.append([place.name, family, *rates([r[place.name] for r in seeds.values()], n),
+            stuck = sum(r[f"{where.name} one answer"] >= 0.95 * n for r in seeds.values())
+            rows.append([where.name, family, *rates([r[where.name] for r in seeds.values()], n),
                          f"{stuck}/{len(seeds)}",
                          pct(b["threshold"], b["n"]), pct(b["observer"], b["n"])])
     summary = [f"{trials} fresh trials per landmark per champion and world (seed {TEST_SEED}), as in the "
-               f"held-out worlds' table; the bounds are fitted on others (seed {FIT_SEED}). Each follower and "
-               "sonar row changes one factor of that held-out world and nothing else; the room world changes "
-               "one thing, its geometry. The goal (issue 47): more than 85% right with the 95% Wilson "
-               "interval's lower end above 80%."]
+               f"held-out worlds' table; the bounds are fitted on others (seed {FIT_SEED}). Each row named "
+               "WORLD: FACTOR changes one factor of that held-out world and nothing else; a row named by its "
+               "world alone is a world that changes one thing. The goal (issue 47): more than 85% right with "
+               "the 95% Wilson interval's lower end above 80%."]
     for family, seeds in families.items():
-        fails = {p.name: sum(not meets(r[p.name], n) for r in seeds.values()) for p in FACTORS}
+        fails = {p.name: sum(not meets(r[p.name], n) for r in seeds.values()) for p in factors(world_set)}
         worst = max(fails.values())
         most = ", ".join(name for name, k in fails.items() if k == worst) if worst else "none (every champion meets the goal in every one)"
         summary.append(f"{family}: the factor that the most champions fail on: {most} ({worst}/{len(seeds)}); "
@@ -174,6 +184,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     p.add_argument("--trials", type=int, default=100, help="fresh test trials per landmark (default 100)")
     p.add_argument("--fit-trials", type=int, default=100,
                    help="trials per landmark the bounds are fitted on, per world (default 100)")
+    p.add_argument("--worlds", choices=sorted(landmark_worlds.SETS), default="first",
+                   help="the set of held-out worlds (default first)")
     p.add_argument("--factors", action="store_true",
                    help="judge in each held-out world's factors, one at a time, instead of the five places")
     p.add_argument("--record", type=Path, metavar="JSON",
@@ -187,19 +199,19 @@ def main(argv: Sequence[str] | None = None) -> None:
     if missing:
         p.error(f"{missing[0]} is not a folder; pass the champions' folders (run folders, or folders "
                 "of seed-N run folders), for example: examples/landmark_transfer.py runs/sweep-landmark")
-    places = FACTORS if args.factors else PLACES
+    judged = factors(args.worlds) if args.factors else places(args.worlds)
     families: dict[str, dict[str, dict[str, int]]] = {}
     start = time.perf_counter()
     for folder in folders:
         family = families.setdefault(folder.name, {})
         for label, run in champions(folder):
-            family[label] = judge(run, args.trials, places)
+            family[label] = judge(run, args.trials, judged)
             print(f"{folder.name} {label}: " + "  ".join(f"{p.name} {pct(family[label][p.name], 2 * args.trials)}%"
-                                                         for p in places), flush=True)
+                                                         for p in judged), flush=True)
     first = champions(folders[0])[0][1]
     base_cfg, base_net = load(first)
-    base = transfer.bounds(base_cfg, base_net, args.fit_trials, args.trials, places)
-    columns, rows, summary = (factor_table if args.factors else table)(families, base, args.trials)
+    base = transfer.bounds(base_cfg, base_net, args.fit_trials, args.trials, judged)
+    columns, rows, summary = (factor_table if args.factors else table)(families, base, args.trials, args.worlds)
     print()
     print(" | ".join(columns))
     for row in rows:

@@ -30,12 +30,16 @@ STATED = {
                                             "specular_max_incidence_deg", "max_range")},
     "room": {f"landmark{n}.{k}" for n in (1, 2) for k in ("room", "start.max", "boxes.0.center")}
     | {"landmark2.boxes.1.center"},
+    "weaving": {"sim.follower.angle_gain", "sim.follower.corner_distance"},
+    "lobe": {f"sim.sonars.0.{k}" for k in ("cone_deg", "rays", "lobe_deg", "dropout")},
+    "boxes": {"landmark1.boxes.0.size", "landmark2.boxes"},  # three crates for two: the list differs whole
 }
+EVERY = {name: w for worlds in landmark_worlds.SETS.values() for name, w in worlds.items()}
 
 
-@pytest.mark.parametrize("name", sorted(landmark_worlds.WORLDS))
+@pytest.mark.parametrize("name", sorted(EVERY))
 def test_each_world_changes_its_stated_factors_and_builds(name: str) -> None:
-    world = landmark_worlds.WORLDS[name]
+    world = EVERY[name]
     assert set(landmark_worlds.factors(world)) == STATED[name]
     cfg = landmark_worlds.config(presets.get("landmark-robust"), world)
     params = landmark.params(cfg)  # the task builds (validates)
@@ -43,9 +47,9 @@ def test_each_world_changes_its_stated_factors_and_builds(name: str) -> None:
     assert params["training"]["cone_deg"] == 0.0 and params["trials_per_landmark"] == 3
 
 
-@pytest.mark.parametrize("name", sorted(landmark_worlds.WORLDS))
+@pytest.mark.parametrize("name", sorted(EVERY))
 def test_a_world_taken_apart_changes_each_of_its_factors_in_one_part(name: str) -> None:
-    world = landmark_worlds.WORLDS[name]
+    world = EVERY[name]
     parts = [landmark_worlds.factors(w) for w in landmark_worlds.single_factors(world)]
     assert all(parts), "a part that changes nothing"
     changed = [k for part in parts for k in part]
@@ -67,6 +71,20 @@ def test_the_worlds_go_beyond_what_training_varies() -> None:
     assert abs(cone[1] - cone[0]) > t["cone_deg"]
     # Training moves the landmark by at most 0.15 m in a 6 m x 5 m room; the room world's is bigger.
     assert f["landmark1.room"][1][0] - f["landmark1.room"][0][0] >= 2.0
+
+
+def test_the_second_set_changes_nothing_the_wide_envelope_varies() -> None:
+    """landmark-wide varies the follower's speed and distance, the sonar's cone and axis, the room
+    and the landmark as a whole; the second set's worlds change other things (the box sizes of
+    the boxes world change the landmarks' proportions, which scaling a landmark as a whole keeps)."""
+    training = presets.get("landmark-wide").task_params["training"]
+    assert training["room_scale"] > 0 and training["sonar_axis_deg"] > 0
+    varied = {"sim.follower.speed", "sim.follower.wall_distance", "sim.sonars.0.mount_angle_deg",
+              "landmark1.room", "landmark2.room"}
+    for world in landmark_worlds.SECOND.values():
+        assert not varied & set(landmark_worlds.factors(world)), world.name
+    assert landmark_worlds.world_set("weaving") == "second" and landmark_worlds.world_set("room") == "first"
+    assert not set(landmark_worlds.WORLDS) & set(landmark_worlds.SECOND), "a name in two sets"
 
 
 def test_a_world_for_another_task_is_refused() -> None:
@@ -150,10 +168,15 @@ def test_the_library_answers_as_the_example_did() -> None:
     """The example's record stays what it was: the judging it now calls gives its earlier answer."""
     cfg = presets.get("landmark-robust")
     net = dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=5)
-    assert transfer.judge(cfg, net, 6) == BEFORE_JUDGE
-    assert transfer.bounds(cfg, net, 5, 6) == BEFORE_BOUNDS
+    first = [transfer.place(n) for n in ["training", "robot-like", *transfer.held_out("first")]]
+    assert transfer.judge(cfg, net, 6, first) == BEFORE_JUDGE
+    assert transfer.bounds(cfg, net, 5, 6, first) == BEFORE_BOUNDS
+    # Every place, the second set's worlds too, answers as each set does on its own.
+    everywhere = transfer.judge(cfg, net, 6)
+    assert {k: everywhere[k] for k in BEFORE_JUDGE} == BEFORE_JUDGE
+    assert set(everywhere) == {f"{p.name}{one}" for p in transfer.PLACES for one in ("", " one answer")}
     # A subset of places answers as the whole does, place by place.
-    some = [transfer.place(n) for n in ["training", *transfer.HELD_OUT]]
+    some = [transfer.place(n) for n in ["training", *transfer.held_out()]]
     assert transfer.bounds(cfg, net, 5, 6, some) == {p.name: BEFORE_BOUNDS[p.name] for p in some}
     assert transfer.judge(cfg, net, 6, some[1:2]) == {"follower": 6, "follower one answer": 12}
 

@@ -68,7 +68,8 @@ def test_the_graph_puts_every_job_after_what_it_needs() -> None:
     assert len(order) == 3 * len(plan.EXPERIMENTS)
     assert {j.experiment for j in plan.jobs([0], only=["landmark"])} == {
         "landmark", "landmark-robot", "landmark-worlds", "landmark-robust", "landmark-robust-robot",
-        "landmark-robust-worlds"}
+        "landmark-robust-worlds", "landmark-robust-second-worlds", "landmark-wide", "landmark-wide-worlds",
+        "landmark-wide-first-worlds"}
     with pytest.raises(ConfigError, match="families are"):
         plan.jobs([0], only=["vision"])
     with pytest.raises(ConfigError, match="distinct"):
@@ -171,11 +172,11 @@ def test_the_held_out_worlds_job_judges_each_world_is_checked_and_renders(tmp_pa
     run = RunDir(tmp_path / landmark.id)
     config, table = run.read_config()
     net = run.read_best(config, table)
-    places = [landmark_transfer.place(p) for p in jobs.WORLD_PLACES]
+    places = [landmark_transfer.place(p) for p in jobs.world_places()]
     right = landmark_transfer.judge(config, net, 10, places)
     bounds = landmark_transfer.bounds(config, net, 10, 10, places)
     assert found["trials"] == found["fit_trials"] == 10 and found["test_seed"] == landmark_transfer.TEST_SEED
-    for p in jobs.WORLD_PLACES:
+    for p in jobs.world_places():
         assert found["worlds"][p] == {"right": right[p], "one answer": right[f"{p} one answer"], **bounds[p]}
     # A damaged field is one line naming it.
     path = jobs.result_path(tmp_path, worlds)
@@ -200,6 +201,18 @@ def test_the_held_out_worlds_job_judges_each_world_is_checked_and_renders(tmp_pa
     n = 2 * 10
     assert block.rows[1][2].startswith(f"{found['worlds']['follower']['right']}/{n} (")
     assert "10 trials per landmark per world, seed 47002" in block.rows[1][7]
+    # A test in the second set of worlds judges there, and its table names them.
+    shutil.copytree(tmp_path / landmark.id, tmp_path / "landmark-robust" / "seed-0")
+    second = plan.Job("landmark-robust-second-worlds", 0, ("landmark-robust/seed-0",))
+    found = jobs.run_job(second, tmp_path, QUICK, 1)
+    assert tuple(found["worlds"]) == jobs.world_places("second") == ("training", "weaving", "lobe", "boxes")
+    assert found["worlds"]["training"]["right"] == jobs.read_result(tmp_path, worlds, QUICK)["worlds"]["training"]["right"]
+    with pytest.raises(ValueError, match="expected the places training, follower, sonar, room"):
+        jobs.world_counts(found)
+    order = [landmark, second]
+    outcomes = {j.id: Outcome(Task(j.id, j.needs, jobs.run_job), "done", r) for j, r in zip(order, [done, found])}
+    block = report.seed_table(plan.experiment(second.experiment), order, outcomes)
+    assert block is not None and block.rows[0][2] == "weaving (held out): right (95% interval)"
 
 
 def test_a_result_is_not_trusted_when_its_runs_changed(tmp_path: Path) -> None:

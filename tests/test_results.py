@@ -45,7 +45,7 @@ def repo(tmp_path: Path, reproduction: Path) -> Path:
     (repo / "README.md").write_text(README, encoding="utf-8")
     r = _results("collect", source, repo / "docs" / "results", "--seeds", "0", "--commit", "abc1234")
     assert r.returncode == 0, r.stderr
-    assert "collected 6 results" in r.stdout
+    assert "collected 10 results" in r.stdout
     shutil.rmtree(source)  # the tables need no run folder
     return repo
 
@@ -53,13 +53,15 @@ def repo(tmp_path: Path, reproduction: Path) -> Path:
 def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) -> None:
     stored = repo / "docs" / "results"
     assert sorted(p.relative_to(stored).as_posix() for p in stored.rglob("*.json")) == [
-        "landmark-robot/seed-0.json", "landmark-robust-robot/seed-0.json", "landmark-robust-worlds/seed-0.json",
-        "landmark-robust/seed-0.json", "landmark-worlds/seed-0.json", "landmark/seed-0.json", "provenance.json",
+        "landmark-robot/seed-0.json", "landmark-robust-robot/seed-0.json",
+        "landmark-robust-second-worlds/seed-0.json", "landmark-robust-worlds/seed-0.json",
+        "landmark-robust/seed-0.json", "landmark-wide-first-worlds/seed-0.json", "landmark-wide-worlds/seed-0.json",
+        "landmark-wide/seed-0.json", "landmark-worlds/seed-0.json", "landmark/seed-0.json", "provenance.json",
         "reproduce.json"]
     provenance = json.loads((stored / "provenance.json").read_text())
     assert provenance["commit"] == "abc1234" and provenance["seeds"] == [0]
     assert provenance["environment"]["SIMD kernel"] and provenance["environment"]["dnnevo"].endswith("(git abc1234)")
-    assert provenance["families"]["landmark"]["runs"] == provenance["families"]["landmark"]["planned"] == 6
+    assert provenance["families"]["landmark"]["runs"] == provenance["families"]["landmark"]["planned"] == 10
     assert provenance["families"]["landmark"]["command"] == (
         "dnnevo reproduce --seeds 0 --only landmark --quick --eval-trials 10 --no-dt-check")
 
@@ -78,7 +80,7 @@ def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) 
     hand = plan.experiment("reactive-navigation-hand")
     assert f"| {hand.name} | {hand.paper} | not yet run | - | - |" in readme
     planned = len(plan.jobs([0], results.REFERENCE_FAMILIES))  # the paper's families and the ablation, seed 0
-    assert "commit abc1234" in readme and f"6 of {planned} runs done" in readme and "Quick mode" in readme
+    assert "commit abc1234" in readme and f"10 of {planned} runs done" in readme and "Quick mode" in readme
     # The ablation of the 2-bit route is part of the reference reproduction: its rows say "not
     # yet run". Other families beyond the paper's appear only once their runs are collected.
     ablation = [e for e in plan.EXPERIMENTS if e.family == "ablation"]
@@ -91,7 +93,7 @@ def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) 
     assert "| seed | training: right (95% interval) | follower (held out): right (95% interval) |" in page
     assert ("### nav1d-far\n\nPaper: §4.2: solved at generation 0. Preset `nav1d-far`.\n\n"
             "Not yet run over seeds 0.") in page
-    assert "| landmark | (whole family) | 6/6 |" in page and "| nav1d | (whole family) | not yet run |" in page
+    assert "| landmark | (whole family) | 10/10 |" in page and "| nav1d | (whole family) | not yet run |" in page
     assert "| ablation | (whole family) | not yet run |" in page
     assert "### ablation-2bit-no-spare\n\nPaper: not in the paper. Preset `sequence-2bit` with `size=10`." in page
     assert "| commit | abc1234 |" in page
@@ -220,7 +222,7 @@ def test_a_family_collected_again_at_another_commit_names_both(tmp_path: Path, r
     provenance = json.loads((dest / "provenance.json").read_text())
     family = provenance["families"]["landmark"]
     assert family["commit"] == provenance["commit"] == "abc1234, def5678"
-    assert family["runs"] == first["runs"] == 6
+    assert family["runs"] == first["runs"] == 10
     assert family["elapsed_s"] >= 100  # the earlier time, and the new run's (under a second here)
     assert family["machines"][0] == "Earlier CPU, SIMD kernel avx2" and len(family["machines"]) == 2
 

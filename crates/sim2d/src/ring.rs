@@ -87,6 +87,8 @@ impl RingSpec {
             max_range: self.max_range,
             noise_sd: self.noise_sd,
             specular_max_incidence_deg: self.specular_max_incidence_deg,
+            lobe_deg: None,
+            dropout: 0.0,
         }
     }
 }

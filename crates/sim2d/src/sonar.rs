@@ -5,8 +5,13 @@
 //! `cone_deg` is sampled by `rays` rays spread evenly over it (one ray points along the axis).
 //! Each ray is cast from the mount point; a ray that meets a surface at an angle of incidence
 //! (between the reversed ray and the surface normal) above `specular_max_incidence_deg` is
-//! reflected away and returns nothing. The echo is the nearest return, plus Gaussian noise of
-//! `noise_sd`, clamped to `[min_range, max_range]`.
+//! reflected away and returns nothing. With a `lobe_deg`, the beam is a lobe rather than a
+//! uniform cone, as a real transducer's sensitivity falls off away from its axis: a ray `theta`
+//! off the axis reaches only `max_range exp(-(theta / lobe_deg)^2)`, so the beam is wide for near
+//! surfaces and narrow for far ones. The echo is the nearest return, plus Gaussian noise of
+//! `noise_sd`, clamped to `[min_range, max_range]`. With a `dropout`, that fraction of readings
+//! is lost at random, as a real sonar misses echoes: the reading is `max_range`, as if nothing
+//! echoed.
 
 use streams::Stream;
 
@@ -42,6 +47,13 @@ pub struct SonarSpec {
     /// When set, a ray whose angle of incidence exceeds this many degrees, in [0, 90], is lost to
     /// a specular reflection. Default `None` (every ray that hits echoes).
     pub specular_max_incidence_deg: Option<f64>,
+    /// When set, the beam's lobe width in degrees, > 0: a ray `theta` off the axis reaches only
+    /// `max_range exp(-(theta / lobe_deg)^2)` (see the [module docs](self)). Default `None` (a
+    /// uniform cone: every ray reaches `max_range`).
+    pub lobe_deg: Option<f64>,
+    /// The probability, in [0, 1), that a reading is lost (reads `max_range`, no point) whatever
+    /// echoed. Default 0 (no losses, and no random draws).
+    pub dropout: f64,
 }
 
 impl Default for SonarSpec {
@@ -55,6 +67,8 @@ impl Default for SonarSpec {
             max_range: 6.5,
             noise_sd: 0.0,
             specular_max_incidence_deg: None,
+            lobe_deg: None,
+            dropout: 0.0,
         }
     }
 }
@@ -87,6 +101,10 @@ impl SonarSpec {
         if let Some(a) = self.specular_max_incidence_deg {
             check_range(&f("specular_max_incidence_deg"), a, 0.0, true, 90.0, true)?;
         }
+        if let Some(w) = self.lobe_deg {
+            check_range(&f("lobe_deg"), w, 0.0, false, inf, false)?;
+        }
+        check_range(&f("dropout"), self.dropout, 0.0, true, 1.0, false)?;
         Ok(())
     }
 }
@@ -135,6 +153,8 @@ pub struct Sonar {
     ray_step: f64,
     /// The cosine of the steepest incidence that still echoes (-1: no specular misses).
     min_cos_incidence: f64,
+    /// The lobe width in radians (`None`: a uniform cone).
+    lobe: Option<f64>,
 }
 
 impl Sonar {
@@ -161,6 +181,7 @@ impl Sonar {
             first_ray,
             ray_step,
             min_cos_incidence,
+            lobe: spec.lobe_deg.map(f64::to_radians),
         }
     }
 
@@ -181,8 +202,8 @@ impl Sonar {
     /// One reading for a robot at `pose`: the nearest echo over the cone's rays (see the
     /// [module docs](self)).
     ///
-    /// Draws one normal variate from `stream` only when `noise_sd > 0` and something echoed;
-    /// otherwise draws nothing. Allocates nothing.
+    /// Draws one normal variate from `stream` only when `noise_sd > 0` and something echoed, then
+    /// one uniform variate only when `dropout > 0`; otherwise draws nothing. Allocates nothing.
     pub fn read(&self, world: &World, pose: &Pose, stream: &mut Stream) -> Echo {
         let s = &self.spec;
         let origin = self.mount_point(pose);
@@ -190,7 +211,14 @@ impl Sonar {
         let mut nearest: Option<(f64, [f64; 2])> = None;
         for i in 0..s.rays {
             let dir = pose.direction_at(axis + self.first_ray + self.ray_step * i as f64);
-            let reach = nearest.map_or(s.max_range, |(d, _)| d);
+            let ray_range = match self.lobe {
+                None => s.max_range,
+                Some(w) => {
+                    let off_axis = self.first_ray + self.ray_step * i as f64;
+                    s.max_range * (-(off_axis / w).powi(2)).exp()
+                }
+            };
+            let reach = nearest.map_or(ray_range, |(d, _)| d.min(ray_range));
             let Some(hit) = world.cast_ray(origin, dir, reach) else {
                 continue;
             };
@@ -203,6 +231,19 @@ impl Sonar {
                 nearest = Some((hit.distance, hit.point));
             }
         }
+        let echo = self.echo(nearest, stream);
+        if s.dropout > 0.0 && stream.bernoulli(s.dropout) {
+            return Echo {
+                range: s.max_range,
+                point: None,
+            };
+        }
+        echo
+    }
+
+    /// The reading for the nearest return (with its noise).
+    fn echo(&self, nearest: Option<(f64, [f64; 2])>, stream: &mut Stream) -> Echo {
+        let s = &self.spec;
         match nearest {
             None => Echo {
                 range: s.max_range,

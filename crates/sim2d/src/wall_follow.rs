@@ -17,14 +17,14 @@
 //!    the wall, all reach the wall before any box); if none is clear, the nearest. It turns to face
 //!    that wall, driving forward only within 60 degrees of facing it and slowing to a stop as
 //!    anything comes up ahead (as in the follow phase below), until the front fan sees a wall (not
-//!    a box) within `wall_distance + 0.35` m while it faces the wall within 15 degrees. Facing the
+//!    a box) within `wall_distance + corner_distance` m while it faces the wall within 15 degrees. Facing the
 //!    wall squarely, the follow phase's corner turn then puts the wall on the right. The landmark
 //!    can therefore never capture it, wherever it starts.
 //! 2. **Follow.** A proportional controller holds the wall on the right at `wall_distance`:
-//!    `omega = -K_DISTANCE clamp(d - wall_distance, ±0.3) - K_ANGLE alpha`. As a wall comes up
-//!    ahead (a corner), the front fan blends in a left turn and slows down: with
-//!    `s = clamp((front - (wall_distance - 0.1)) / 0.45, 0, 1)` the speed is `s speed` and the turn
-//!    rate `s omega + (1 - s) max_turn_rate`. If neither right ray sees anything within
+//!    `omega = -distance_gain clamp(d - wall_distance, ±0.3) - angle_gain alpha`. As a wall comes
+//!    up ahead (a corner), the front fan blends in a left turn and slows down: with
+//!    `s = clamp((front - (wall_distance - 0.1)) / (corner_distance + 0.1), 0, 1)` the speed is
+//!    `s speed` and the turn rate `s omega + (1 - s) max_turn_rate`. If neither right ray sees anything within
 //!    `sensor_range`, it curves right at half its turn rate to find the wall again.
 //!
 //! Wheel speeds are scaled down together when one would exceed the robot's `max_speed`, which
@@ -40,18 +40,12 @@ use crate::world::{Surface, World};
 /// Half the spacing of the right-side ray pair, in metres (rays 0.15 m ahead of and behind the
 /// centre).
 pub const SIDE_SPACING: f64 = 0.15;
-/// Turn rate per metre of distance error in the follow phase, rad/s per m.
-const K_DISTANCE: f64 = 3.0;
-/// Turn rate per radian of wall angle in the follow phase, rad/s per rad.
-const K_ANGLE: f64 = 2.2;
 /// Turn rate per radian of heading error in the seek phase, rad/s per rad.
 const K_SEEK: f64 = 3.0;
 /// How closely the seek phase must face the chosen wall before following starts, rad (15 deg).
 const SEEK_ALIGNED: f64 = 15.0 * PI / 180.0;
 /// The largest distance error the follow controller acts on, m.
 const MAX_DISTANCE_ERROR: f64 = 0.3;
-/// The front distance, beyond `wall_distance`, where the corner turn starts, m.
-const FRONT_TURN: f64 = 0.35;
 /// The front distance, short of `wall_distance`, where forward motion stops, m.
 const FRONT_STOP: f64 = 0.1;
 
@@ -84,6 +78,14 @@ pub struct WallFollowerSpec {
     pub max_turn_rate: f64,
     /// The range of the follower's own rays, in metres, > `wall_distance`. Default 2.0.
     pub sensor_range: f64,
+    /// The follow phase's turn rate per metre of distance error, in rad/s per m, > 0. Default 3.0.
+    pub distance_gain: f64,
+    /// The follow phase's turn rate per radian of the wall's angle, in rad/s per rad, > 0. Default
+    /// 2.2, which damps the approach to the wall; a much smaller gain makes the robot weave.
+    pub angle_gain: f64,
+    /// How far beyond `wall_distance` a wall ahead starts the corner turn (and ends the seek
+    /// phase), in metres, > 0. Default 0.35.
+    pub corner_distance: f64,
 }
 
 impl Default for WallFollowerSpec {
@@ -93,6 +95,9 @@ impl Default for WallFollowerSpec {
             wall_distance: 0.55,
             max_turn_rate: 2.0,
             sensor_range: 2.0,
+            distance_gain: 3.0,
+            angle_gain: 2.2,
+            corner_distance: 0.35,
         }
     }
 }
@@ -119,6 +124,13 @@ impl WallFollowerSpec {
             inf,
             false,
         )?;
+        for (name, value) in [
+            ("follower.distance_gain", self.distance_gain),
+            ("follower.angle_gain", self.angle_gain),
+            ("follower.corner_distance", self.corner_distance),
+        ] {
+            check_range(name, value, 0.0, false, inf, false)?;
+        }
         if !(self.sensor_range.is_finite() && self.sensor_range > self.wall_distance) {
             return Err(Error::invalid(
                 "follower.sensor_range",
@@ -201,7 +213,7 @@ impl WallFollower {
                 };
                 let e = wrap_angle(target - pose.heading);
                 let (front, surface) = self.front(world, pose);
-                let at_wall = front <= self.spec.wall_distance + FRONT_TURN
+                let at_wall = front <= self.spec.wall_distance + self.spec.corner_distance
                     && surface == Some(Surface::Wall)
                     && e.abs() < SEEK_ALIGNED;
                 if at_wall {
@@ -250,7 +262,7 @@ impl WallFollower {
             let alpha = ((d_f - d_r) / (2.0 * SIDE_SPACING)).atan();
             let d = 0.5 * (d_f + d_r) * alpha.cos();
             let err = (d - s.wall_distance).clamp(-MAX_DISTANCE_ERROR, MAX_DISTANCE_ERROR);
-            -K_DISTANCE * err - K_ANGLE * alpha
+            -s.distance_gain * err - s.angle_gain * alpha
         };
         let free = self.free_ahead(front);
         let omega = free * omega_wall + (1.0 - free) * s.max_turn_rate;
@@ -261,10 +273,10 @@ impl WallFollower {
     }
 
     /// How free the way ahead is, from 0 (something within `wall_distance - FRONT_STOP`) to 1
-    /// (nothing within `wall_distance + FRONT_TURN`), linear in between.
+    /// (nothing within `wall_distance + corner_distance`), linear in between.
     fn free_ahead(&self, front: f64) -> f64 {
         let stop = self.spec.wall_distance - FRONT_STOP;
-        let turn = self.spec.wall_distance + FRONT_TURN;
+        let turn = self.spec.wall_distance + self.spec.corner_distance;
         ((front - stop) / (turn - stop)).clamp(0.0, 1.0)
     }
 

@@ -210,3 +210,26 @@ fn small_run(task: &str, params: serde_json::Value, precision: Precision) -> Run
         ..RunConfig::default()
     }
 }
+
+/// A small landmark run with `landmark-robust`'s varied training (every variation of its preset
+/// on, validated on varied trials too): later variations draw from streams of their own, so this
+/// run, and the preset's reference results, keep their bits.
+#[test]
+fn a_small_landmark_run_with_varied_training_keeps_its_stored_bits() {
+    let task_params = serde_json::json!({
+        "trials_per_landmark": 3, "validation_trials": 2, "trial_seconds": 8.0,
+        "training": {
+            "ideal_trials_per_landmark": 1, "landmark_shift": 0.15, "landmark_turn_deg": 5.0,
+            "landmark_scale": 0.08, "follower_speed": 0.08, "follower_distance": 0.05,
+            "cone_deg": 8.0, "trial_seconds": 3.0, "input_gain": 0.15, "input_offset": 0.025,
+            "input_noise_sd": 0.015,
+        },
+    });
+    let mut config = small_run("landmark", task_params, Precision::F64);
+    config.generations = 3;
+    same_on_every_kernel(
+        "a small landmark run with varied training",
+        0x8705_a4a0_cea0_66fd,
+        || evolution_fingerprint(&config),
+    );
+}

@@ -39,7 +39,7 @@ from dnnevo.evolution.seeding import Seeding
 from dnnevo.robots import navigation
 
 __all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "HAND_STARTS", "HAND_QUICK_STARTS", "HAND_CONDITIONS", "WORLD_TRIALS",
-           "WORLD_QUICK_TRIALS", "WORLD_PLACES", "Settings", "Stopped", "result_path", "read_result", "run_job",
+           "WORLD_QUICK_TRIALS", "world_places", "Settings", "Stopped", "result_path", "read_result", "run_job",
            "hand_counts", "world_counts"]
 
 ROBOT_SEED_BASE = 3_000_003
@@ -70,9 +70,14 @@ bounds on."""
 WORLD_QUICK_TRIALS = 10
 """The same in a quick reproduction: it shows that the test runs, in about a second."""
 
-WORLD_PLACES = ("training", *landmark_transfer.HELD_OUT)
-"""The places a held-out-worlds job judges its champion in: the training world and the held-out
-worlds (the robot-like test is its own job)."""
+def world_places(world_set: str = "first") -> tuple[str, ...]:
+    """The places a held-out-worlds job judges its champion in: the training world and the
+    held-out worlds of ``world_set`` (the robot-like test is its own job).
+
+    >>> world_places("second")
+    ('training', 'weaving', 'lobe', 'boxes')
+    """
+    return ("training", *landmark_transfer.held_out(world_set))
 
 _BOUNDS = ("threshold", "observer", "observer, other worlds")
 
@@ -255,8 +260,9 @@ def hand_counts(found: dict[str, Any]) -> dict[str, dict[str, tuple[int, int]]]:
     return out
 
 
-def world_counts(found: dict[str, Any]) -> dict[str, dict[str, int]]:
-    """A held-out-worlds result's counts, checked, by place (:data:`WORLD_PLACES`): ``right``
+def world_counts(found: dict[str, Any], world_set: str = "first") -> dict[str, dict[str, int]]:
+    """A held-out-worlds result's counts, checked, by place (:func:`world_places` of
+    ``world_set``): ``right``
     and ``one answer`` of the champion and the bounds' ``threshold``, ``observer`` and (in a
     held-out world) ``observer, other worlds``, each of ``n``, twice the result's ``trials``. Its
     ``test_seed`` and ``fit_seed`` must be :mod:`~dnnevo.tasks.landmark_transfer`'s (trials of
@@ -268,12 +274,13 @@ def world_counts(found: dict[str, Any]) -> dict[str, dict[str, int]]:
     trials = _count(found["trials"], "trials", 1)
     _count(found["fit_trials"], "fit_trials", trials, trials)
     worlds = found["worlds"]
-    if not isinstance(worlds, dict) or sorted(worlds) != sorted(WORLD_PLACES):
-        raise ValueError(f"worlds is {short(worlds)}; expected the places {', '.join(WORLD_PLACES)}")
+    places = world_places(world_set)
+    if not isinstance(worlds, dict) or sorted(worlds) != sorted(places):
+        raise ValueError(f"worlds is {short(worlds)}; expected the places {', '.join(places)}")
     out: dict[str, dict[str, int]] = {}
-    for name in WORLD_PLACES:
+    for name in places:
         w = worlds[name]
-        keys = ["right", "one answer", "n", "rule", *_BOUNDS[:3 if name in landmark_transfer.HELD_OUT else 2]]
+        keys = ["right", "one answer", "n", "rule", *_BOUNDS[:2 if name == "training" else 3]]
         if not isinstance(w, dict) or sorted(w) != sorted(keys):
             raise ValueError(f"worlds.{name} is {short(w)}; expected {', '.join(keys)}")
         n = _count(w["n"], f"worlds.{name}.n", 2 * trials, 2 * trials)
@@ -300,7 +307,7 @@ def _check_body(job: plan.Job, found: dict[str, Any], settings: Settings) -> Non
                 isinstance(x, int) and not isinstance(x, bool) and x >= 0 for row in matrix for x in row):
             raise ValueError("confusion is not a 2 x 2 matrix of counts")
     elif kind == plan.HELD_OUT:
-        world_counts(found)
+        world_counts(found, job.spec.worlds)
         if found["trials"] != settings.world_trials():
             raise ValueError(f"trials is {found['trials']}; these settings draw {settings.world_trials()}")
     elif kind == plan.HAND_DESIGNED:
@@ -385,10 +392,11 @@ def _held_out(job: plan.Job, root: Path, settings: Settings, threads: int | None
     config, table = run.read_config()
     net = run.read_best(config, table)
     trials = settings.world_trials()
-    places = [landmark_transfer.place(p) for p in WORLD_PLACES]
+    names = world_places(job.spec.worlds)
+    places = [landmark_transfer.place(p) for p in names]
     right = landmark_transfer.judge(config, net, trials, places)
     bounds = landmark_transfer.bounds(config, net, trials, trials, places)
-    worlds = {p: {"right": right[p], "one answer": right[f"{p} one answer"], **bounds[p]} for p in WORLD_PLACES}
+    worlds = {p: {"right": right[p], "one answer": right[f"{p} one answer"], **bounds[p]} for p in names}
     return {"test_seed": landmark_transfer.TEST_SEED, "fit_seed": landmark_transfer.FIT_SEED, "trials": trials,
             "fit_trials": trials, "worlds": worlds}
 

@@ -31,8 +31,8 @@ from dnnevo.experiments import plan
 from dnnevo.evaluation import stats
 from dnnevo.experiments import sweep
 from dnnevo.evaluation.assessment import Assessment
-from dnnevo.experiments.jobs import (HAND_CONDITIONS, ROBOT_SEED_BASE, SYSTEM_TRIALS, WORLD_PLACES, Settings,
-                                     hand_counts, world_counts)
+from dnnevo.experiments.jobs import (HAND_CONDITIONS, ROBOT_SEED_BASE, SYSTEM_TRIALS, Settings,
+                                     hand_counts, world_counts, world_places)
 from dnnevo.robots.navigation import WORLDS
 from dnnevo.runs import RunDir, save_figure, write_atomic
 from dnnevo.tasks import landmark_transfer, nav1d
@@ -119,8 +119,8 @@ def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[st
         counts = [hand_counts(o.result) for o in done if o.result]
         return (*head, "-", _hand_pooled(counts) if counts else "-", "-", "-", _median_wall(walls))
     if e.kind == plan.HELD_OUT:
-        worlds = [world_counts(o.result) for o in done if o.result]
-        every = sum(_meets_every(w) for w in worlds)
+        worlds = [world_counts(o.result, e.worlds) for o in done if o.result]
+        every = sum(_meets_every(w, e.worlds) for w in worlds)
         text = (f"seeds right in >85% with the interval's lower end >80% in every held-out world: "
                 f"{k_of_n(every, len(worlds))}" if worlds else "-")
         return (*head, "-", text, "-", "-", _median_wall(walls))
@@ -129,9 +129,10 @@ def summary_row(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[st
     return (*head, "-", text, "-", "-", _median_wall(walls))
 
 
-def _meets_every(counts: dict[str, dict[str, int]]) -> bool:
-    """Whether a champion meets issue 47's goal in every held-out world."""
-    return all(landmark_transfer.meets(counts[w]["right"], counts[w]["n"]) for w in landmark_transfer.HELD_OUT)
+def _meets_every(counts: dict[str, dict[str, int]], world_set: str) -> bool:
+    """Whether a champion meets issue 47's goal in every held-out world of ``world_set``."""
+    return all(landmark_transfer.meets(counts[w]["right"], counts[w]["n"])
+               for w in landmark_transfer.held_out(world_set))
 
 
 def _hand_pooled(counts: Sequence[dict[str, dict[str, tuple[int, int]]]]) -> str:
@@ -175,12 +176,12 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
                          f"{o.result['wall_s']:.0f} s"))
         elif e.kind == plan.HELD_OUT:
             res = o.result
-            held = world_counts(res)
+            held = world_counts(res, e.worlds)
             bounds = "; ".join(f"{w} " + " / ".join(_pct(held[w][b] / held[w]["n"]) for b in
                                                     ("threshold", "observer", "observer, other worlds") if b in held[w])
-                               for w in WORLD_PLACES)
-            rows.append((str(job.seed), *(k_of_n(held[w]["right"], held[w]["n"]) for w in WORLD_PLACES),
-                         "yes" if _meets_every(held) else "no", bounds,
+                               for w in world_places(e.worlds))
+            rows.append((str(job.seed), *(k_of_n(held[w]["right"], held[w]["n"]) for w in world_places(e.worlds)),
+                         "yes" if _meets_every(held, e.worlds) else "no", bounds,
                          f"{res['trials']} trials per landmark per world, seed {res['test_seed']}; bounds "
                          f"fitted on {res['fit_trials']} per landmark, seed {res['fit_seed']}",
                          f"{res['wall_s']:.0f} s"))
@@ -206,7 +207,7 @@ def seed_table(e: plan.Experiment, order: Sequence[plan.Job], outcomes: dict[str
         plan.ROBOT_LIKE: ("seed", "right (95% interval)", "confusion [[1 as 1, 1 as 2], [2 as 1, 2 as 2]]",
                           "per landmark", "verdict (95% rule)", "wall"),
         plan.HELD_OUT: ("seed", *(f"{w}{'' if w == 'training' else ' (held out)'}: right (95% interval)"
-                                  for w in WORLD_PLACES), "goal in every held-out world (>85%, lower end >80%)",
+                                  for w in world_places(e.worlds)), "goal in every held-out world (>85%, lower end >80%)",
                         "bounds, % right: threshold rule / observer / observer fitted on the other held-out worlds",
                         "conditions", "wall"),
         plan.SYSTEM: ("seed", "goal reached (95% interval, by environment)", "classifier right",

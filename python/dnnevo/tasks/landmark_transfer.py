@@ -4,8 +4,8 @@ upper bound fitted on each world: what ``examples/landmark_transfer.py`` and the
 
 A champion is judged on fresh trials per landmark drawn from :data:`TEST_SEED` in each
 :class:`Place`: the training world (the paper's ideal world, unvaried), the robot-like test, and
-the three held-out worlds of :mod:`dnnevo.tasks.landmark_worlds`. In each world, on the same
-test trials, :func:`bounds` gives
+the held-out worlds of :mod:`dnnevo.tasks.landmark_worlds`, in sets of three. In each world, on
+the same test trials, :func:`bounds` gives
 
 - **constant**: always one answer: 50% by construction (as many trials of each landmark);
 - **threshold**: the best single-threshold rule on the sonar input's mean or the fraction of
@@ -13,14 +13,16 @@ test trials, :func:`bounds` gives
   world drawn from :data:`FIT_SEED`;
 - **observer**: logistic regression (:mod:`dnnevo.evaluation.observer`) on seven features of the
   input stream, fitted on the same :data:`FIT_SEED` trials; for a held-out world also fitted on
-  the other two held-out worlds' trials only (leave one world out), which says whether the
+  the other two held-out worlds of its set only (leave one world out), which says whether the
   features themselves transfer.
 
 The sonar does not depend on the network, so the bounds do not depend on the champion judged:
 only on the trial counts (and the task settings a world keeps).
 
 >>> [p.name for p in PLACES]
-['training', 'robot-like', 'follower', 'sonar', 'room']
+['training', 'robot-like', 'follower', 'sonar', 'room', 'weaving', 'lobe', 'boxes']
+>>> held_out("second")
+['weaving', 'lobe', 'boxes']
 >>> meets(172, 200), meets(171, 200)
 (True, False)
 """
@@ -40,7 +42,7 @@ from dnnevo.evaluation.stats import wilson
 from dnnevo.tasks import landmark, landmark_worlds
 
 __all__ = ["FIT_SEED", "TEST_SEED", "NEAR", "THRESHOLD_COLUMNS", "GOAL_RATE", "GOAL_LOWER", "Place", "PLACES",
-           "HELD_OUT", "place", "sonar_features", "bounds", "judge", "meets"]
+           "held_out", "place", "sonar_features", "bounds", "judge", "meets"]
 
 FIT_SEED = 47_001
 """The seed of the trials the threshold rule and the observer are fitted on."""
@@ -70,11 +72,14 @@ class Place:
 
 PLACES = [Place("training", landmark_worlds.TRAINING),
           Place("robot-like", landmark_worlds.TRAINING, robot_like=True),
-          *(Place(name, w) for name, w in landmark_worlds.WORLDS.items())]
+          *(Place(name, w) for worlds in landmark_worlds.SETS.values() for name, w in worlds.items())]
 """Every place, in the tables' order."""
 
-HELD_OUT = list(landmark_worlds.WORLDS)
-"""The held-out worlds' names."""
+
+def held_out(world_set: str = "first") -> list[str]:
+    """The names of the held-out worlds of ``world_set`` (see ``landmark_worlds.SETS``)."""
+    return list(landmark_worlds.SETS[world_set])
+
 
 
 def place(name: str) -> Place:
@@ -99,9 +104,9 @@ def sonar_features(config: EvolutionConfig, net: _core.Network, per_landmark: in
 def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,
            places: Sequence[Place] | None = None) -> dict[str, dict[str, Any]]:
     """Each place's threshold rule and observer (of ``places``, default :data:`PLACES`), fitted
-    on ``fit`` trials per landmark from FIT_SEED and judged on ``test`` from TEST_SEED; held-out
-    worlds also get the observer fitted on the other held-out worlds when all three are among
-    ``places``."""
+    on ``fit`` trials per landmark from FIT_SEED and judged on ``test`` from TEST_SEED; a held-out
+    world also gets the observer fitted on the other held-out worlds of its set when all of them
+    are among ``places``."""
     data = {}
     for p in PLACES if places is None else places:
         cfg = landmark_worlds.config(base, p.world)
@@ -114,8 +119,10 @@ def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,
         result = {"threshold": int(np.sum(rule.predict(xt) == yt)), "observer": int(np.sum(model.predict(xt) == yt)),
                   "n": len(yt), "rule": f"{observer.FEATURES[rule.feature]} {'>' if rule.sign > 0 else '<'} "
                                         f"{rule.threshold:.3g} says landmark 2"}
-        if name in HELD_OUT and set(HELD_OUT) <= set(data):
-            others = [data[o][0] for o in HELD_OUT if o != name]
+        world_set = landmark_worlds.world_set(name)
+        group = held_out(world_set) if world_set else []
+        if group and set(group) <= set(data):
+            others = [data[o][0] for o in group if o != name]
             lowo = observer.fit_logistic(np.vstack([x for x, _ in others]), np.concatenate([y for _, y in others]))
             result["observer, other worlds"] = int(np.sum(lowo.predict(xt) == yt))
         out[name] = result

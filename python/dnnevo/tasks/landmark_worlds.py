@@ -31,7 +31,7 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.tasks import landmark
 
-__all__ = ["TRAINING", "WORLDS", "World", "config", "factors", "single_factors"]
+__all__ = ["SECOND", "SETS", "TRAINING", "WORLDS", "World", "config", "factors", "single_factors", "world_set"]
 
 
 @dataclass(frozen=True)
@@ -106,7 +106,54 @@ WORLDS: dict[str, World] = {w.name: w for w in [
           "left and bottom walls, 3.6-4.2 m from the others (2.1-2.4 m from every wall in training)",
           _room(8.0, 6.5, (3.2, 2.6))),
 ]}
-"""The held-out worlds by name."""
+"""The first set of held-out worlds by name: chosen against ``landmark-robust``'s training."""
+
+_WEAVING = {"damping": {"angle_gain": 0.3}, "corners": {"corner_distance": 0.9}}
+_LOBE = {"beam pattern": {"cone_deg": 60.0, "rays": 15, "lobe_deg": 10.0},  # rays as close as training's
+         "dropouts": {"dropout": 0.1}}
+
+
+def _boxes(one: list[dict[str, Any]], two: list[dict[str, Any]]) -> dict[str, Any]:
+    """Both landmarks' boxes replaced (the room and the start region as shipped)."""
+    return {f"landmark{n}": {**landmark.default_world(n), "boxes": boxes} for n, boxes in ((1, one), (2, two))}
+
+
+_BAR = [{"center": [3.0, 2.5], "size": [1.2, 0.3], "angle_deg": 0.0}]
+_CRATES = [{"center": [x, 2.5], "size": [0.4, 0.4], "angle_deg": 0.0} for x in (2.3, 3.0, 3.7)]
+
+SECOND: dict[str, World] = {w.name: w for w in [
+    World("weaving",
+          "another wall-following law: weakly damped (angle gain 0.3, 2.2 in training), so that the robot "
+          "weaves along each wall, and corners started 0.9 m early (0.35), so that it cuts them wide",
+          {"sim": _sim(follower=_all(_WEAVING))},
+          {name: {"sim": _sim(follower=part)} for name, part in _WEAVING.items()}),
+    World("lobe",
+          "another beam pattern and failures: a 60 deg cone of 15 rays whose reach falls off away from the "
+          "axis (a 10 deg Gaussian lobe: wide for near surfaces, narrow for far ones), and 10% of readings "
+          "lost at random",
+          {"sim": _sim(sonar=_all(_LOBE))},
+          {name: {"sim": _sim(sonar=part)} for name, part in _LOBE.items()}),
+    World("boxes",
+          "other landmarks of the same extents: landmark 1 a thin 1.2 m x 0.3 m bar (1.2 x 0.6), landmark 2 "
+          "three 0.4 m crates 0.3 m apart (two 0.6 m crates 0.6 m apart), spanning 1.8 m as in training",
+          _boxes(_BAR, _CRATES),
+          {"landmark 1": _boxes(_BAR, landmark.default_world(2)["boxes"]),
+           "landmark 2": _boxes(landmark.default_world(1)["boxes"], _CRATES)}),
+]}
+"""The second set of held-out worlds by name: chosen against ``landmark-wide``'s training, before
+any of its runs was judged, each differing in kind from what that training varies."""
+
+SETS: dict[str, dict[str, World]] = {"first": WORLDS, "second": SECOND}
+"""Every set of held-out worlds by name. A world's name is unique across sets."""
+
+
+def world_set(name: str) -> str | None:
+    """The set the held-out world ``name`` belongs to (``None`` for any other name).
+
+    >>> world_set("room"), world_set("boxes"), world_set("training")
+    ('first', 'second', None)
+    """
+    return next((s for s, worlds in SETS.items() if name in worlds), None)
 
 
 def single_factors(world: World) -> list[World]:

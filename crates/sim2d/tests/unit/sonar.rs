@@ -190,3 +190,70 @@ fn mount_geometry_and_validation() {
     assert_eq!(input(0.0, 0.5), 1.0);
     assert_eq!(input(6.5, 0.5), 0.5 / 6.5);
 }
+
+#[test]
+fn a_lobe_shortens_the_off_axis_rays() {
+    // The scene of `an_off_axis_ray_finds_the_nearer_box`: only the ray 8.3333 deg off the axis
+    // meets the box, 2.93094 m away; the axis meets the right wall 9 m away. With a 10 deg lobe
+    // that ray reaches 20 exp(-(8.3333 / 10)^2) = 9.99 m and still echoes; with a 5 deg lobe it
+    // reaches 20 exp(-(8.3333 / 5)^2) = 1.24 m and misses, and the axis (reaching 20 m) is left.
+    let w = world(vec![BoxSpec {
+        center: [4.0, 4.5],
+        size: [0.2, 0.2],
+        angle_deg: 0.0,
+    }]);
+    let pose = Pose::new(1.0, 4.0, 0.0);
+    let lobed = |lobe: f64| SonarSpec {
+        lobe_deg: Some(lobe),
+        ..forward(25.0, 7)
+    };
+    let e = Sonar::new(&lobed(10.0))
+        .unwrap()
+        .read(&w, &pose, &mut stream());
+    let expected = 2.9 / (25.0f64 / 6.0 * 2.0).to_radians().cos();
+    assert!((e.range - expected).abs() < TOL, "{e:?} vs {expected}");
+    let e = Sonar::new(&lobed(5.0))
+        .unwrap()
+        .read(&w, &pose, &mut stream());
+    assert!((e.range - 9.0).abs() < TOL, "{e:?}");
+    let e = SonarSpec {
+        lobe_deg: Some(0.0),
+        ..SonarSpec::default()
+    }
+    .validate()
+    .unwrap_err();
+    assert!(e.to_string().starts_with("sonar.lobe_deg is 0"), "{e}");
+}
+
+#[test]
+fn dropout_loses_that_fraction_of_readings_and_draws_only_when_on() {
+    let w = world(vec![]);
+    let pose = Pose::new(1.0, 4.0, 0.0);
+    let lossy = Sonar::new(&SonarSpec {
+        dropout: 0.25,
+        ..forward(25.0, 1)
+    })
+    .unwrap();
+    let mut s = stream();
+    let lost = (0..4000)
+        .filter(|_| {
+            let e = lossy.read(&w, &pose, &mut s);
+            assert!(e.range == 20.0 && e.point.is_none() || (e.range - 9.0).abs() < TOL);
+            e.point.is_none()
+        })
+        .count();
+    // Binomial(4000, 0.25): sd 27.4; 1000 +- 110 is four sds.
+    assert!((890..=1110).contains(&lost), "{lost}");
+    let (mut a, mut b) = (stream(), stream());
+    Sonar::new(&forward(25.0, 7))
+        .unwrap()
+        .read(&w, &pose, &mut a);
+    assert_eq!(a.next_u64(), b.next_u64(), "no dropout, no draw");
+    let e = SonarSpec {
+        dropout: 1.0,
+        ..SonarSpec::default()
+    }
+    .validate()
+    .unwrap_err();
+    assert!(e.to_string().starts_with("sonar.dropout is 1"), "{e}");
+}

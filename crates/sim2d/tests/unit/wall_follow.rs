@@ -26,7 +26,18 @@ struct LapRun {
 
 /// Runs until two laps are done or `limit_s` has passed.
 fn lap_run(world: &World, start: Option<Pose>, stream: &mut Stream, limit_s: f64) -> LapRun {
-    let spec = SimSpec::default();
+    lap_run_with(&SimSpec::default(), world, start, stream, limit_s)
+}
+
+/// [`lap_run`] with the follower and robot of `spec`.
+fn lap_run_with(
+    spec: &SimSpec,
+    world: &World,
+    start: Option<Pose>,
+    stream: &mut Stream,
+    limit_s: f64,
+) -> LapRun {
+    let spec = spec.clone();
     let mut sim = match start {
         Some(p) => Sim::new(world, &spec, p).unwrap(),
         None => Sim::random_start(world, &spec, stream).unwrap(),
@@ -188,4 +199,33 @@ fn settings_are_validated() {
         ..WallFollowerSpec::default()
     };
     assert!(WallFollower::new(&bad, &robot).is_err());
+}
+
+#[test]
+fn a_weaving_follower_with_wide_corners_still_laps() {
+    // A weakly damped law (angle gain 0.3: damping ratio about 0.1 at 0.6 m/s) that starts each
+    // corner 0.9 m early: the held-out follower of the landmark transfer worlds.
+    let mut spec = SimSpec::default();
+    spec.follower.angle_gain = 0.3;
+    spec.follower.corner_distance = 0.9;
+    let (mut low, mut high) = (f64::INFINITY, 0.0f64);
+    for n in [1, 2] {
+        let world = World::new(&WorldSpec::landmark(n).unwrap()).unwrap();
+        for trial in 0..6 {
+            let mut s = Stream::new(2024, 0, Purpose::Trial, u64::from(n), trial);
+            let run = lap_run_with(&spec, &world, None, &mut s, 150.0);
+            assert!(run.laps[1].is_some() && run.contacts == 0, "{run:?}");
+            assert!(run.wall_on_right > 0.8, "{run:?}");
+            low = low.min(run.wall_gap.0);
+            high = high.max(run.wall_gap.1);
+        }
+    }
+    // It strays further from wall_distance = 0.55 than the default law's 0.4-0.7.
+    assert!(low > 0.35 && high > 0.75, "{low} {high}");
+    let bad = WallFollowerSpec {
+        angle_gain: 0.0,
+        ..WallFollowerSpec::default()
+    };
+    let e = bad.validate(&RobotSpec::default()).unwrap_err();
+    assert!(e.to_string().starts_with("follower.angle_gain is 0"), "{e}");
 }

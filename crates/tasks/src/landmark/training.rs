@@ -19,8 +19,11 @@
 //! stream, `Stream::new(seed, generation, Purpose::Trial, 1, t)`, in this order: the landmark's
 //! shift in x and y, its turn, its scale, the follower's speed factor and distance offset, the
 //! sonar's cone offset, the trial-length offset, the input's gain and offset, then one normal
-//! variate per step for the input noise (only when `input_noise_sd > 0`). Every draw is made even
-//! when its range is 0, so changing one range never moves another's draws.
+//! variate per step for the input noise (only when `input_noise_sd > 0`). The variations added
+//! later draw from a third stream, `Stream::new(seed, generation, Purpose::Trial, 2, t)`, so that
+//! they leave the first two streams' draws as they were: the room's scale in x and in y, then the
+//! sonar's axis offset. Every draw is made even when its range is 0, so changing one range never
+//! moves another's draws.
 //!
 //! # Validation
 //! A champion chosen on the ideal world alone can be one that relies on exactly what training
@@ -30,7 +33,7 @@
 
 use ctrnn::{Error, Result, Stream};
 use serde::{Deserialize, Serialize};
-use sim2d::{BoxSpec, WorldSpec};
+use sim2d::{BoxSpec, StartRegion, WorldSpec};
 
 /// How the training trials vary (all ranges default to 0: no variation, the paper's training).
 ///
@@ -71,6 +74,13 @@ pub struct Training {
     /// Gaussian noise added to the input itself (not the range) at every step, sd in [0, 1].
     /// Default 0.
     pub input_noise_sd: f64,
+    /// The room, with everything in it (the boxes' centres and the start region, not the boxes'
+    /// sizes), scales by a factor in `1 ± room_scale` in x and another in y, in [0, 0.3], before
+    /// the landmark moves. Drawn from the third stream. Default 0.
+    pub room_scale: f64,
+    /// The network's sonar's axis turns by up to this many degrees, in [0, 90]. Drawn from the
+    /// third stream. Default 0.
+    pub sonar_axis_deg: f64,
 }
 
 /// One trial's draw of [`Training`]'s variations.
@@ -85,6 +95,8 @@ pub(crate) struct Variation {
     pub(super) seconds_offset: f64,
     pub(super) gain: f64,
     pub(super) offset: f64,
+    pub(super) room_scale: [f64; 2],
+    pub(super) axis_offset: f64,
 }
 
 /// `range(-r, r)`: uniform over `[-r, r)`, and exactly 0 when `r` is 0.
@@ -118,6 +130,8 @@ impl Training {
             ("input_gain", self.input_gain, 0.9),
             ("input_offset", self.input_offset, 0.5),
             ("input_noise_sd", self.input_noise_sd, 1.0),
+            ("room_scale", self.room_scale, 0.3),
+            ("sonar_axis_deg", self.sonar_axis_deg, 90.0),
         ] {
             if !(value.is_finite() && (0.0..=hi).contains(&value)) {
                 return err(format!("{name} is {value}; it must be in [0, {hi}]"));
@@ -126,8 +140,9 @@ impl Training {
         Ok(())
     }
 
-    /// Draws one trial's variation from `stream` (see the [module docs](self) for the order).
-    pub(crate) fn draw(&self, stream: &mut Stream) -> Variation {
+    /// Draws one trial's variation from `stream` and `third` (see the [module docs](self) for the
+    /// order).
+    pub(crate) fn draw(&self, stream: &mut Stream, third: &mut Stream) -> Variation {
         let shift = [
             symmetric(stream, self.landmark_shift),
             symmetric(stream, self.landmark_shift),
@@ -140,6 +155,11 @@ impl Training {
         let seconds_offset = symmetric(stream, self.trial_seconds);
         let gain = 1.0 + symmetric(stream, self.input_gain);
         let offset = symmetric(stream, self.input_offset);
+        let room_scale = [
+            1.0 + symmetric(third, self.room_scale),
+            1.0 + symmetric(third, self.room_scale),
+        ];
+        let axis_offset = symmetric(third, self.sonar_axis_deg);
         Variation {
             shift,
             turn_deg,
@@ -150,7 +170,31 @@ impl Training {
             seconds_offset,
             gain,
             offset,
+            room_scale,
+            axis_offset,
         }
+    }
+}
+
+/// `world` with its room, its boxes' centres and its start region scaled by `v.room_scale` in x
+/// and y (the boxes keep their sizes).
+pub(super) fn scale_room(world: &WorldSpec, v: &Variation) -> WorldSpec {
+    let [sx, sy] = v.room_scale;
+    let scale = |p: [f64; 2]| [p[0] * sx, p[1] * sy];
+    WorldSpec {
+        room: scale(world.room),
+        boxes: world
+            .boxes
+            .iter()
+            .map(|b| BoxSpec {
+                center: scale(b.center),
+                ..b.clone()
+            })
+            .collect(),
+        start: StartRegion {
+            min: scale(world.start.min),
+            max: scale(world.start.max),
+        },
     }
 }
 

@@ -5,7 +5,7 @@ use ctrnn::{Purpose, Result, Stream};
 use rayon::prelude::*;
 
 use super::task::{LandmarkTask, Sensing};
-use super::training::move_landmark;
+use super::training::{move_landmark, scale_room};
 
 impl LandmarkTask {
     /// Training trial `t` of `generation` (landmark 1 for `t < trials_per_landmark`, then 2):
@@ -47,7 +47,8 @@ impl LandmarkTask {
 
     /// Trial `t` of `set` (landmark 1 for `t < per_landmark`, then 2), from the streams
     /// `(seed, generation, purpose, 0, t)` for its start pose and sonar, and
-    /// `(seed, generation, purpose, 1, t)` for its variation.
+    /// `(seed, generation, purpose, 1, t)` and `(seed, generation, purpose, 2, t)` for its
+    /// variation.
     fn drawn_trial(&self, set: &TrialSet, seed: u64, t: usize) -> Result<Sensing> {
         let c = self.config();
         let k = set.per_landmark;
@@ -58,12 +59,14 @@ impl LandmarkTask {
             return self.sense(landmark, stream, c.train_robot_like);
         }
         let mut draws = Stream::new(seed, set.generation, set.purpose, 1, t as u64);
-        let v = training.draw(&mut draws);
-        let world = move_landmark(c.world(landmark), &v)?;
+        let mut third = Stream::new(seed, set.generation, set.purpose, 2, t as u64);
+        let v = training.draw(&mut draws, &mut third);
+        let world = move_landmark(&scale_room(c.world(landmark), &v), &v)?;
         let mut sim = c.sim.clone();
         sim.follower.speed *= v.speed_factor;
         sim.follower.wall_distance += v.distance_offset;
         sim.sonars[0].cone_deg += v.cone_offset;
+        sim.sonars[0].mount_angle_deg += v.axis_offset;
         let steps = ((c.trial_seconds + v.seconds_offset) / sim.dt).round() as usize;
         let mut sensing = self.sense_in(landmark, world, &sim, steps, stream)?;
         let sd = training.input_noise_sd;

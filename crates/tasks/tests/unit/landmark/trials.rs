@@ -23,6 +23,8 @@ fn varied() -> LandmarkConfig {
             input_gain: 0.3,
             input_offset: 0.05,
             input_noise_sd: 0.02,
+            room_scale: 0.0,
+            sonar_axis_deg: 0.0,
         },
         ..LandmarkConfig::default()
     }
@@ -287,4 +289,56 @@ fn varied_training_validates_on_ideal_and_varied_trials() {
             .sum();
         assert_eq!(v.score, total / 12.0);
     }
+}
+
+/// The room's scale and the sonar's axis draw from a third stream: the other variations keep
+/// their draws, the room and everything in it scale within range, and the boxes keep the size
+/// and turn the second stream gave them.
+#[test]
+fn room_and_axis_variations_leave_the_other_draws_alone() {
+    let base = varied();
+    let wider = LandmarkConfig {
+        training: Training {
+            room_scale: 0.2,
+            sonar_axis_deg: 15.0,
+            ..base.training.clone()
+        },
+        ..base.clone()
+    };
+    let before = task(base).trials(6, 3).unwrap();
+    let after = task(wider).trials(6, 3).unwrap();
+    let mut rooms = vec![];
+    for (k, (a, b)) in after.iter().zip(&before).enumerate() {
+        if k % 3 == 0 {
+            assert_eq!(a, b, "the ideal trials do not vary");
+            continue;
+        }
+        let [sx, sy] = [a.world.room[0] / 6.0, a.world.room[1] / 5.0];
+        assert!(
+            (0.8..=1.2).contains(&sx) && (0.8..=1.2).contains(&sy),
+            "{sx} {sy}"
+        );
+        rooms.push(a.world.room);
+        assert!((a.world.start.max[0] - 5.6 * sx).abs() < 1e-12);
+        assert!((a.world.start.min[1] - 0.4 * sy).abs() < 1e-12);
+        for (p, q) in a.world.boxes.iter().zip(&b.world.boxes) {
+            assert_eq!((p.size, p.angle_deg), (q.size, q.angle_deg));
+        }
+        assert_eq!(
+            a.input.len(),
+            b.input.len(),
+            "the trial's length is the second stream's"
+        );
+    }
+    assert!(rooms.iter().any(|r| r != &rooms[0]));
+    let e = err(json!({"training": {"room_scale": 0.4}}));
+    assert!(
+        e.contains("training.room_scale is 0.4; it must be in [0, 0.3]"),
+        "{e}"
+    );
+    let e = err(json!({"training": {"sonar_axis_deg": -1.0}}));
+    assert!(
+        e.contains("training.sonar_axis_deg is -1; it must be in [0, 90]"),
+        "{e}"
+    );
 }

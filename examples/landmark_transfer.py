@@ -190,7 +190,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                    help="judge in each held-out world's factors, one at a time, instead of the five places")
     p.add_argument("--record", type=Path, metavar="JSON",
                    help="also write the table here, for the docs (docs/results/examples/landmark-transfer.json, "
-                        "or landmark-factors.json with --factors)")
+                        "or landmark-factors.json with --factors; landmark-transfer-second.json with --worlds "
+                        "second)")
     args = p.parse_args(argv)
     if args.trials < 1 or args.fit_trials < 1:
         p.error("--trials and --fit-trials must be at least 1")

@@ -76,13 +76,17 @@ def test_the_worlds_go_beyond_what_training_varies() -> None:
 def test_the_second_set_changes_nothing_the_wide_envelope_varies() -> None:
     """landmark-wide varies the follower's speed and distance, the sonar's cone and axis, the room
     and the landmark as a whole; the second set's worlds change other things (the box sizes of
-    the boxes world change the landmarks' proportions, which scaling a landmark as a whole keeps)."""
+    the boxes world change the landmarks' proportions, which scaling a landmark as a whole keeps),
+    and the one varied setting they change, the cone, stays within training's range."""
     training = presets.get("landmark-wide").task_params["training"]
     assert training["room_scale"] > 0 and training["sonar_axis_deg"] > 0
     varied = {"sim.follower.speed", "sim.follower.wall_distance", "sim.sonars.0.mount_angle_deg",
               "landmark1.room", "landmark2.room"}
     for world in landmark_worlds.SECOND.values():
         assert not varied & set(landmark_worlds.factors(world)), world.name
+    # The lobed sonar's cone is one that training draws (25 +- 15 deg): what differs is its lobe.
+    default, cone = landmark_worlds.factors(landmark_worlds.SECOND["lobe"])["sim.sonars.0.cone_deg"]
+    assert abs(cone - default) <= training["cone_deg"]
     assert landmark_worlds.world_set("weaving") == "second" and landmark_worlds.world_set("room") == "first"
     assert not set(landmark_worlds.WORLDS) & set(landmark_worlds.SECOND), "a name in two sets"
 

@@ -168,6 +168,11 @@ def test_the_held_out_worlds_job_judges_each_world_is_checked_and_renders(tmp_pa
     found = jobs.run_job(worlds, tmp_path, QUICK, 1)
     assert time.perf_counter() - t0 < 10  # quick reproductions stay quick
     assert jobs.read_result(tmp_path, worlds, QUICK) == found
+    # A result judged in worlds that have changed since is done again.
+    real = landmark_transfer.worlds_digest
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(landmark_transfer, "worlds_digest", lambda s: "0" * 64 if s == "first" else real(s))
+        assert jobs.read_result(tmp_path, worlds, QUICK) is None
     # The library's figures for the champion, on the example's trials (10 per landmark here).
     run = RunDir(tmp_path / landmark.id)
     config, table = run.read_config()

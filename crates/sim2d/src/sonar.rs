@@ -102,7 +102,15 @@ impl SonarSpec {
             check_range(&f("specular_max_incidence_deg"), a, 0.0, true, 90.0, true)?;
         }
         if let Some(w) = self.lobe_deg {
+            // In radians it must stay above 0 too (a subnormal width would blind the sonar).
             check_range(&f("lobe_deg"), w, 0.0, false, inf, false)?;
+            if w.to_radians() <= 0.0 {
+                return Err(Error::invalid(
+                    f("lobe_deg"),
+                    w,
+                    "a positive number, also in radians",
+                ));
+            }
         }
         check_range(&f("dropout"), self.dropout, 0.0, true, 1.0, false)?;
         Ok(())
@@ -214,6 +222,8 @@ impl Sonar {
             let ray_range = match self.lobe {
                 None => s.max_range,
                 Some(w) => {
+                    // The ray's angle from the axis (the direction above adds it to the axis in
+                    // the order the sonar always has, so a sonar without a lobe keeps its bits).
                     let off_axis = self.first_ray + self.ray_step * i as f64;
                     s.max_range * (-(off_axis / w).powi(2)).exp()
                 }

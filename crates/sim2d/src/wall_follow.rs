@@ -78,13 +78,16 @@ pub struct WallFollowerSpec {
     pub max_turn_rate: f64,
     /// The range of the follower's own rays, in metres, > `wall_distance`. Default 2.0.
     pub sensor_range: f64,
-    /// The follow phase's turn rate per metre of distance error, in rad/s per m, > 0. Default 3.0.
+    /// The follow phase's turn rate per metre of distance error, in rad/s per m, in (0,
+    /// [`MAX_GAIN`]]. Default 3.0.
     pub distance_gain: f64,
-    /// The follow phase's turn rate per radian of the wall's angle, in rad/s per rad, > 0. Default
-    /// 2.2, which damps the approach to the wall; a much smaller gain makes the robot weave.
+    /// The follow phase's turn rate per radian of the wall's angle, in rad/s per rad, in (0,
+    /// [`MAX_GAIN`]]. Default 2.2, which damps the approach to the wall (a damping ratio of about
+    /// 0.8 at the default speed); a much smaller gain makes the robot weave.
     pub angle_gain: f64,
     /// How far beyond `wall_distance` a wall ahead starts the corner turn (and ends the seek
-    /// phase), in metres, > 0. Default 0.35.
+    /// phase), in metres, > 0, with `wall_distance + corner_distance < sensor_range` (the front
+    /// fan must see where the turn starts). Default 0.35.
     pub corner_distance: f64,
 }
 
@@ -124,13 +127,20 @@ impl WallFollowerSpec {
             inf,
             false,
         )?;
-        for (name, value) in [
+        for (name, gain) in [
             ("follower.distance_gain", self.distance_gain),
             ("follower.angle_gain", self.angle_gain),
-            ("follower.corner_distance", self.corner_distance),
         ] {
-            check_range(name, value, 0.0, false, inf, false)?;
+            check_range(name, gain, 0.0, false, MAX_GAIN, true)?;
         }
+        check_range(
+            "follower.corner_distance",
+            self.corner_distance,
+            0.0,
+            false,
+            inf,
+            false,
+        )?;
         if !(self.sensor_range.is_finite() && self.sensor_range > self.wall_distance) {
             return Err(Error::invalid(
                 "follower.sensor_range",
@@ -141,9 +151,26 @@ impl WallFollowerSpec {
                 ),
             ));
         }
+        let corner = self.wall_distance + self.corner_distance;
+        if corner >= self.sensor_range {
+            return Err(Error::invalid(
+                "follower.corner_distance",
+                self.corner_distance,
+                &format!(
+                    "less than follower.sensor_range - follower.wall_distance = {} (the front \
+                     rays must see where the corner turn starts)",
+                    self.sensor_range - self.wall_distance
+                ),
+            ));
+        }
         Ok(())
     }
 }
+
+/// The largest gain of the follow law, in rad/s per m or per rad: at 100 a 2 cm error (or a wall
+/// angle of 1.1 degrees) already asks for the default fastest turn, 2 rad/s, so a larger gain is
+/// a switch rather than a gain.
+pub const MAX_GAIN: f64 = 100.0;
 
 /// Which phase the follower is in.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -246,31 +246,46 @@ impl WorldSpec {
             1.0 + stream.range(-room_scale_frac, room_scale_frac),
             1.0 + stream.range(-room_scale_frac, room_scale_frac),
         ];
-        let room = [self.room[0] * scale[0], self.room[1] * scale[1]];
-        let mut out = WorldSpec {
-            room,
-            boxes: Vec::with_capacity(self.boxes.len()),
-            start: StartRegion {
-                min: [self.start.min[0] * scale[0], self.start.min[1] * scale[1]],
-                max: [self.start.max[0] * scale[0], self.start.max[1] * scale[1]],
-            },
-        };
-        for b in &self.boxes {
+        let mut out = self.scaled(scale);
+        let room = out.room;
+        for b in &mut out.boxes {
             let half = b.aabb_half_extents();
-            let mut center = [0.0; 2];
             for k in 0..2 {
-                let c = b.center[k] * scale[k] + stream.range(-box_shift_m, box_shift_m);
+                let c = b.center[k] + stream.range(-box_shift_m, box_shift_m);
                 // Clamp into [half, room - half]; if the box no longer fits, validate() says so.
-                center[k] = c.min(room[k] - half[k]).max(half[k]);
+                b.center[k] = c.min(room[k] - half[k]).max(half[k]);
             }
-            out.boxes.push(BoxSpec {
-                center,
-                size: b.size,
-                angle_deg: b.angle_deg,
-            });
         }
         out.validate()?;
         Ok(out)
+    }
+
+    /// This world with the room, the boxes' centres and the start region scaled by `scale[0]` in
+    /// x and `scale[1]` in y; the boxes keep their sizes and turns. Not validated.
+    ///
+    /// # Example
+    /// ```
+    /// let w = sim2d::WorldSpec::landmark(1)?.scaled([1.5, 0.8]);
+    /// assert_eq!((w.room, w.boxes[0].center, w.boxes[0].size), ([9.0, 4.0], [4.5, 2.0], [1.2, 0.6]));
+    /// # Ok::<(), sim2d::Error>(())
+    /// ```
+    pub fn scaled(&self, scale: [f64; 2]) -> WorldSpec {
+        let at = |p: [f64; 2]| [p[0] * scale[0], p[1] * scale[1]];
+        WorldSpec {
+            room: at(self.room),
+            boxes: self
+                .boxes
+                .iter()
+                .map(|b| BoxSpec {
+                    center: at(b.center),
+                    ..b.clone()
+                })
+                .collect(),
+            start: StartRegion {
+                min: at(self.start.min),
+                max: at(self.start.max),
+            },
+        }
     }
 }
 

@@ -39,7 +39,7 @@ from dnnevo.evolution.seeding import Seeding
 from dnnevo.robots import navigation
 
 __all__ = ["ROBOT_SEED_BASE", "SYSTEM_TRIALS", "HAND_STARTS", "HAND_QUICK_STARTS", "HAND_CONDITIONS", "WORLD_TRIALS",
-           "WORLD_QUICK_TRIALS", "world_places", "Settings", "Stopped", "result_path", "read_result", "run_job",
+           "WORLD_QUICK_TRIALS", "WORLDS_INPUT", "world_places", "Settings", "Stopped", "result_path", "read_result", "run_job",
            "hand_counts", "world_counts"]
 
 ROBOT_SEED_BASE = 3_000_003
@@ -80,6 +80,10 @@ def world_places(world_set: str = "first") -> tuple[str, ...]:
     return ("training", *landmark_transfer.held_out(world_set))
 
 _BOUNDS = ("threshold", "observer", "observer, other worlds")
+
+WORLDS_INPUT = "held-out worlds: "
+"""The start of a held-out-worlds test's input that holds its worlds' digest (results written
+before it was added lack it)."""
 
 
 class Stopped(Exception):
@@ -188,8 +192,9 @@ def _inputs(root: Path, job: plan.Job) -> dict[str, Any]:
     evolution's generation count (the rows of ``log.csv``; the file itself holds wall times).
     None stands for a missing file. A result whose inputs changed (a run folder deleted, a run
     extended with ``dnnevo resume``) is done again. The hand-designed navigator's inputs are the
-    SHA-256 of the shipped network and worlds, so that a result made with other ones is done
-    again."""
+    SHA-256 of the shipped network and worlds, and a held-out-worlds test's also the SHA-256 of
+    its worlds' task settings as the core reads them, so that a result made with other ones is
+    done again."""
     if job.spec.kind == plan.HAND_DESIGNED:
         files = ["navigator.json", *(f"{w}.toml" for w in navigation.WORLDS)]
         data = resources.files("dnnevo.robots").joinpath("data")
@@ -202,6 +207,8 @@ def _inputs(root: Path, job: plan.Job) -> dict[str, Any]:
             out[f"{run}/best.json"] = hashlib.sha256((root / run / "best.json").read_bytes()).hexdigest()
         except FileNotFoundError:
             out[f"{run}/best.json"] = None
+    if job.spec.kind == plan.HELD_OUT:
+        out[f"{WORLDS_INPUT}{job.spec.worlds}"] = landmark_transfer.worlds_digest(job.spec.worlds)
     if own:
         try:
             out[f"{job.id}/log.csv rows"] = len((root / job.id / "log.csv").read_text(encoding="utf-8").splitlines()) - 1

@@ -271,9 +271,14 @@ def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
 def _comparable(result: Any) -> Any:
     """What two machines that ran the same job must agree on: its result without wall times,
     its config with the settings added since it was written at their defaults (a result
-    collected before a setting existed is the same run as one collected after)."""
+    collected before a setting existed is the same run as one collected after), and its inputs
+    without a held-out-worlds test's digest of its worlds (checked against the code when the
+    reproduction reads the result; results collected before it existed lack it)."""
     if isinstance(result, dict) and isinstance(result.get("config"), dict):
         result = manifest_with_later_defaults(result)
+    if isinstance(result, dict) and isinstance(result.get("inputs"), dict):
+        inputs = {k: v for k, v in result["inputs"].items() if not str(k).startswith(jobs.WORLDS_INPUT)}
+        result = {**result, "inputs": inputs}
     return _timeless(result)
 
 

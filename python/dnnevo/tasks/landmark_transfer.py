@@ -29,6 +29,9 @@ only on the trial counts (and the task settings a world keeps).
 
 from __future__ import annotations
 
+import copy
+import hashlib
+import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -37,12 +40,13 @@ import numpy as np
 
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
+from dnnevo.errors import InvalidArgumentError
 from dnnevo.evaluation import observer
 from dnnevo.evaluation.stats import wilson
 from dnnevo.tasks import landmark, landmark_worlds
 
 __all__ = ["FIT_SEED", "TEST_SEED", "NEAR", "THRESHOLD_COLUMNS", "GOAL_RATE", "GOAL_LOWER", "Place", "PLACES",
-           "held_out", "place", "sonar_features", "bounds", "judge", "meets"]
+           "held_out", "worlds_digest", "place", "sonar_features", "bounds", "judge", "meets"]
 
 FIT_SEED = 47_001
 """The seed of the trials the threshold rule and the observer are fitted on."""
@@ -77,9 +81,27 @@ PLACES = [Place("training", landmark_worlds.TRAINING),
 
 
 def held_out(world_set: str = "first") -> list[str]:
-    """The names of the held-out worlds of ``world_set`` (see ``landmark_worlds.SETS``)."""
+    """The names of the held-out worlds of ``world_set`` (see ``landmark_worlds.SETS``).
+
+    >>> held_out("third")
+    Traceback (most recent call last):
+    ...
+    dnnevo.errors.InvalidArgumentError: world_set is 'third'; the sets of held-out worlds are first, second
+    """
+    if world_set not in landmark_worlds.SETS:
+        raise InvalidArgumentError(f"world_set is {world_set!r}; the sets of held-out worlds are "
+                                   + ", ".join(landmark_worlds.SETS))
     return list(landmark_worlds.SETS[world_set])
 
+
+
+def worlds_digest(world_set: str) -> str:
+    """SHA-256 of the task settings of ``world_set``'s held-out worlds and of the training world,
+    every default filled in as the core reads them: it changes when any of those worlds does."""
+    settings = {name: landmark.params(EvolutionConfig(task=landmark.NAME, task_params=copy.deepcopy(w.params)))
+                for name, w in [("training", landmark_worlds.TRAINING), *landmark_worlds.SETS[world_set].items()]}
+    text = json.dumps(settings, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def place(name: str) -> Place:

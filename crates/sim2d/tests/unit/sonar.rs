@@ -223,6 +223,13 @@ fn a_lobe_shortens_the_off_axis_rays() {
     .validate()
     .unwrap_err();
     assert!(e.to_string().starts_with("sonar.lobe_deg is 0"), "{e}");
+    let e = SonarSpec {
+        lobe_deg: Some(5e-324),
+        ..SonarSpec::default()
+    }
+    .validate()
+    .unwrap_err();
+    assert!(e.to_string().contains("also in radians"), "{e}");
 }
 
 #[test]

@@ -228,4 +228,25 @@ fn a_weaving_follower_with_wide_corners_still_laps() {
     };
     let e = bad.validate(&RobotSpec::default()).unwrap_err();
     assert!(e.to_string().starts_with("follower.angle_gain is 0"), "{e}");
+    let bad = WallFollowerSpec {
+        distance_gain: 101.0,
+        ..WallFollowerSpec::default()
+    };
+    let e = bad.validate(&RobotSpec::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("follower.distance_gain is 101; it must be in (0, 100]"),
+        "{e}"
+    );
+    // The front rays (2 m) must see where the corner turn starts: 0.55 + 1.45 is too far.
+    let bad = WallFollowerSpec {
+        corner_distance: 1.45,
+        ..WallFollowerSpec::default()
+    };
+    let e = bad.validate(&RobotSpec::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("follower.corner_distance is 1.45; it must be less than"),
+        "{e}"
+    );
 }

@@ -205,6 +205,12 @@ impl LandmarkConfig {
                     .into(),
             ));
         }
+        for n in [1, 2] {
+            t.check_world(self.world(n)).map_err(|e| match e {
+                Error::Config(m) => Error::Config(format!("landmark{n}: {m}")),
+                other => other,
+            })?;
+        }
         // The follower and the sonar must be valid at both ends of their ranges.
         for sign in [-1.0, 1.0] {
             let mut sim = self.sim.clone();

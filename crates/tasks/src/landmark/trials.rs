@@ -5,7 +5,7 @@ use ctrnn::{Purpose, Result, Stream};
 use rayon::prelude::*;
 
 use super::task::{LandmarkTask, Sensing};
-use super::training::{move_landmark, scale_room};
+use super::training::vary_world;
 
 impl LandmarkTask {
     /// Training trial `t` of `generation` (landmark 1 for `t < trials_per_landmark`, then 2):
@@ -61,7 +61,7 @@ impl LandmarkTask {
         let mut draws = Stream::new(seed, set.generation, set.purpose, 1, t as u64);
         let mut third = Stream::new(seed, set.generation, set.purpose, 2, t as u64);
         let v = training.draw(&mut draws, &mut third);
-        let world = move_landmark(&scale_room(c.world(landmark), &v), &v)?;
+        let world = vary_world(c.world(landmark), &v)?;
         let mut sim = c.sim.clone();
         sim.follower.speed *= v.speed_factor;
         sim.follower.wall_distance += v.distance_offset;

@@ -74,8 +74,19 @@ fn bad_training_fields_are_config_errors_that_name_them() {
         },
         ..varied()
     };
-    let e = task(far).trials(0, 0).unwrap_err().to_string();
-    assert!(e.contains("moved the landmark out of the room"), "{e}");
+    let e = LandmarkTask::new(far).unwrap_err().to_string();
+    assert!(
+        e.contains(
+            "landmark1: training moved the landmark out of the room (training.landmark_shift"
+        ),
+        "{e}"
+    );
+    // So is a room scaled until the landmark no longer fits, when the config is read.
+    let e = err(json!({"training": {"room_scale": 0.3}, "landmark1": {
+        "room": [6.0, 5.0], "start": {"min": [0.4, 0.4], "max": [5.6, 4.6]},
+        "boxes": [{"center": [0.8, 2.5], "size": [1.2, 0.6]}]}}));
+    assert!(e.contains("room_scale reach too far for this world"), "{e}");
+    assert!(LandmarkTask::from_params(&json!({"training": {"room_scale": 0.3}})).is_ok());
     // All ranges 0 is off, whatever ideal_trials_per_landmark says.
     assert!(Training::default().is_off());
     assert!(Training {

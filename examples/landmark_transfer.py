@@ -53,6 +53,7 @@ from typing import Any
 
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
+from dnnevo.errors import DnnevoError
 from dnnevo.evaluation.stats import wilson
 from dnnevo.experiments import examples
 from dnnevo.runs import RunDir
@@ -176,6 +177,36 @@ def factor_table(families: dict[str, dict[str, dict[str, int]]], base: dict[str,
     return columns, rows, summary
 
 
+def labels(folders: Sequence[Path]) -> list[str]:
+    """Each folder's label in the tables: its name, or its whole path where two share a name (two
+    reproductions' ``landmark`` folders, say).
+
+    >>> labels([Path("a/landmark"), Path("b/landmark"), Path("b/landmark-robust")])
+    ['a/landmark', 'b/landmark', 'landmark-robust']
+    """
+    names = [f.name for f in folders]
+    return [f.name if names.count(f.name) == 1 else str(f) for f in folders]
+
+
+def judge_all(folders: Sequence[Path], trials: int, fit_trials: int, judged: Sequence[Place]
+              ) -> tuple[dict[str, dict[str, dict[str, int]]], dict[str, dict[str, Any]]]:
+    """Every champion of ``folders`` judged in ``judged`` (by family label and seed), and the
+    bounds in each place (fitted on the first champion's config: the sonar does not depend on the
+    network)."""
+    families: dict[str, dict[str, dict[str, int]]] = {}
+    start = time.perf_counter()
+    for label_of, folder in zip(labels(folders), folders, strict=True):
+        family = families.setdefault(label_of, {})
+        for label, run in champions(folder):
+            family[label] = judge(run, trials, judged)
+            print(f"{label_of} {label}: " + "  ".join(f"{p.name} {pct(family[label][p.name], 2 * trials)}%"
+                                                      for p in judged), flush=True)
+    base_cfg, base_net = load(champions(folders[0])[0][1])
+    base = transfer.bounds(base_cfg, base_net, fit_trials, trials, judged)
+    print(f"{time.perf_counter() - start:.0f} s", file=sys.stderr)
+    return families, base
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("folders", nargs="*", type=Path, metavar="FOLDER",
@@ -201,24 +232,16 @@ def main(argv: Sequence[str] | None = None) -> None:
         p.error(f"{missing[0]} is not a folder; pass the champions' folders (run folders, or folders "
                 "of seed-N run folders), for example: examples/landmark_transfer.py runs/sweep-landmark")
     judged = factors(args.worlds) if args.factors else places(args.worlds)
-    families: dict[str, dict[str, dict[str, int]]] = {}
-    start = time.perf_counter()
-    for folder in folders:
-        family = families.setdefault(folder.name, {})
-        for label, run in champions(folder):
-            family[label] = judge(run, args.trials, judged)
-            print(f"{folder.name} {label}: " + "  ".join(f"{p.name} {pct(family[label][p.name], 2 * args.trials)}%"
-                                                         for p in judged), flush=True)
-    first = champions(folders[0])[0][1]
-    base_cfg, base_net = load(first)
-    base = transfer.bounds(base_cfg, base_net, args.fit_trials, args.trials, judged)
+    try:
+        families, base = judge_all(folders, args.trials, args.fit_trials, judged)
+    except DnnevoError as e:  # a run folder that cannot be read, or not a landmark run
+        sys.exit(f"error: {e}")
     columns, rows, summary = (factor_table if args.factors else table)(families, base, args.trials, args.worlds)
     print()
     print(" | ".join(columns))
     for row in rows:
         print(" | ".join(row))
     print("\n".join(summary))
-    print(f"{time.perf_counter() - start:.0f} s", file=sys.stderr)
     if args.record:
         examples.write(args.record, command=examples.command("examples/landmark_transfer.py", argv),
                        columns=columns, rows=rows, summary=summary)

@@ -4,6 +4,7 @@ example's code path writes a record that renders."""
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -222,3 +223,44 @@ def test_help_names_an_example_and_a_missing_folder_is_named(capsys: pytest.Capt
     with pytest.raises(SystemExit):
         landmark_transfer.main([str(tmp_path / "nowhere")])
     assert "nowhere is not a folder; pass the champions' folders" in capsys.readouterr().err
+
+
+def test_a_held_out_world_keeps_the_run_s_own_settings() -> None:
+    """A run read its answer from neuron 3 after 30 s: in the training place it is judged as
+    ``assess`` judges it with its own config, and a held-out world keeps those settings."""
+    base = presets.get("landmark")
+    own = dataclasses.replace(base, task_params={"classifier": 3, "trial_seconds": 30.0, "trials_per_landmark": 5})
+    net = dnnevo.Network.random(own.size, own.n_inputs, seed=11)
+    mine = landmark.assess(own, net, 4, transfer.TEST_SEED)["confusion"]
+    assert transfer.judge(own, net, 4, ["training"])["training"] == mine[0][0] + mine[1][1]
+    params = landmark.params(landmark_worlds.config(own, "weaving"))
+    assert (params["classifier"], params["trial_seconds"], params["trials_per_landmark"]) == (3, 30.0, 3)
+    assert params["sim"]["follower"]["angle_gain"] == 0.3
+    # A sonar of the run's own keeps what the world does not change.
+    ranged = dataclasses.replace(base, task_params={"sim": {"sonars": [{"max_range": 5.0, "rays": 9}]}})
+    sonar = landmark.params(landmark_worlds.config(ranged, "lobe"))["sim"]["sonars"][0]
+    assert (sonar["max_range"], sonar["rays"], sonar["lobe_deg"]) == (5.0, 11, 10.0)
+
+
+def test_names_and_counts_are_checked() -> None:
+    cfg = presets.get("landmark")
+    net = dnnevo.Network.random(cfg.size, cfg.n_inputs, seed=1)
+    with pytest.raises(dnnevo.InvalidArgumentError, match="no place is called 'folower'"):
+        transfer.judge(cfg, net, 2, ["folower"])
+    with pytest.raises(dnnevo.InvalidArgumentError, match="world_set is 'secnd'"):
+        transfer.worlds_digest("secnd")
+    with pytest.raises(dnnevo.InvalidArgumentError, match="fit is 0"):
+        transfer.bounds(cfg, net, 0, 5, ["training"])
+    with pytest.raises(dnnevo.InvalidArgumentError, match="no held-out world is called 'rooom'"):
+        landmark_worlds.single_factors("rooom")
+    assert [w.name for w in landmark_worlds.single_factors("lobe")] == ["lobe: beam pattern", "lobe: dropouts"]
+
+
+def test_the_example_labels_same_named_folders_apart_and_refuses_other_tasks(tmp_path: Path) -> None:
+    assert landmark_transfer.labels([Path("a/landmark"), Path("b/landmark"), Path("c/x")]) == [
+        "a/landmark", "b/landmark", "x"]
+    r = run_cli("run", "sequence-1bit", "--quick", "--out", tmp_path / "seq", "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    with pytest.raises(SystemExit, match="^error: the run's task is 'sequence'; held-out worlds are for the "
+                                         "'landmark' task$"):
+        landmark_transfer.main([str(tmp_path / "seq")])

@@ -68,8 +68,8 @@ const FRONT_STOP: f64 = 0.1;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WallFollowerSpec {
-    /// The cruising speed in m/s, > 0. Default 0.6 (the paper's simulated robot ran at 3 times the
-    /// real robot's 0.2 m/s).
+    /// The cruising speed in m/s, in (0, `robot.max_speed`]. Default 0.6 (the paper's simulated
+    /// robot ran at 3 times the real robot's 0.2 m/s).
     pub speed: f64,
     /// The distance held between the wall and the robot's centre, in metres, > the robot's radius
     /// + 0.1. Default 0.55 (a gap of 0.285 m for the default robot).
@@ -110,7 +110,15 @@ impl WallFollowerSpec {
     /// `follower.<field>`).
     pub fn validate(&self, robot: &RobotSpec) -> Result<(), Error> {
         let inf = f64::INFINITY;
-        check_range("follower.speed", self.speed, 0.0, false, inf, false)?;
+        // The robot's wheels cannot go faster: a faster cruising speed would be clamped.
+        check_range(
+            "follower.speed",
+            self.speed,
+            0.0,
+            false,
+            robot.max_speed,
+            true,
+        )?;
         let min_d = robot.radius + FRONT_STOP;
         if !(self.wall_distance.is_finite() && self.wall_distance > min_d) {
             return Err(Error::invalid(

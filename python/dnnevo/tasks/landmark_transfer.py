@@ -40,6 +40,7 @@ import numpy as np
 
 from dnnevo import _core
 from dnnevo.config import EvolutionConfig
+from dnnevo._checks import bounded_count
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.evaluation import observer
 from dnnevo.evaluation.stats import wilson
@@ -88,7 +89,7 @@ def held_out(world_set: str = "first") -> list[str]:
     ...
     dnnevo.errors.InvalidArgumentError: world_set is 'third'; the sets of held-out worlds are first, second
     """
-    if world_set not in landmark_worlds.SETS:
+    if not isinstance(world_set, str) or world_set not in landmark_worlds.SETS:
         raise InvalidArgumentError(f"world_set is {world_set!r}; the sets of held-out worlds are "
                                    + ", ".join(landmark_worlds.SETS))
     return list(landmark_worlds.SETS[world_set])
@@ -98,15 +99,33 @@ def held_out(world_set: str = "first") -> list[str]:
 def worlds_digest(world_set: str) -> str:
     """SHA-256 of the task settings of ``world_set``'s held-out worlds and of the training world,
     every default filled in as the core reads them: it changes when any of those worlds does."""
-    settings = {name: landmark.params(EvolutionConfig(task=landmark.NAME, task_params=copy.deepcopy(w.params)))
-                for name, w in [("training", landmark_worlds.TRAINING), *landmark_worlds.SETS[world_set].items()]}
+    worlds = [landmark_worlds.TRAINING, *(landmark_worlds.get(name) for name in held_out(world_set))]
+    settings = {w.name: landmark.params(EvolutionConfig(task=landmark.NAME, task_params=copy.deepcopy(w.params)))
+                for w in worlds}
     text = json.dumps(settings, sort_keys=True, separators=(",", ":"), allow_nan=False)
     return hashlib.sha256(text.encode()).hexdigest()
 
 
 def place(name: str) -> Place:
-    """The place called ``name``."""
-    return next(p for p in PLACES if p.name == name)
+    """The place called ``name``.
+
+    >>> place("lobe").world.name
+    'lobe'
+    >>> place("folower")
+    Traceback (most recent call last):
+    ...
+    dnnevo.errors.InvalidArgumentError: no place is called 'folower'; the places are training, robot-like, follower, sonar, room, weaving, lobe, boxes
+    """
+    found = next((p for p in PLACES if p.name == name), None)
+    if found is None:
+        raise InvalidArgumentError(f"no place is called {name!r}; the places are "
+                                   + ", ".join(p.name for p in PLACES))
+    return found
+
+
+def _places(places: Sequence[Place | str] | None) -> list[Place]:
+    """``places`` as places (names looked up), :data:`PLACES` when None."""
+    return list(PLACES) if places is None else [place(p) if isinstance(p, str) else p for p in places]
 
 
 def sonar_features(config: EvolutionConfig, net: _core.Network, per_landmark: int, seed: int,
@@ -124,13 +143,15 @@ def sonar_features(config: EvolutionConfig, net: _core.Network, per_landmark: in
 
 
 def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,
-           places: Sequence[Place] | None = None) -> dict[str, dict[str, Any]]:
-    """Each place's threshold rule and observer (of ``places``, default :data:`PLACES`), fitted
-    on ``fit`` trials per landmark from FIT_SEED and judged on ``test`` from TEST_SEED; a held-out
-    world also gets the observer fitted on the other held-out worlds of its set when all of them
-    are among ``places``."""
+           places: Sequence[Place | str] | None = None) -> dict[str, dict[str, Any]]:
+    """Each place's threshold rule and observer (of ``places``, places or their names, default
+    :data:`PLACES`), fitted on ``fit`` trials per landmark from FIT_SEED and judged on ``test``
+    from TEST_SEED; a held-out world also gets the observer fitted on the other held-out worlds of
+    its set when all of them are among ``places``."""
+    bounded_count("fit", fit)
+    bounded_count("test", test)
     data = {}
-    for p in PLACES if places is None else places:
+    for p in _places(places):
         cfg = landmark_worlds.config(base, p.world)
         data[p.name] = (sonar_features(cfg, net, fit, FIT_SEED, p.robot_like),
                         sonar_features(cfg, net, test, TEST_SEED, p.robot_like))
@@ -152,12 +173,12 @@ def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,
 
 
 def judge(config: EvolutionConfig, net: _core.Network, trials: int,
-          places: Sequence[Place] | None = None) -> dict[str, int]:
-    """Trials right of ``net`` (a champion of ``config``) in each place (of ``places``, default
-    :data:`PLACES`; of ``2 trials``, drawn from TEST_SEED), and under ``"<place> one answer"``
-    the trials given its commoner answer."""
+          places: Sequence[Place | str] | None = None) -> dict[str, int]:
+    """Trials right of ``net`` (a champion of ``config``) in each place (of ``places``, places or
+    their names, default :data:`PLACES`; of ``2 trials``, drawn from TEST_SEED), and under
+    ``"<place> one answer"`` the trials given its commoner answer."""
     out = {}
-    for p in PLACES if places is None else places:
+    for p in _places(places):
         report = landmark.assess(landmark_worlds.config(config, p.world), net, trials, TEST_SEED,
                                  robot_like=p.robot_like)
         (a, b), (c, d) = report["confusion"]

@@ -34,7 +34,8 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.tasks import landmark
 
-__all__ = ["SECOND", "SETS", "TRAINING", "WORLDS", "World", "config", "factors", "single_factors", "world_set"]
+__all__ = ["NOT_CARRIED", "SECOND", "SETS", "TRAINING", "WORLDS", "World", "config", "factors", "get", "single_factors",
+           "world_set"]
 
 
 @dataclass(frozen=True)
@@ -158,44 +159,101 @@ def world_set(name: str) -> str | None:
     return next((s for s, worlds in SETS.items() if name in worlds), None)
 
 
-def single_factors(world: World) -> list[World]:
-    """``world`` taken apart: one world per factor it changes, named ``"WORLD: FACTOR"``, with only
-    that factor changed; ``[world]`` for a world that changes one thing. Judging a champion in
-    each says which factor it fails on.
+def get(world: World | str) -> World:
+    """``world`` itself, or the held-out world of that name (of any set).
+
+    >>> get("boxes").name
+    'boxes'
+    >>> get("folower")
+    Traceback (most recent call last):
+    ...
+    dnnevo.errors.InvalidArgumentError: no held-out world is called 'folower'; they are follower, sonar, room, weaving, lobe, boxes
+    """
+    if isinstance(world, World):
+        return world
+    found = world_set(world) if isinstance(world, str) else None
+    if found is None:
+        names = ", ".join(name for worlds in SETS.values() for name in worlds)
+        raise InvalidArgumentError(f"no held-out world is called {world!r}; they are {names}")
+    return SETS[found][world]
+
+
+def single_factors(world: World | str) -> list[World]:
+    """``world`` (or the held-out world of that name) taken apart: one world per factor it changes,
+    named ``"WORLD: FACTOR"``, with only that factor changed; ``[world]`` for a world that changes
+    one thing. Judging a champion in each says which factor it fails on.
 
     >>> [w.name for w in single_factors(WORLDS["follower"])]
     ['follower: speed', 'follower: wall distance', 'follower: turn rate']
     >>> [w.name for w in single_factors(WORLDS["room"])]
     ['room']
     """
+    world = get(world)
     if not world.parts:
         return [world]
     return [World(f"{world.name}: {name}", f"{world.name}'s {name} alone", params)
             for name, params in world.parts.items()]
 
 
-def config(base: EvolutionConfig, world: World) -> EvolutionConfig:
+NOT_CARRIED = ("training", "trials_per_landmark", "validation_trials", "train_robot_like")
+"""A run's task settings that a held-out world leaves out: how the run trained and chose its
+champion, which never changes a fresh trial."""
+
+
+def _overlay(own: dict[str, Any], world: dict[str, Any]) -> dict[str, Any]:
+    """``own`` task settings with ``world``'s on top: a ``sim`` section merges part by part (the
+    follower's and the robot's keys, each sonar's keys by its place in the list), any other
+    setting (a landmark's whole world, say) is replaced."""
+    out = copy.deepcopy(own)
+    for key, value in world.items():
+        sim = out.get("sim")
+        if key != "sim" or not isinstance(sim, dict) or not isinstance(value, dict):
+            out[key] = copy.deepcopy(value)
+            continue
+        for part, settings in value.items():
+            mine = sim.get(part)
+            if part == "sonars" and isinstance(mine, list) and isinstance(settings, list):
+                sim[part] = [{**(mine[i] if i < len(mine) else {}), **s} for i, s in enumerate(settings)]
+                sim[part] += copy.deepcopy(mine[len(settings):])
+            elif isinstance(mine, dict) and isinstance(settings, dict):
+                sim[part] = {**mine, **settings}
+            else:
+                sim[part] = copy.deepcopy(settings)
+    return out
+
+
+def config(base: EvolutionConfig, world: World | str) -> EvolutionConfig:
     """``base`` (a run's config: its network layout and integrator) with ``world``'s task settings
-    in place of its own. The task is built here, so a world that does not validate fails now.
+    on top of its own, less those that only say how it trained (:data:`NOT_CARRIED`): the run's
+    classifier, trial length, input scale and worlds stay its own wherever the held-out world
+    does not change them. The task is built here, so a world that does not validate fails now.
 
     >>> from dnnevo import presets
     >>> cfg = config(presets.get("landmark-robust"), WORLDS["room"])
     >>> landmark.params(cfg)["landmark1"]["room"], landmark.params(cfg)["training"]["cone_deg"]
     ([8.0, 6.5], 0.0)
+    >>> own = dataclasses.replace(presets.get("landmark"), task_params={"classifier": 3})
+    >>> landmark.params(config(own, "weaving"))["classifier"]
+    3
     """
+    world = get(world)
     if base.task != landmark.NAME:
-        raise InvalidArgumentError(f"the run's task is {base.task!r}; the held-out worlds are {landmark.NAME!r}'s")
-    out = dataclasses.replace(base, task_params=copy.deepcopy(world.params))
+        raise InvalidArgumentError(f"the run's task is {base.task!r}; held-out worlds are for the "
+                                   f"{landmark.NAME!r} task")
+    own = {k: v for k, v in base.task_params.items() if k not in NOT_CARRIED}
+    out = dataclasses.replace(base, task_params=_overlay(own, world.params))
     landmark.params(out)  # builds the task: an invalid world fails here
     return out
 
 
-def factors(world: World) -> dict[str, tuple[Any, Any]]:
-    """The task settings ``world`` changes, by dotted name, as (training value, world value).
+def factors(world: World | str) -> dict[str, tuple[Any, Any]]:
+    """The task settings ``world`` (or the held-out world of that name) changes, by dotted name,
+    as (training value, world value).
 
     >>> factors(WORLDS["follower"])["sim.follower.speed"]
     (0.6, 0.45)
     """
+    world = get(world)
     base = landmark.params(EvolutionConfig(task=landmark.NAME))
     mine = landmark.params(EvolutionConfig(task=landmark.NAME, task_params=copy.deepcopy(world.params)))
     out: dict[str, tuple[Any, Any]] = {}

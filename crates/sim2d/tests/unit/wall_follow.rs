@@ -249,4 +249,15 @@ fn a_weaving_follower_with_wide_corners_still_laps() {
             .contains("follower.corner_distance is 1.45; it must be less than"),
         "{e}"
     );
+    // The robot's wheels would clamp a cruising speed above its top speed (1 m/s).
+    let bad = WallFollowerSpec {
+        speed: 1.5,
+        ..WallFollowerSpec::default()
+    };
+    let e = bad.validate(&RobotSpec::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("follower.speed is 1.5; it must be in (0, 1]"),
+        "{e}"
+    );
 }

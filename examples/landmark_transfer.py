@@ -20,8 +20,9 @@ on the same test trials:
   worlds of its set only (leave one world out), which says whether the features themselves
   transfer.
 
-The judging is :mod:`dnnevo.tasks.landmark_transfer`'s, which the reproduction's
-``landmark-worlds`` and ``landmark-robust-worlds`` jobs also run. A champion meets the issue's
+The judging is :mod:`dnnevo.tasks.landmark_transfer`'s, which the reproduction's held-out-worlds
+jobs also run (``landmark-worlds``, ``landmark-robust-worlds`` and ``landmark-wide-first-worlds`` in
+the first set; ``landmark-robust-second-worlds`` and ``landmark-wide-worlds`` in the second). A champion meets the issue's
 goal in a world when it is right in more than 85% of the trials and
 the 95% Wilson interval's lower end is above 80%::
 

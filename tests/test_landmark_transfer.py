@@ -240,6 +240,12 @@ def test_a_held_out_world_keeps_the_run_s_own_settings() -> None:
     ranged = dataclasses.replace(base, task_params={"sim": {"sonars": [{"max_range": 5.0, "rays": 9}]}})
     sonar = landmark.params(landmark_worlds.config(ranged, "lobe"))["sim"]["sonars"][0]
     assert (sonar["max_range"], sonar["rays"], sonar["lobe_deg"]) == (5.0, 11, 10.0)
+    # A world that changes the boxes keeps the run's own room and start region.
+    room = {"room": [7.0, 5.0], "start": {"min": [0.4, 0.4], "max": [6.6, 4.6]},
+            "boxes": [{"center": [3.5, 2.5], "size": [1.2, 0.6]}]}
+    roomy = dataclasses.replace(base, task_params={"landmark1": room})
+    world = landmark.params(landmark_worlds.config(roomy, "boxes"))["landmark1"]
+    assert world["room"] == [7.0, 5.0] and world["boxes"][0]["size"] == [1.2, 0.3]
 
 
 def test_names_and_counts_are_checked() -> None:

@@ -271,15 +271,24 @@ def _joined(held: Any, found: dict[str, Any]) -> dict[str, Any] | None:
 def _comparable(result: Any) -> Any:
     """What two machines that ran the same job must agree on: its result without wall times,
     its config with the settings added since it was written at their defaults (a result
-    collected before a setting existed is the same run as one collected after), and its inputs
-    without a held-out-worlds test's digest of its worlds (checked against the code when the
-    reproduction reads the result; results collected before it existed lack it)."""
+    collected before a setting existed is the same run as one collected after)."""
     if isinstance(result, dict) and isinstance(result.get("config"), dict):
         result = manifest_with_later_defaults(result)
-    if isinstance(result, dict) and isinstance(result.get("inputs"), dict):
-        inputs = {k: v for k, v in result["inputs"].items() if not str(k).startswith(jobs.WORLDS_INPUT)}
-        result = {**result, "inputs": inputs}
     return _timeless(result)
+
+
+def _comparable_pair(kept: Any, new: Any) -> tuple[Any, Any]:
+    """Both results as :func:`_comparable` makes them, and where only one of them holds a
+    held-out-worlds test's digest of its worlds (results collected before it existed lack it),
+    both without it."""
+    def digests(result: Any) -> set[str]:
+        inputs = result.get("inputs") if isinstance(result, dict) else None
+        return {k for k in inputs if str(k).startswith(jobs.WORLDS_INPUT)} if isinstance(inputs, dict) else set()
+
+    if bool(digests(kept)) != bool(digests(new)):
+        kept, new = ({**r, "inputs": {k: v for k, v in r["inputs"].items() if k not in digests(r)}}
+                     if digests(r) else r for r in (kept, new))
+    return _comparable(kept), _comparable(new)
 
 
 def _timeless(result: Any) -> Any:
@@ -367,8 +376,7 @@ def collect(source: Path, dest: Path, *, families: Sequence[str] | None = None,
             kept = jobs.result_path(dest, job)
             if not kept.exists():
                 continue
-            diff = first_difference(_comparable(read_json(kept)),
-                                    _comparable(read_json(jobs.result_path(source, job))))
+            diff = first_difference(*_comparable_pair(read_json(kept), read_json(jobs.result_path(source, job))))
             if diff is not None:
                 raise DnnevoError(f"{job.id}: the result in {source} differs from the one in {dest} "
                                   f"at {diff[0]} ({short(diff[2])} against {short(diff[1])}); runs "

@@ -3,7 +3,8 @@ upper bound fitted on each world: what ``examples/landmark_transfer.py`` and the
 ``held-out-worlds`` jobs (:mod:`dnnevo.experiments.jobs`) both compute.
 
 A champion is judged on fresh trials per landmark drawn from :data:`TEST_SEED` in each
-:class:`Place`: the training world (the paper's ideal world, unvaried), the robot-like test, and
+:class:`Place`: the training world (the run's own world, unvaried: the paper's ideal world for a
+run that keeps the defaults), the robot-like test, and
 the held-out worlds of :mod:`dnnevo.tasks.landmark_worlds`, in sets of three. In each world, on
 the same test trials, :func:`bounds` gives
 
@@ -29,7 +30,6 @@ only on the trial counts (and the task settings a world keeps).
 
 from __future__ import annotations
 
-import copy
 import hashlib
 import json
 from collections.abc import Sequence
@@ -98,10 +98,14 @@ def held_out(world_set: str = "first") -> list[str]:
 
 def worlds_digest(world_set: str) -> str:
     """SHA-256 of the task settings of ``world_set``'s held-out worlds and of the training world,
-    every default filled in as the core reads them: it changes when any of those worlds does."""
+    on the defaults, every default filled in as the core reads them, less what a held-out job
+    never uses (how a run trains, the robot-like test): it changes when any of those worlds does."""
     worlds = [landmark_worlds.TRAINING, *(landmark_worlds.get(name) for name in held_out(world_set))]
-    settings = {w.name: landmark.params(EvolutionConfig(task=landmark.NAME, task_params=copy.deepcopy(w.params)))
-                for w in worlds}
+    unused = {*landmark_worlds.NOT_CARRIED, "robot_like"}
+    settings = {}
+    for w in worlds:
+        params = landmark.params(landmark_worlds.config(EvolutionConfig(task=landmark.NAME), w))
+        settings[w.name] = {k: v for k, v in params.items() if k not in unused}
     text = json.dumps(settings, sort_keys=True, separators=(",", ":"), allow_nan=False)
     return hashlib.sha256(text.encode()).hexdigest()
 

@@ -4,9 +4,10 @@ from what the varied training it was chosen against changes, so that a champion'
 measures transfer. The first set (:data:`WORLDS`) was chosen against ``landmark-robust``'s
 training, the second (:data:`SECOND`) against ``landmark-wide``'s.
 
-Each world is a ``task_params`` overlay on the paper's ideal world (the defaults of
-``crates/tasks/src/landmark/config.rs``); :func:`config` puts one on a run's config in place of
-its own task settings (trial counts and training variation do not change a fresh trial). Every
+Each world is a ``task_params`` overlay; :func:`config` puts one on top of a run's own task
+settings (less how it trained, :data:`NOT_CARRIED`, which never changes a fresh trial), and on the
+paper's ideal world (the defaults of ``crates/tasks/src/landmark/config.rs``) for a run that keeps
+the defaults. Every
 number and why it was chosen: ``docs/landmark.md``, "Transfer to held-out worlds".
 
 What ``landmark-robust`` varies in training, per trial (``training.rs``; ``landmark-wide`` varies
@@ -46,7 +47,8 @@ class World:
     changes: str
     """What differs from the training world, in words."""
     params: dict[str, Any]
-    """The ``task_params`` of the world (the paper's defaults for everything it leaves out)."""
+    """The ``task_params`` the world changes (the run's own settings for everything it leaves
+    out: see :func:`config`)."""
     parts: dict[str, dict[str, Any]] = dataclasses.field(default_factory=dict)
     """The factors it changes, each alone: name to the ``task_params`` that change only that
     factor (empty for a world that changes one thing); :func:`single_factors` makes worlds of
@@ -79,8 +81,9 @@ def _room(width: float, height: float, centre: tuple[float, float]) -> dict[str,
     return out
 
 
-TRAINING = World("training", "the paper's ideal world, unvaried (what every trial starts from)", {})
-"""The training world itself, for reference: the defaults, no variation."""
+TRAINING = World("training", "the run's own world, unvaried (the paper's ideal world for a run that keeps "
+                 "the defaults)", {})
+"""The training world itself, for reference: the run's own settings, no variation."""
 
 _FOLLOWER = {"speed": {"speed": 0.45}, "wall distance": {"wall_distance": 0.80},
              "turn rate": {"max_turn_rate": 1.2}}
@@ -116,9 +119,9 @@ _WEAVING = {"damping": {"angle_gain": 0.3}, "corners": {"corner_distance": 0.9}}
 _LOBE = {"beam pattern": {"cone_deg": 40.0, "rays": 11, "lobe_deg": 10.0}, "dropouts": {"dropout": 0.1}}
 
 
-def _boxes(one: list[dict[str, Any]], two: list[dict[str, Any]]) -> dict[str, Any]:
-    """Both landmarks' boxes replaced (the room and the start region as shipped)."""
-    return {f"landmark{n}": {**landmark.default_world(n), "boxes": boxes} for n, boxes in ((1, one), (2, two))}
+def _boxes(n: int, boxes: list[dict[str, Any]]) -> dict[str, Any]:
+    """Landmark ``n``'s boxes replaced (its room and start region kept)."""
+    return {f"landmark{n}": {"boxes": boxes}}
 
 
 _BAR = [{"center": [3.0, 2.5], "size": [1.2, 0.3], "angle_deg": 0.0}]
@@ -139,9 +142,8 @@ SECOND: dict[str, World] = {w.name: w for w in [
     World("boxes",
           "other landmarks of the same extents: landmark 1 a thin 1.2 m x 0.3 m bar (1.2 x 0.6), landmark 2 "
           "three 0.4 m crates 0.3 m apart (two 0.6 m crates 0.6 m apart), spanning 1.8 m as in training",
-          _boxes(_BAR, _CRATES),
-          {"landmark 1": _boxes(_BAR, landmark.default_world(2)["boxes"]),
-           "landmark 2": _boxes(landmark.default_world(1)["boxes"], _CRATES)}),
+          {**_boxes(1, _BAR), **_boxes(2, _CRATES)},
+          {"landmark 1": _boxes(1, _BAR), "landmark 2": _boxes(2, _CRATES)}),
 ]}
 """The second set of held-out worlds by name: chosen against ``landmark-wide``'s training, before
 any of its runs was judged, each differing in kind from what that training varies."""
@@ -201,11 +203,17 @@ champion, which never changes a fresh trial."""
 
 
 def _overlay(own: dict[str, Any], world: dict[str, Any]) -> dict[str, Any]:
-    """``own`` task settings with ``world``'s on top: a ``sim`` section merges part by part (the
-    follower's and the robot's keys, each sonar's keys by its place in the list), any other
-    setting (a landmark's whole world, say) is replaced."""
+    """``own`` task settings with ``world``'s on top: a landmark's world merges key by key (a
+    world that changes the boxes keeps the run's room; the shipped world stands in for one the run
+    does not set), a ``sim`` section part by part (the follower's and the robot's keys, each
+    sonar's keys by its place in the list); any other setting is replaced."""
     out = copy.deepcopy(own)
     for key, value in world.items():
+        if key in ("landmark1", "landmark2") and isinstance(value, dict):
+            mine = out.get(key)
+            base = mine if isinstance(mine, dict) else landmark.default_world(int(key[-1]))
+            out[key] = {**base, **copy.deepcopy(value)}
+            continue
         sim = out.get("sim")
         if key != "sim" or not isinstance(sim, dict) or not isinstance(value, dict):
             out[key] = copy.deepcopy(value)
@@ -253,9 +261,8 @@ def factors(world: World | str) -> dict[str, tuple[Any, Any]]:
     >>> factors(WORLDS["follower"])["sim.follower.speed"]
     (0.6, 0.45)
     """
-    world = get(world)
     base = landmark.params(EvolutionConfig(task=landmark.NAME))
-    mine = landmark.params(EvolutionConfig(task=landmark.NAME, task_params=copy.deepcopy(world.params)))
+    mine = landmark.params(config(EvolutionConfig(task=landmark.NAME), world))
     out: dict[str, tuple[Any, Any]] = {}
 
     def walk(a: Any, b: Any, path: str) -> None:

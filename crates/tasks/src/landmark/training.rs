@@ -78,9 +78,9 @@ pub struct Training {
     /// Gaussian noise added to the input itself (not the range) at every step, sd in [0, 1].
     /// Default 0.
     pub input_noise_sd: f64,
-    /// The room, with everything in it (the boxes' centres and the start region, not the boxes'
-    /// sizes), scales by a factor in `1 ± room_scale` in x and another in y, in [0, 0.3], before
-    /// the landmark moves. Drawn from the third stream. Default 0.
+    /// The room and its start region scale by a factor in `1 ± room_scale` in x and another in y,
+    /// in [0, 0.3], and the landmark, whole (its boxes keep their layout and sizes), keeps its
+    /// place relative to the room, before it moves. Drawn from the third stream. Default 0.
     pub room_scale: f64,
     /// The network's sonar's axis turns by up to this many degrees, in [0, 90]. Drawn from the
     /// third stream. Default 0.
@@ -230,18 +230,40 @@ impl Training {
     }
 }
 
-/// `world` as one trial of `v` varies it: the room scaled (with the boxes' centres and the start
-/// region), then the landmark moved. An error if a box leaves the room.
+/// `world` as one trial of `v` varies it: the room scaled (with its start region), the landmark
+/// kept whole at the same place relative to the room, then the landmark moved. An error if a box
+/// leaves the room.
 pub(super) fn vary_world(world: &WorldSpec, v: &Variation) -> Result<WorldSpec> {
-    move_landmark(&world.scaled(v.room_scale), v)
+    move_landmark(&scale_room(world, v.room_scale), v)
 }
 
-/// `world` with its boxes, taken together as one landmark, scaled about the landmark's centre
-/// (the centre of the boxes' bounding box), turned about it and moved. An error if a box leaves
-/// the room.
-fn move_landmark(world: &WorldSpec, v: &Variation) -> Result<WorldSpec> {
+/// `world` with its room and start region scaled by `scale` in x and y, and its landmark (all its
+/// boxes, keeping their layout and sizes) moved so that its centre keeps its place relative to
+/// the room. (Scaling each box's centre, as the robot-like test's jitter does, would stretch the
+/// gap between landmark 2's crates, and so the extent that tells the landmarks apart.)
+fn scale_room(world: &WorldSpec, scale: [f64; 2]) -> WorldSpec {
+    let Some(centre) = landmark_centre(world) else {
+        return world.scaled(scale);
+    };
+    let shift = [centre[0] * (scale[0] - 1.0), centre[1] * (scale[1] - 1.0)];
+    WorldSpec {
+        boxes: world
+            .boxes
+            .iter()
+            .map(|b| BoxSpec {
+                center: [b.center[0] + shift[0], b.center[1] + shift[1]],
+                ..b.clone()
+            })
+            .collect(),
+        ..world.scaled(scale)
+    }
+}
+
+/// The centre of the landmark: of the bounding box of all of `world`'s boxes (None if it has
+/// none).
+fn landmark_centre(world: &WorldSpec) -> Option<[f64; 2]> {
     if world.boxes.is_empty() {
-        return Ok(world.clone());
+        return None;
     }
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
@@ -252,7 +274,16 @@ fn move_landmark(world: &WorldSpec, v: &Variation) -> Result<WorldSpec> {
             hi[k] = hi[k].max(b.center[k] + half[k]);
         }
     }
-    let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    Some([0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])])
+}
+
+/// `world` with its boxes, taken together as one landmark, scaled about the landmark's centre
+/// (the centre of the boxes' bounding box), turned about it and moved. An error if a box leaves
+/// the room.
+fn move_landmark(world: &WorldSpec, v: &Variation) -> Result<WorldSpec> {
+    let Some(centre) = landmark_centre(world) else {
+        return Ok(world.clone());
+    };
     let (s, c) = v.turn_deg.to_radians().sin_cos();
     let boxes = world
         .boxes

@@ -334,6 +334,12 @@ fn room_and_axis_variations_leave_the_other_draws_alone() {
         assert!((a.world.start.min[1] - 0.4 * sy).abs() < 1e-12);
         for (p, q) in a.world.boxes.iter().zip(&b.world.boxes) {
             assert_eq!((p.size, p.angle_deg), (q.size, q.angle_deg));
+            // The landmark moves whole: its layout (landmark 2's gap) does not stretch.
+            for k in 0..2 {
+                let apart =
+                    |w: &WorldSpec| w.boxes.last().unwrap().center[k] - w.boxes[0].center[k];
+                assert!((apart(&a.world) - apart(&b.world)).abs() < 1e-9);
+            }
         }
         assert_eq!(
             a.input.len(),

@@ -13,7 +13,8 @@ import pytest
 
 from cli_helpers import run_cli, run_main
 from dnnevo.errors import DnnevoError
-from dnnevo.experiments import plan, results
+from dnnevo.experiments import jobs, plan, results
+from dnnevo.runs import first_difference
 
 ROOT = Path(__file__).resolve().parent.parent
 README = "# dnnevo\n\nBefore.\n\n<!-- results-table:begin -->\nold\n<!-- results-table:end -->\n\nAfter.\n"
@@ -456,3 +457,14 @@ def test_the_robot_like_rows_count_the_transfer_goal_as_the_stored_results_give_
             beat += p > 0.85 and lower > 0.80
         (row,) = [line for line in readme.splitlines() if line.startswith(f"| {name} |")]
         assert f"lower end >80%: {beat}/{len(files)} " in row, row
+
+
+def test_a_worlds_digest_is_compared_only_when_both_results_hold_one() -> None:
+    """A held-out result collected before results held their worlds' digest is the same job as
+    one judged since; two results that both hold one must agree on it."""
+    digest = jobs.WORLDS_INPUT + "first"
+    old = {"inputs": {"landmark/seed-0/best.json": "ab"}, "wall_s": 1.0}
+    new = {"inputs": {"landmark/seed-0/best.json": "ab", digest: "d1"}, "wall_s": 2.0}
+    assert first_difference(*results._comparable_pair(old, new)) is None
+    other = {"inputs": {**new["inputs"], digest: "d2"}, "wall_s": 3.0}
+    assert first_difference(*results._comparable_pair(new, other)) is not None

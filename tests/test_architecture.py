@@ -1,12 +1,16 @@
-"""The package keeps the shape docs/architecture.md describes (measured by tests/structure.py)."""
+"""The package and the crates keep the shape docs/architecture.md describes (measured by
+tests/structure.py and tests/rust_structure.py)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import rust_structure
 from structure import measure
 
-PACKAGE = Path(__file__).resolve().parent.parent / "python" / "dnnevo"
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = ROOT / "python" / "dnnevo"
+CRATES = sorted(p.parent for p in (ROOT / "crates").glob("*/Cargo.toml"))
 
 
 def test_no_import_loop_and_no_task_name_outside_the_tasks() -> None:
@@ -31,3 +35,20 @@ def test_the_measure_sees_a_loop_and_a_deferred_import(tmp_path: Path) -> None:
     (pkg / "c.py").write_text("def g(config):\n    return config.task == 'nav1d'\n")
     shape = measure(pkg)
     assert shape.loops and len(shape.deferred) == 1 and len(shape.task_name_branches) == 1
+
+
+def test_no_module_loop_in_any_crate() -> None:
+    assert len(CRATES) == 5
+    for crate in CRATES:
+        assert rust_structure.loops(crate) == [], crate.name
+
+
+def test_the_rust_measure_sees_a_loop_through_a_group_and_not_through_a_comment(tmp_path: Path) -> None:
+    src = tmp_path / "src"
+    (src / "b").mkdir(parents=True)
+    (src / "a.rs").write_text("use crate::{c, b::{x, y}};\n")
+    (src / "b" / "mod.rs").write_text("/// See [`crate::c`].\nmod inner;\n")
+    (src / "b" / "inner.rs").write_text("fn f() { crate::a::g() }\n")
+    (src / "c.rs").write_text("// crate::a\n")
+    assert rust_structure.arrows(tmp_path) == {("a", "c"), ("a", "b"), ("b", "a")}
+    assert rust_structure.loops(tmp_path) == [["a", "b", "a"]]

@@ -109,10 +109,24 @@ fn with_fma<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
-/// [`exp`] in every lane, or [`exp_f32`] in every lane of an `f32` vector.
+/// [`exp`] in every lane, or [`exp_f32`] in every lane of an `f32` vector. Which one is known
+/// when the caller is compiled, and only that one is compiled in.
 #[inline(always)]
 pub(crate) fn exp_lanes<V: Arith>(x: V) -> V {
-    V::Elem::exp_lanes(x)
+    if V::Elem::SINGLE {
+        exp_lanes_f32(x)
+    } else {
+        exp_lanes_f64(x)
+    }
+}
+
+/// [`sigmoid`] or [`sigmoid_f32`], for the element type `E`.
+#[inline]
+pub(crate) fn sigmoid_of<E: Elem>(x: E) -> E {
+    with_fma(
+        #[inline(always)]
+        || sigmoid_lanes(x),
+    )
 }
 
 /// [`exp`] in every lane.

@@ -68,11 +68,10 @@ pub trait Arith:
 }
 
 /// An element type the integrator computes in: `f64` (the default and the reference) or `f32`
-/// (opt-in single precision). It is its own one-lane [`Vector`], names the register backends
-/// that hold a block of [`crate::LANES`] networks of it, and brings its own exponential.
+/// (opt-in single precision). It is its own one-lane [`Vector`] and names the register backends
+/// that hold a block of [`crate::LANES`] networks of it.
 pub trait Elem:
     Vector<Elem = Self, Row = Self>
-    + crate::integrate::Dispatch
     + Pod
     + Default
     + PartialEq
@@ -88,10 +87,8 @@ pub trait Elem:
     fn to_f64(self) -> f64;
     /// Neither infinite nor NaN.
     fn finite(self) -> bool;
-    /// The logistic sigmoid of one value, with the bits of every lane of the kernel's.
-    fn sigmoid(x: Self) -> Self;
-    /// This type's exponential in every lane (see [`crate::math`]).
-    fn exp_lanes<V: Arith<Elem = Self>>(x: V) -> V;
+    /// Single precision, which has an exponential of its own ([`crate::math`]).
+    const SINGLE: bool;
 
     /// A block of [`crate::LANES`] networks in AVX-512 registers.
     #[cfg(target_arch = "x86_64")]
@@ -325,14 +322,7 @@ impl Elem for f64 {
     fn finite(self) -> bool {
         self.is_finite()
     }
-    #[inline(always)]
-    fn sigmoid(x: Self) -> Self {
-        crate::math::sigmoid(x)
-    }
-    #[inline(always)]
-    fn exp_lanes<V: Arith<Elem = Self>>(x: V) -> V {
-        crate::math::exp_lanes_f64(x)
-    }
+    const SINGLE: bool = false;
     #[cfg(target_arch = "x86_64")]
     type Avx512Block = Group<Avx512, 2>;
     #[cfg(target_arch = "x86_64")]
@@ -399,14 +389,7 @@ impl Elem for f32 {
     fn finite(self) -> bool {
         self.is_finite()
     }
-    #[inline(always)]
-    fn sigmoid(x: Self) -> Self {
-        crate::math::sigmoid_f32(x)
-    }
-    #[inline(always)]
-    fn exp_lanes<V: Arith<Elem = Self>>(x: V) -> V {
-        crate::math::exp_lanes_f32(x)
-    }
+    const SINGLE: bool = true;
     #[cfg(target_arch = "x86_64")]
     type Avx512Block = Group<Avx512F32, 1>;
     #[cfg(target_arch = "x86_64")]

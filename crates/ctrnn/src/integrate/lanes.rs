@@ -5,6 +5,7 @@ use std::any::Any;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::error::{Error, Result};
+use crate::math::sigmoid_of;
 use crate::network::Network;
 use crate::rows::Rows;
 use crate::simd::{self, Kernel};
@@ -198,7 +199,7 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
     }
     /// Firing rate `f(v_i - theta_i)` of neuron `i` in every lane.
     pub fn output(&self, i: usize) -> [E; L] {
-        std::array::from_fn(|l| E::sigmoid(self.state[i][l] - self.theta[i][l]))
+        std::array::from_fn(|l| sigmoid_of(self.state[i][l] - self.theta[i][l]))
     }
     /// Every neuron's firing rate in every lane, `outputs()[i][l] = f(v_i - theta_i)`, with the
     /// same bits as [`output`](Self::output). Computed once per state, in the lane vectors of a
@@ -222,8 +223,15 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
         &self.scratch.out
     }
 
+    /// [`outputs`](Self::outputs)' rates, through the shared copy of this width if there is one.
     fn compute_outputs(&mut self) {
-        E::compute_outputs(self);
+        if const { L == LANES && !E::SINGLE } {
+            shared::<L, LANES, E>(self).compute_outputs_once();
+        } else if const { L == 1 && !E::SINGLE } {
+            shared::<L, 1, E>(self).compute_outputs_once();
+        } else {
+            self.compute_outputs_on(simd::kernel());
+        }
     }
 
     #[inline(always)]
@@ -340,7 +348,13 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
     /// there is one.
     #[inline(always)]
     fn advance_by(&mut self, kernel: Kernel, inputs: Option<&[[E; L]]>, integ: &Integrator) {
-        E::advance(self, kernel, inputs, integ);
+        if const { L == LANES && !E::SINGLE } {
+            shared::<L, LANES, E>(self).advance_once(kernel, inputs.map(as_rows), integ);
+        } else if const { L == 1 && !E::SINGLE } {
+            shared::<L, 1, E>(self).advance_once(kernel, inputs.map(as_rows), integ);
+        } else {
+            self.advance_on(kernel, inputs, integ);
+        }
     }
 
     /// [`advance`](Self::advance) on a given kernel, which the CPU must support.
@@ -494,67 +508,6 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
     }
 }
 
-/// How [`Lanes`] of each element type reach their stepping code: `f64` through copies compiled
-/// once (see [`compile_once!`]), `f32` directly.
-pub trait Dispatch: Sized {
-    /// [`Lanes::advance_by`].
-    fn advance<const L: usize>(
-        lanes: &mut Lanes<L, Self>,
-        kernel: Kernel,
-        inputs: Option<&[[Self; L]]>,
-        integ: &Integrator,
-    ) where
-        Self: Elem;
-    /// [`Lanes::compute_outputs`].
-    fn compute_outputs<const L: usize>(lanes: &mut Lanes<L, Self>)
-    where
-        Self: Elem;
-}
-
-impl Dispatch for f64 {
-    #[inline(always)]
-    fn advance<const L: usize>(
-        lanes: &mut Lanes<L>,
-        kernel: Kernel,
-        inputs: Option<&[[f64; L]]>,
-        integ: &Integrator,
-    ) {
-        if const { L == LANES } {
-            as_width::<L, LANES>(lanes).advance_once(kernel, inputs.map(as_rows), integ);
-        } else if const { L == 1 } {
-            as_width::<L, 1>(lanes).advance_once(kernel, inputs.map(as_rows), integ);
-        } else {
-            lanes.advance_on(kernel, inputs, integ);
-        }
-    }
-    fn compute_outputs<const L: usize>(lanes: &mut Lanes<L>) {
-        if const { L == LANES } {
-            as_width::<L, LANES>(lanes).compute_outputs_once();
-        } else if const { L == 1 } {
-            as_width::<L, 1>(lanes).compute_outputs_once();
-        } else {
-            lanes.compute_outputs_on(simd::kernel());
-        }
-    }
-}
-
-/// Single precision is only stepped from this crate (the population run), so it needs no
-/// shared copies.
-impl Dispatch for f32 {
-    #[inline(always)]
-    fn advance<const L: usize>(
-        lanes: &mut Lanes<L, f32>,
-        kernel: Kernel,
-        inputs: Option<&[[f32; L]]>,
-        integ: &Integrator,
-    ) {
-        lanes.advance_on(kernel, inputs, integ);
-    }
-    fn compute_outputs<const L: usize>(lanes: &mut Lanes<L, f32>) {
-        lanes.compute_outputs_on(simd::kernel());
-    }
-}
-
 /// Compiles the stepping methods of `Lanes<W>` once, in this crate, for each width `W` given.
 ///
 /// A generic method is compiled again in every crate that calls it, and the kernel under it is
@@ -581,16 +534,20 @@ macro_rules! compile_once {
 }
 compile_once!(1, LANES);
 
-/// `lanes` at its own width `W`; only called where `L == W`.
-fn as_width<const L: usize, const W: usize>(lanes: &mut Lanes<L>) -> &mut Lanes<W> {
+/// `lanes` as the `f64` block of width `W` whose stepping methods [`compile_once!`] compiled;
+/// only called where it is one (`E` is `f64`, not [`Elem::SINGLE`], and `L == W`). The callers
+/// decide that when they are compiled (`if const`), so the other widths and `f32` never compile
+/// the branch, and this is a cast that costs nothing.
+fn shared<const L: usize, const W: usize, E: Elem>(lanes: &mut Lanes<L, E>) -> &mut Lanes<W> {
     (lanes as &mut dyn Any)
         .downcast_mut()
-        .expect("as_width is only called with L == W")
+        .expect("shared is only called on an f64 block of width W")
 }
 
-/// `rows` at their own width `W`; only called where `L == W`.
-fn as_rows<const L: usize, const W: usize>(rows: &[[f64; L]]) -> &[[f64; W]] {
-    let (rows, rest) = rows.as_flattened().as_chunks::<W>();
+/// `rows` as the `f64` rows of width `W` of the block [`shared`] returns; only called where it
+/// does, so it reinterprets nothing.
+fn as_rows<const L: usize, const W: usize, E: Elem>(rows: &[[E; L]]) -> &[[f64; W]] {
+    let (rows, rest) = bytemuck::cast_slice::<E, f64>(rows.as_flattened()).as_chunks::<W>();
     debug_assert!(rest.is_empty());
     rows
 }

@@ -26,7 +26,7 @@ mod lanes;
 mod settings;
 
 pub(crate) use lanes::CANCEL_CHECK_STEPS;
-pub use lanes::{copy_lane, Dispatch, Lanes, LANES};
+pub use lanes::{copy_lane, Lanes, LANES};
 pub use settings::{Integrator, Method, Precision};
 
 impl Network {

@@ -124,6 +124,10 @@ def test_run_folder_contents(tmp_path: Path) -> None:
     best = dnnevo.Network.load(out / "best.json")
     assert best == result.best
     assert best.meta["fitness"] == result.best_fitness
+    # The file alone says how the run integrated its networks.
+    integ = SMALL.integrator
+    assert best.integrator == {"method": integ.method, "dt": integ.dt, "substeps": integ.substeps}
+    assert best.meta["precision"] == SMALL.precision == "f64"
     assert result.history["best"].shape == (SMALL.generations,)
     assert result.run_dir == out
     with pytest.raises(dnnevo.DnnevoError, match="not empty"):

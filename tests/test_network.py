@@ -257,6 +257,36 @@ def test_bad_population_arguments(networks, inputs, error, fragment) -> None:  #
     assert fragment in str(info.value)
 
 
+def test_save_gives_an_integrator_that_load_keeps(tmp_path: Path) -> None:
+    path = tmp_path / "i.json"
+    net = make()
+    assert net.integrator is None
+    rk4 = {"method": "rk4", "dt": 0.05, "substeps": 10}
+    net.save(path, integrator=rk4)
+    back = dnnevo.Network.load(path)
+    assert back.integrator == rk4 and json.loads(path.read_text())["integrator"] == rk4
+    assert net.integrator is None, "save leaves the network itself as it was"
+    inputs = np.ones((3, net.n_inputs))
+    assert np.array_equal(back.run(inputs, **back.integrator).states, make().run(inputs, **rk4).states)
+    back.save(path)  # a loaded network writes its own integrator back
+    assert dnnevo.Network.load(path).integrator == rk4
+
+
+@pytest.mark.parametrize("integrator, message", [
+    ({"method": "rk4", "dt": 0.1}, "missing field `substeps`"),
+    ({"method": "rk4", "dt": 0.1, "substeps": 1, "steps": 2}, "unknown field `steps`"),
+    ({"method": "heun", "dt": 0.1, "substeps": 1}, "unknown variant `heun`"),
+    ({"method": "euler", "dt": -1.0, "substeps": 1}, "dt is -1"),
+    ({"method": "euler", "dt": 0.1, "substeps": 0}, "substeps"),
+    ([("method", "euler")], "integrator must be a dict"),
+])
+def test_save_refuses_an_integrator_that_load_would_refuse(tmp_path: Path, integrator: object, message: str) -> None:
+    path = tmp_path / "i.json"
+    with pytest.raises(InvalidArgumentError, match=re.escape(message)):
+        make().save(path, integrator=integrator)  # type: ignore[arg-type]
+    assert not path.exists()
+
+
 def test_save_refuses_meta_that_load_would_refuse(tmp_path: Path) -> None:
     path = tmp_path / "m.json"
     for meta, message in [({"seed": -1}, "meta.seed is -1"), ({"input_labels": [1]}, "meta.input_labels is [1]"),

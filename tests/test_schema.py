@@ -47,7 +47,7 @@ FULL = {
     "integrator": {"method": "rk4", "dt": 0.05, "substeps": 10},
     "meta": {"task": "sequence-1bit", "seed": 3, "generation": 10, "fitness": 0.5,
              "dnnevo_version": "0.1.0", "input_labels": ["trigger", "reinforcement"],
-             "output_labels": ["out"], "anything": {"else": [1, None]}},
+             "output_labels": ["out"], "precision": "f64", "anything": {"else": [1, None]}},
 }
 
 

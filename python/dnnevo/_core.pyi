@@ -130,6 +130,11 @@ class Network:
     def outputs(self) -> _Array: ...
     @property
     def meta(self) -> dict[str, Any]: ...
+    @property
+    def integrator(self) -> dict[str, Any] | None:
+        """How the network is meant to be run, ``{"method", "dt", "substeps"}``, from its file or
+        the ``save`` that gave it one; None if neither said. ``run`` does not read it:
+        ``net.run(inputs, **net.integrator)`` does."""
     def reset(self, state: npt.ArrayLike | None = None) -> None: ...
     def run(
         self,
@@ -152,8 +157,14 @@ class Network:
     @staticmethod
     def from_dict(d: Mapping[str, Any]) -> Network: ...
     def save(
-        self, path: str | PathLike[str], *, meta: Mapping[str, Any] | None = None
-    ) -> None: ...
+        self,
+        path: str | PathLike[str],
+        *,
+        meta: Mapping[str, Any] | None = None,
+        integrator: Mapping[str, Any] | None = None,
+    ) -> None:
+        """Writes the network file atomically; ``meta`` entries are added to the network's own,
+        and ``integrator`` (``{"method", "dt", "substeps"}``, all three) replaces its own."""
     @staticmethod
     def load(path: str | PathLike[str]) -> Network: ...
     def copy(self) -> Network: ...

@@ -282,7 +282,8 @@ fn meta_problem(meta: &Map<String, Value>) -> Option<String> {
     let whole: Check =
         |v| v.as_u64().is_some() || v.as_f64().is_some_and(|x| x >= 0.0 && x.fract() == 0.0);
     let strings: Check = |v| v.as_array().is_some_and(|a| a.iter().all(Value::is_string));
-    let rules: [(&str, &str, Check); 7] = [
+    let precision: Check = |v| v.as_str().is_some_and(|p| p == "f64" || p == "f32");
+    let rules: [(&str, &str, Check); 8] = [
         ("task", "a string", Value::is_string),
         ("seed", "an integer >= 0", whole),
         ("generation", "an integer >= 0", whole),
@@ -290,6 +291,7 @@ fn meta_problem(meta: &Map<String, Value>) -> Option<String> {
         ("dnnevo_version", "a string", Value::is_string),
         ("input_labels", "a list of strings", strings),
         ("output_labels", "a list of strings", strings),
+        ("precision", "\"f64\" or \"f32\"", precision),
     ];
     for (key, what, ok) in rules {
         if let Some(v) = meta.get(key) {

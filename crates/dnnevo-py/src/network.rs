@@ -81,6 +81,22 @@ pub fn integrator(dt: f64, substeps: &AnyInt, method: &str) -> PyResult<Integrat
     Ok(integ)
 }
 
+/// An integrator block as the network file has it, from a dict with exactly `method`, `dt` and
+/// `substeps`; any other dict is an `InvalidArgumentError` that names what is wrong.
+fn integrator_from_dict(d: &Bound<'_, PyAny>) -> PyResult<Integrator> {
+    if !d.is_instance_of::<PyDict>() {
+        return Err(arg_err(format!(
+            "integrator must be a dict with method, dt and substeps, not {}",
+            d.get_type().name()?
+        )));
+    }
+    let map = dict_to_map(d, "integrator")?;
+    let integ: Integrator = serde_json::from_value(Value::Object(map))
+        .map_err(|e| arg_err(format!("integrator: {e}")))?;
+    integ.validate().py_err()?;
+    Ok(integ)
+}
+
 /// Parameter ranges from a dict such as `{"tau": (0.5, 10.0)}`; missing kinds keep their default.
 pub fn ranges_from(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Ranges> {
     let mut ranges = Ranges::default();
@@ -235,6 +251,15 @@ impl PyNetwork {
     fn meta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         json_to_py(py, &Value::Object(self.meta.clone()).to_string())
     }
+    /// How the network is meant to be run, `{"method", "dt", "substeps"}`, from the file it came
+    /// from or the `save` that gave it one; None if neither said. `run` does not read it:
+    /// `net.run(inputs, **net.integrator)` does.
+    #[getter]
+    fn integrator<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.integrator
+            .map(|i| json_to_py(py, &serde_json::json!(i).to_string()))
+            .transpose()
+    }
 
     /// Sets the state to `state`, or to zeros.
     #[pyo3(signature = (state=None))]
@@ -341,12 +366,21 @@ impl PyNetwork {
         Self::from_json(&Value::Object(map).to_string())
     }
 
-    /// Writes the network file atomically; `meta` entries are added to the network's own.
-    #[pyo3(signature = (path, *, meta=None))]
-    fn save(&self, path: std::path::PathBuf, meta: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+    /// Writes the network file atomically; `meta` entries are added to the network's own, and
+    /// `integrator` (`{"method", "dt", "substeps"}`, all three) replaces its own.
+    #[pyo3(signature = (path, *, meta=None, integrator=None))]
+    fn save(
+        &self,
+        path: std::path::PathBuf,
+        meta: Option<&Bound<'_, PyAny>>,
+        integrator: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
         let mut file = self.file();
         if let Some(m) = meta.filter(|m| !m.is_none()) {
             file.meta.extend(dict_to_map(m, "meta")?);
+        }
+        if let Some(i) = integrator.filter(|i| !i.is_none()) {
+            file.integrator = Some(integrator_from_dict(i)?);
         }
         ctrnn::io::save(&path, &file).py_err()
     }

@@ -593,7 +593,10 @@ def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
     }
     if ga.best_validation is not None:
         meta["validation_rate"], meta["validation_score"] = ga.best_validation
-    net.save(run.best, meta=meta)
+    # How the run integrated it, so that the file alone says how to run the champion.
+    integ = ga.config.integrator
+    meta["precision"] = ga.config.precision
+    net.save(run.best, meta=meta, integrator={"method": integ.method, "dt": integ.dt, "substeps": integ.substeps})
 
 
 def _result(

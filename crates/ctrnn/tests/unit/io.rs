@@ -159,6 +159,10 @@ fn nan_and_infinity_are_named_and_meta_s_conventional_keys_are_checked() {
             r#"{"output_labels": "x"}"#,
             "meta.output_labels is \"x\"; expected a list of strings",
         ),
+        (
+            r#"{"precision": "f16"}"#,
+            "meta.precision is \"f16\"; expected \"f64\" or \"f32\"",
+        ),
     ] {
         assert_eq!(err(&with_meta(meta)), message);
     }
@@ -171,7 +175,7 @@ fn nan_and_infinity_are_named_and_meta_s_conventional_keys_are_checked() {
     let nested = with_meta(r#"{"a": {"b": 1, "b": 2}}"#);
     assert!(err(&nested).contains("the key \"b\" appears twice"));
     let fine = r#"{"seed": 3, "generation": 0, "fitness": -0.5, "task": "x", "input_labels": ["a"],
-        "anything": [1, {"b": null}]}"#;
+        "precision": "f32", "anything": [1, {"b": null}]}"#;
     assert_eq!(from_json(&with_meta(fine)).unwrap().meta["seed"], 3);
     assert!(from_json(&with_meta(r#"{"seed": 3.0}"#)).is_ok()); // the schema's integer
     assert!(err(&with_meta(r#"{"seed": -2.0}"#)).starts_with("meta.seed is -2.0"));

@@ -101,6 +101,11 @@ def test_a_preset_meant_to_start_from_earlier_runs_warns_without_them(tmp_path: 
          "error: task_params.training.cone_deg is -1"),
         (["run", "landmark", "--quick", "--set", "task_params.trials_per_landmark.x=1"],
          "task_params.trials_per_landmark.x cannot be set: task_params.trials_per_landmark is 3, not a table"),
+        # A number picks a list's entry; one that is not there is named with the entries that are.
+        (["run", "landmark", "--quick", "--set", "task_params.sim.sonars.2.lobe_deg=10"],
+         "task_params.sim.sonars is a list of 1, so its entries are 0 to 0"),
+        (["run", "landmark", "--quick", "--set", "task_params.sim.sonars.0.lobe_deg=-1"],
+         "sonars[0].lobe_deg is -1; it must be a finite number > 0"),
         (["run", "sequence-1bit", "--seed", "-1"], "-1 is negative"),
         (["run", "sequence-1bit", "--threads", "0"], "must be >= 1"),
         (["resume", "/no/such/dir"], "/no/such/dir does not exist"),

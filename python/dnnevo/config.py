@@ -19,7 +19,7 @@ from typing import Any
 import tomli_w
 
 from dnnevo import _core
-from dnnevo.errors import ConfigError, did_you_mean
+from dnnevo.errors import ConfigError, DnnevoError, did_you_mean
 
 __all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides", "with_later_defaults"]
 
@@ -299,31 +299,71 @@ def _parse_value(text: str) -> Any:
         return text
 
 
-def _with_key(table: dict[str, Any], path: list[str], value: Any, key: str) -> dict[str, Any]:
-    """``table`` with ``path`` set to ``value``: ``task_params.training.cone_deg`` reaches into
-    the nested table (made when missing), as in the config file; ``key`` is the setting's whole
+def _with_key(node: Any, path: list[str], value: Any, key: str) -> Any:
+    """``node`` (a table or a list) with ``path`` set to ``value``: ``task_params.training.cone_deg``
+    reaches into the nested table (made when missing), as in the config file, and a number picks
+    an entry of a list (``task_params.sim.sonars.0.lobe_deg``); ``key`` is the setting's whole
     name, for the error.
 
     >>> _with_key({"a": 1, "b": {"c": 2}}, ["b", "d"], 3, "task_params.b.d")
     {'a': 1, 'b': {'c': 2, 'd': 3}}
+    >>> _with_key({"s": [{"x": 1}, {"x": 2}]}, ["s", "1", "x"], 5, "task_params.s.1.x")
+    {'s': [{'x': 1}, {'x': 5}]}
     >>> _with_key({"a": 1}, ["a", "c"], 3, "task_params.a.c")
     Traceback (most recent call last):
       ...
     dnnevo.errors.ConfigError: task_params.a.c cannot be set: task_params.a is 1, not a table
+    >>> _with_key({"s": [{"x": 1}]}, ["s", "2", "x"], 5, "task_params.s.2.x")
+    Traceback (most recent call last):
+      ...
+    dnnevo.errors.ConfigError: task_params.s.2.x cannot be set: task_params.s is a list of 1, so its entries are 0 to 0
     """
     head, rest = path[0], path[1:]
+    if isinstance(node, list):
+        if not (head.isdecimal() and int(head) < len(node)):
+            within = key[: len(key) - len(".".join(path)) - 1]
+            entries = f"its entries are 0 to {len(node) - 1}" if node else "it has no entry to change"
+            raise ConfigError(f"{key} cannot be set: {within} is a list of {len(node)}, so {entries}")
+        i = int(head)
+        return [*node[:i], _with_key(node[i], rest, value, key) if rest else value, *node[i + 1:]]
     if not rest:
-        return {**table, head: value}
-    inner = table.get(head, {})
-    if not isinstance(inner, dict):
+        return {**node, head: value}
+    inner = node.get(head, {})
+    if not isinstance(inner, dict | list):
         reached = key[: len(key) - len(".".join(rest)) - 1]
         raise ConfigError(f"{key} cannot be set: {reached} is {inner!r}, not a table")
-    return {**table, head: _with_key(inner, rest, value, key)}
+    return {**node, head: _with_key(inner, rest, value, key)}
+
+
+def _task_default(d: dict[str, Any], name: str) -> Any:
+    """The built-in task's whole setting ``name`` (a table or a list) as the core fills it in for
+    the settings ``d``, so that ``--set`` can change one part of it and keep the rest; None for a
+    task written in Python, a setting that is a plain value, or settings the core refuses (the
+    config made at the end says why). TOML has no null, so an unset optional part is left out,
+    as the core reads it."""
+    try:
+        params = EvolutionConfig.from_dict(d).native.builtin().params()
+    except DnnevoError:
+        return None
+    found = params.get(name)
+    return _without_nulls(found) if isinstance(found, dict | list) else None
+
+
+def _without_nulls(x: Any) -> Any:
+    """``x`` with every ``None`` entry of its tables left out, at any depth."""
+    if isinstance(x, dict):
+        return {k: _without_nulls(v) for k, v in x.items() if v is not None}
+    if isinstance(x, list):
+        return [_without_nulls(v) for v in x]
+    return x
 
 
 def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> EvolutionConfig:
     """Applies ``key=value`` overrides, e.g. ``population=50``, ``integrator.dt=0.05``,
-    ``ranges.tau=[1, 5]`` or ``task_params.targets=["01", "10"]``."""
+    ``ranges.tau=[1, 5]``, ``task_params.targets=["01", "10"]`` or
+    ``task_params.sim.sonars.0.lobe_deg=10``. A built-in task's table or list that the config
+    does not hold yet (``sim`` here) starts from the task's own defaults, so that one part of
+    it can be changed and the rest kept."""
     d = config.to_dict()
     for item in assignments:
         key, sep, raw = item.partition("=")
@@ -343,7 +383,12 @@ def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> Evolutio
                 raise ConfigError(
                     f"unknown setting {key!r}{hint}; {head} has {', '.join(sorted(d[head]))}"
                 )
-            d[head] = _with_key(d[head], sub.split(".") if head == "task_params" else [sub], value, key)
+            path = sub.split(".") if head == "task_params" else [sub]
+            if head == "task_params" and len(path) > 1 and path[0] not in d[head]:
+                whole = _task_default(d, path[0])
+                if whole is not None:
+                    d[head] = {**d[head], path[0]: whole}
+            d[head] = _with_key(d[head], path, value, key)
         else:
             d[head] = value
     return EvolutionConfig.from_dict(d)

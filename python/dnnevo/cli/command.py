@@ -133,13 +133,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     def run_options(p: argparse.ArgumentParser) -> None:
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                       help="override a setting, e.g. population=200 or integrator.dt=0.05")
+                       help="override a setting, e.g. population=200, integrator.dt=0.05 or "
+                            "task_params.sim.sonars.0.lobe_deg=10 (a number picks a list's entry; "
+                            "the rest of a task's table keeps its defaults)")
         p.add_argument("--quick", action="store_true",
                        help="small population, few generations: a demo, not a result")
         p.add_argument("--threads", type=_positive, help="worker threads (default: all cores)")
 
     p = sub.add_parser("run", help="run a preset, or a task written in Python",
                        epilog="examples:\n  dnnevo run sequence-1bit --quick --out runs/demo\n"
+                              "  dnnevo run landmark --quick --set task_params.sim.sonars.0.lobe_deg=10 "
+                              "--set task_params.sim.follower.angle_gain=0.3\n"
                               "  dnnevo run python:light.Light --set size=3 --set selection=rank "
                               "--set task_params.max_steps=300 --set task_params.episodes=4\n"
                               "    (the class Light of light.py in this folder: docs/closed-loop.md)",

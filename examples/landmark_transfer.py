@@ -208,6 +208,24 @@ def judge_all(folders: Sequence[Path], trials: int, fit_trials: int, judged: Seq
     return families, base
 
 
+def checked_folders(p: argparse.ArgumentParser, folders: Sequence[Path], example: str) -> Sequence[Path]:
+    """``folders``, or the parser's one-line error naming the first that is not a folder."""
+    missing = [f for f in folders if not f.is_dir()]
+    if missing:
+        p.error(f"{missing[0]} is not a folder; pass the champions' folders (run folders, or folders "
+                f"of seed-N run folders), for example: {example}")
+    return folders
+
+
+def show(columns: Sequence[str], rows: Sequence[Sequence[str]], summary: Sequence[str]) -> None:
+    """Prints a table and its summary, as the record holds them."""
+    print()
+    print(" | ".join(columns))
+    for row in rows:
+        print(" | ".join(row))
+    print("\n".join(summary))
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("folders", nargs="*", type=Path, metavar="FOLDER",
@@ -227,22 +245,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     args = p.parse_args(argv)
     if args.trials < 1 or args.fit_trials < 1:
         p.error("--trials and --fit-trials must be at least 1")
-    folders = args.folders or REFERENCE
-    missing = [f for f in folders if not f.is_dir()]
-    if missing:
-        p.error(f"{missing[0]} is not a folder; pass the champions' folders (run folders, or folders "
-                "of seed-N run folders), for example: examples/landmark_transfer.py runs/sweep-landmark")
+    folders = checked_folders(p, args.folders or REFERENCE, "examples/landmark_transfer.py runs/sweep-landmark")
     judged = factors(args.worlds) if args.factors else places(args.worlds)
     try:
         families, base = judge_all(folders, args.trials, args.fit_trials, judged)
     except DnnevoError as e:  # a run folder that cannot be read, or not a landmark run
         sys.exit(f"error: {e}")
     columns, rows, summary = (factor_table if args.factors else table)(families, base, args.trials, args.worlds)
-    print()
-    print(" | ".join(columns))
-    for row in rows:
-        print(" | ".join(row))
-    print("\n".join(summary))
+    show(columns, rows, summary)
     if args.record:
         examples.write(args.record, command=examples.command("examples/landmark_transfer.py", argv),
                        columns=columns, rows=rows, summary=summary)

@@ -270,3 +270,46 @@ def test_the_example_labels_same_named_folders_apart_and_refuses_other_tasks(tmp
     with pytest.raises(SystemExit, match="^error: the run's task is 'sequence'; held-out worlds are for the "
                                          "'landmark' task$"):
         landmark_transfer.main([str(tmp_path / "seq")])
+
+
+def test_the_envelope_s_ends_change_one_setting_each_as_a_training_trial_does() -> None:
+    wide = presets.get("landmark-wide")
+    training = landmark.params(wide)["training"]
+    edges = landmark_worlds.envelope_edges(wide)
+    assert len(edges) == 8
+    changed = {}
+    for world in edges:
+        diff = landmark_worlds.factors(world)  # against the paper's training world
+        assert len(diff) == 1, (world.name, diff)
+        (key, (was, now)), = diff.items()
+        changed[world.name] = (key, now - was if key != "sim.follower.speed" else now / was)
+    assert changed["follower speed x0.8"] == ("sim.follower.speed", pytest.approx(1 - training["follower_speed"]))
+    assert changed["wall distance +0.15 m"] == ("sim.follower.wall_distance",
+                                                pytest.approx(training["follower_distance"]))
+    assert changed["sonar cone -15 deg"] == ("sim.sonars.0.cone_deg", -training["cone_deg"])
+    assert changed["sonar axis +15 deg"] == ("sim.sonars.0.mount_angle_deg", training["sonar_axis_deg"])
+    # Judged as it is: the run's training variation is gone.
+    assert landmark.params(landmark_worlds.config(wide, edges[0]))["training"]["cone_deg"] == 0.0
+
+
+def test_the_envelope_example_records_each_end_and_refuses_a_run_without_an_envelope(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import landmark_envelope
+
+    runs = tmp_path / "robust"
+    r = run_cli("run", "landmark-robust", "--quick", "--out", runs / "seed-0", "--seed", "0", "--set",
+                "generations=1", "--set", "population=12", "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    record = tmp_path / "results" / "examples" / "landmark-envelope.json"
+    argv = [str(runs), "--trials", "3", "--record", str(record)]
+    landmark_envelope.main(argv)
+    doc = examples.read(record)
+    assert doc["command"] == examples.command("examples/landmark_envelope.py", argv[:-2])
+    assert [row[1] for row in doc["rows"]] == [w.name for w in landmark_worlds.envelope_edges(
+        presets.get("landmark-robust", quick=True))]
+    assert doc["summary"][1].startswith("robust: ") and "validation rate" in doc["summary"][1]
+    plain = tmp_path / "plain"
+    r = run_cli("run", "landmark", "--quick", "--out", plain, "--set", "generations=1", "--set", "population=10")
+    assert r.returncode == 0, r.stderr
+    with pytest.raises(SystemExit, match="vary none of the follower's speed"):
+        landmark_envelope.main([str(plain), "--trials", "2"])

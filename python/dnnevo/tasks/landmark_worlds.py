@@ -35,8 +35,8 @@ from dnnevo.config import EvolutionConfig
 from dnnevo.errors import InvalidArgumentError
 from dnnevo.tasks import landmark
 
-__all__ = ["NOT_CARRIED", "SECOND", "SETS", "TRAINING", "WORLDS", "World", "config", "factors", "get", "single_factors",
-           "world_set"]
+__all__ = ["NOT_CARRIED", "SECOND", "SETS", "TRAINING", "WORLDS", "World", "config", "envelope_edges", "factors", "get",
+           "single_factors", "world_set"]
 
 
 @dataclass(frozen=True)
@@ -195,6 +195,45 @@ def single_factors(world: World | str) -> list[World]:
         return [world]
     return [World(f"{world.name}: {name}", f"{world.name}'s {name} alone", params)
             for name, params in world.parts.items()]
+
+
+def envelope_edges(base: EvolutionConfig) -> list[World]:
+    """Worlds at the ends of ``base``'s own training envelope, one variation at a time: each of
+    the wall follower's speed and distance and the network's sonar's cone and axis that its
+    ``training`` varies, set to the low and then the high end of its range as a training trial
+    sets it (``crates/tasks/src/landmark/trials.rs``), the rest as in its training world. Training
+    draws each variation uniformly over its range, so a champion that has learnt its envelope
+    holds at each end. These are no held-out worlds: the run trained on every one of them, rarely.
+    The landmark's, the room's, the trial's and the input's variations are not among them.
+
+    >>> from dnnevo import presets
+    >>> [w.name for w in envelope_edges(presets.get("landmark-robust"))]  # doctest: +NORMALIZE_WHITESPACE
+    ['follower speed x0.92', 'wall distance -0.05 m', 'sonar cone -8 deg',
+     'follower speed x1.08', 'wall distance +0.05 m', 'sonar cone +8 deg']
+    >>> envelope_edges(presets.get("landmark"))
+    []
+    """
+    params = landmark.params(base)
+    training, follower, sonar = params["training"], params["sim"]["follower"], params["sim"]["sonars"][0]
+    speed, distance = training["follower_speed"], training["follower_distance"]
+    cone, axis = training["cone_deg"], training["sonar_axis_deg"]
+    edges = []
+    for sign in (-1, 1):
+        if speed:
+            factor = 1.0 + sign * speed
+            edges.append(World(f"follower speed x{factor:g}", "the follower's speed at an end of training's range",
+                               {"sim": {"follower": {"speed": follower["speed"] * factor}}}))
+        if distance:
+            edges.append(World(f"wall distance {sign * distance:+g} m",
+                               "the follower's wall distance at an end of training's range",
+                               {"sim": {"follower": {"wall_distance": follower["wall_distance"] + sign * distance}}}))
+        if cone:
+            edges.append(World(f"sonar cone {sign * cone:+g} deg", "the sonar's cone at an end of training's range",
+                               {"sim": {"sonars": [{"cone_deg": sonar["cone_deg"] + sign * cone}]}}))
+        if axis:
+            edges.append(World(f"sonar axis {sign * axis:+g} deg", "the sonar's axis at an end of training's range",
+                               {"sim": {"sonars": [{"mount_angle_deg": sonar["mount_angle_deg"] + sign * axis}]}}))
+    return edges
 
 
 NOT_CARRIED = ("training", "trials_per_landmark", "validation_trials", "train_robot_like")

@@ -1,0 +1,114 @@
+"""Landmark recognition at the ends of the training envelope (issue 47): have the champions of a
+varied training learnt the envelope they were trained on?
+
+A run of ``landmark-robust`` or ``landmark-wide`` draws, for every training trial, the wall
+follower's speed and distance and the sonar's cone (and for ``landmark-wide`` its axis) uniformly
+over a range. Each champion (the ``best.json`` of each run folder given) is judged on ``--trials``
+fresh trials per landmark, drawn from ``TEST_SEED``, in one world per end of each such range, with
+nothing else varied (:func:`dnnevo.tasks.landmark_worlds.envelope_edges`). These are no held-out
+worlds: training saw each of them, if rarely. A champion that fails at the ends of its own
+envelope was not made robust by its training, whatever it does beyond it. The goal is the
+held-out worlds' (more than 85% right, the 95% Wilson interval's lower end above 80%)::
+
+    python examples/landmark_envelope.py /root/dnnevo-reference/landmark-robust \\
+        /root/dnnevo-reference/landmark-wide --record docs/results/examples/landmark-envelope.json
+
+Each FOLDER is a run folder or a folder of ``seed-N`` run folders, as for
+``examples/landmark_transfer.py``, whose runs share one training envelope; its name labels its
+champions. Without any, the reference reproduction's ``landmark-robust`` and ``landmark-wide``
+folders are used. Nothing is written into them. The summary gives each champion's validation
+rate, the share of its run's own varied validation trials it was right in.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from landmark_transfer import champions, checked_folders, labels, load, rates, show
+
+from dnnevo.errors import DnnevoError
+from dnnevo.experiments import examples
+from dnnevo.tasks import landmark_worlds
+from dnnevo.tasks import landmark_transfer as transfer
+from dnnevo.tasks.landmark_transfer import TEST_SEED, Place, meets
+
+REFERENCE = [Path("/root/dnnevo-reference/landmark-robust"), Path("/root/dnnevo-reference/landmark-wide")]
+"""The champions judged by default: the reference reproduction's two varied-training presets."""
+
+COLUMNS = ["champions", "end of the training envelope", "meet the goal", "% right, seed by seed",
+           "pooled % (95% interval)", "one answer in >= 95% of trials"]
+
+
+def judge_family(label: str, folder: Path, trials: int) -> tuple[list[str], dict[str, dict[str, int]], list[float]]:
+    """The envelope's ends of ``folder``'s runs, each champion's trials right (and given its commoner
+    answer) at each, by seed label, and each champion's validation rate."""
+    edges: list[str] | None = None
+    judged: dict[str, dict[str, int]] = {}
+    validation = []
+    for seed, run in champions(folder):
+        config, net = load(run)
+        places = [Place(w.name, w) for w in landmark_worlds.envelope_edges(config)]
+        names = [p.name for p in places]
+        if edges is None:
+            edges = names
+        elif names != edges:
+            raise DnnevoError(f"{run}'s training envelope differs from the other runs' of {folder}; "
+                              "give runs of one envelope per folder")
+        judged[seed] = transfer.judge(config, net, trials, places)
+        validation.append(float(net.meta.get("validation_rate", float("nan"))))
+        print(f"{label} {seed}: " + "  ".join(f"{p} {100 * judged[seed][p] / (2 * trials):.1f}%" for p in names),
+              flush=True)
+    if not edges:
+        raise DnnevoError(f"{folder}'s runs vary none of the follower's speed and distance and the sonar's "
+                          "cone and axis in training, so their envelope has no ends to judge")
+    return edges, judged, validation
+
+
+def table(families: dict[str, tuple[list[str], dict[str, dict[str, int]], list[float]]],
+          trials: int) -> tuple[list[list[str]], list[str]]:
+    """The record's rows, one per family and end of its envelope, and the summary lines."""
+    n = 2 * trials
+    rows = []
+    summary = [f"{trials} fresh trials per landmark per champion and end (seed {TEST_SEED}); each row sets one "
+               "variation of the family's training to one end of its range and varies nothing else. The goal "
+               "(issue 47): more than 85% right with the 95% Wilson interval's lower end above 80%."]
+    for family, (edges, judged, validation) in families.items():
+        for edge in edges:
+            stuck = sum(r[f"{edge} one answer"] >= 0.95 * n for r in judged.values())
+            rows.append([family, edge, *rates([r[edge] for r in judged.values()], n), f"{stuck}/{len(judged)}"])
+        every = sum(all(meets(r[e], n) for e in edges) for r in judged.values())
+        summary.append(f"{family}: {every}/{len(judged)} champions meet the goal at every end of their envelope; "
+                       "validation rate on the run's own varied trials, per champion: "
+                       + " ".join(f"{v:.2f}" for v in validation) + ".")
+    return rows, summary
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("folders", nargs="*", type=Path, metavar="FOLDER",
+                   help="run folders, or folders of seed-N run folders (default: "
+                        + " and ".join(map(str, REFERENCE)) + ")")
+    p.add_argument("--trials", type=int, default=100, help="fresh test trials per landmark (default 100)")
+    p.add_argument("--record", type=Path, metavar="JSON",
+                   help="also write the table here, for the docs (docs/results/examples/landmark-envelope.json)")
+    args = p.parse_args(argv)
+    if args.trials < 1:
+        p.error("--trials must be at least 1")
+    folders = checked_folders(p, args.folders or REFERENCE, "examples/landmark_envelope.py runs/sweep-landmark-robust")
+    try:
+        families = {label: judge_family(label, folder, args.trials)
+                    for label, folder in zip(labels(folders), folders, strict=True)}
+    except DnnevoError as e:  # a run folder that cannot be read, not a landmark run, or no envelope
+        sys.exit(f"error: {e}")
+    rows, summary = table(families, args.trials)
+    show(COLUMNS, rows, summary)
+    if args.record:
+        examples.write(args.record, command=examples.command("examples/landmark_envelope.py", argv),
+                       columns=COLUMNS, rows=rows, summary=summary)
+
+
+if __name__ == "__main__":
+    main()

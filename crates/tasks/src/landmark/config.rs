@@ -162,6 +162,7 @@ impl LandmarkConfig {
                 return config(format!("{name} is {value}; it must be in [0, {hi}]"));
             }
         }
+        self.check_robot_like_fits()?;
         self.training.validate()?;
         self.validate_training()?;
         self.integrator.validate().map_err(|e| match e {
@@ -175,6 +176,42 @@ impl LandmarkConfig {
             longest as u128,
             self.integrator.substeps,
         )
+    }
+
+    /// The robot-like jitter keeps every box inside its room at the extremes of
+    /// `robot_like.box_shift` and `room_scale`, so that `WorldSpec::jittered` never has to clamp
+    /// a box back in: a box's distance from each wall scales with the room, so the room at its
+    /// smallest, `1 - room_scale`, leaves the least margin, and the shift must stay within it.
+    fn check_robot_like_fits(&self) -> Result<()> {
+        let r = &self.robot_like;
+        let least = 1.0 - r.room_scale;
+        for (name, world) in [
+            ("landmark1", &self.landmark1),
+            ("landmark2", &self.landmark2),
+        ] {
+            for (i, b) in world.boxes.iter().enumerate() {
+                let half = b.aabb_half_extents();
+                for k in 0..2 {
+                    let margin = b.center[k].min(world.room[k] - b.center[k]) * least - half[k];
+                    if margin < 0.0 {
+                        return Err(Error::Config(format!(
+                            "robot_like.room_scale is {}; a room that much smaller would push \
+                             {name}'s box {i} into its wall",
+                            r.room_scale
+                        )));
+                    }
+                    if r.box_shift > margin {
+                        return Err(Error::Config(format!(
+                            "robot_like.box_shift is {}; with robot_like.room_scale {} it could \
+                             move {name}'s box {i} out of its room (at most {margin:.3} m keeps it \
+                             inside)",
+                            r.box_shift, r.room_scale
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// How `training`'s ranges fit the rest of the config: trial counts and lengths, robot-like

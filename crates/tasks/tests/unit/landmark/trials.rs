@@ -98,6 +98,29 @@ fn bad_training_fields_are_config_errors_that_name_them() {
 }
 
 #[test]
+fn a_robot_like_jitter_that_could_move_a_box_out_of_its_room_is_refused() {
+    // Landmark 1's box (1.2 m x 0.6 m at (3, 2.5) in a 6 m x 5 m room) is 3 * 0.95 - 0.6 = 2.25 m
+    // from the left and right walls of the room 5% narrower.
+    let e = err(json!({"robot_like": {"box_shift": 3.0}}));
+    assert_eq!(
+        e,
+        "invalid config: robot_like.box_shift is 3; with robot_like.room_scale 0.05 it could move \
+         landmark1's box 0 out of its room (at most 2.250 m keeps it inside)"
+    );
+    let near = json!({"robot_like": {"box_shift": 0.2, "room_scale": 0.3}, "landmark1": {
+        "room": [6.0, 5.0], "start": {"min": [0.4, 0.4], "max": [5.6, 4.6]},
+        "boxes": [{"center": [0.8, 2.5], "size": [1.2, 0.6]}]}});
+    assert!(err(near).contains(
+        "robot_like.room_scale is 0.3; a room that much smaller would push \
+                                landmark1's box 0 into its wall"
+    ));
+    assert!(LandmarkTask::from_params(
+        &json!({"robot_like": {"box_shift": 0.9, "room_scale": 0.45}})
+    )
+    .is_ok());
+}
+
+#[test]
 fn with_training_off_the_trials_are_the_unvaried_ones() {
     for robot_like in [false, true] {
         let plain = LandmarkConfig {

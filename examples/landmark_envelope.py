@@ -17,7 +17,8 @@ Each FOLDER is a run folder or a folder of ``seed-N`` run folders, as for
 ``examples/landmark_transfer.py``, whose runs share one training envelope; its name labels its
 champions. Without any, the reference reproduction's ``landmark-robust`` and ``landmark-wide``
 folders are used. Nothing is written into them. The summary gives each champion's validation
-rate, the share of its run's own varied validation trials it was right in.
+rate: the share of its run's validation set it was right in, a set of as many ideal trials as
+varied ones.
 """
 
 from __future__ import annotations
@@ -81,7 +82,7 @@ def table(families: dict[str, tuple[list[str], dict[str, dict[str, int]], list[f
             rows.append([family, edge, *rates([r[edge] for r in judged.values()], n), f"{stuck}/{len(judged)}"])
         every = sum(all(meets(r[e], n) for e in edges) for r in judged.values())
         summary.append(f"{family}: {every}/{len(judged)} champions meet the goal at every end of their envelope; "
-                       "validation rate on the run's own varied trials, per champion: "
+                       "validation rate (half ideal, half varied trials), per champion: "
                        + " ".join(f"{v:.2f}" for v in validation) + ".")
     return rows, summary
 

@@ -4,8 +4,10 @@ folder under ``src/``) names which through ``crate::``, and the loops among them
 
     python tests/rust_structure.py crates/ctrnn
 
-A module's own submodules (``super::``) stay inside it. Comments are left out, doc comments too:
-a link in the docs is no dependency.
+A path reaches a module by name (``crate::math::exp``), through an item the crate's root
+re-exports (``crate::Network``, which ``lib.rs`` takes from ``network``), or up through
+``super::`` to the root and down again. Comments are left out, doc comments too: a link in the
+docs is no dependency. Paths that a macro writes are not seen.
 """
 
 from __future__ import annotations
@@ -32,24 +34,59 @@ def _first_segments(group: str) -> set[str]:
     return {m.group(0) for m in (re.match(r"\w+", i.strip()) for i in items) if m}
 
 
+def _group_after(text: str, start: int) -> str:
+    """The text of the ``{...}`` group that opens just before ``start``, without its braces."""
+    depth, end = 1, start
+    while depth and end < len(text):
+        depth += {"{": 1, "}": -1}.get(text[end], 0)
+        end += 1
+    return text[start:end - 1]
+
+
+def _reexports(src: Path) -> dict[str, str]:
+    """The items the crate's root re-exports (``pub use network::{compose, Network};``), each
+    mapped to the top-level module it comes from."""
+    root = next((src / name for name in ("lib.rs", "main.rs") if (src / name).is_file()), None)
+    if root is None:
+        return {}
+    text = _COMMENT.sub("", root.read_text(encoding="utf-8"))
+    out = {}
+    for m in re.finditer(r"\bpub(?:\([^)]*\))?\s+use\s+(?:crate::)?(\w+)::(\{|[\w:]+)", text):
+        group = _group_after(text, m.end()) if m.group(2) == "{" else m.group(2)
+        # The names a use brings in: each last segment (at any depth of braces), or its alias.
+        for name, alias in re.findall(r"(\w+)\s*(?:as\s+(\w+))?\s*(?=[,}]|$)", group):
+            if (alias or name) != "self":
+                out[alias or name] = m.group(1)
+    return out
+
+
 def arrows(crate: Path) -> set[tuple[str, str]]:
     """``(a, b)`` for each top-level module ``a`` of the crate in the folder ``crate`` whose code
     names a path under the top-level module ``b``."""
     src = crate / "src"
+    modules = {p.stem if p.is_file() else p.name for p in src.iterdir()
+               if (p.suffix == ".rs" and p.stem not in ("lib", "main")) or p.is_dir()}
+    reexports = _reexports(src)
+
+    def module(name: str) -> str | None:
+        found = name if name in modules else reexports.get(name)
+        return found if found in modules else None  # another crate's item is no arrow here
+
     found = set()
     for path in sorted(src.rglob("*.rs")):
-        here = path.relative_to(src).with_suffix("").parts[0]
+        parts = path.relative_to(src).with_suffix("").parts
+        here = parts[0]
+        depth = len(parts) - (parts[-1] == "mod")  # how many super:: reach the root
         text = _COMMENT.sub("", path.read_text(encoding="utf-8"))
+        targets: set[str | None] = set()
         for m in _PATH.finditer(text):
-            if m.group(1) != "{":
-                targets = {m.group(1)}
-            else:
-                depth, end = 1, m.end()
-                while depth and end < len(text):
-                    depth += {"{": 1, "}": -1}.get(text[end], 0)
-                    end += 1
-                targets = _first_segments(text[m.end():end - 1])
-            found |= {(here, t) for t in targets if t not in (here, "self")}
+            named = {m.group(1)} if m.group(1) != "{" else _first_segments(_group_after(text, m.end()))
+            targets |= {module(t) for t in named}
+        if depth:
+            for m in re.finditer(r"\b((?:super::)+)(\w+)", text):
+                if m.group(1).count("super::") == depth:
+                    targets.add(module(m.group(2)))
+        found |= {(here, t) for t in targets if t is not None and t != here}
     return found
 
 

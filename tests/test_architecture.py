@@ -52,3 +52,16 @@ def test_the_rust_measure_sees_a_loop_through_a_group_and_not_through_a_comment(
     (src / "c.rs").write_text("// crate::a\n")
     assert rust_structure.arrows(tmp_path) == {("a", "c"), ("a", "b"), ("b", "a")}
     assert rust_structure.loops(tmp_path) == [["a", "b", "a"]]
+
+
+def test_the_rust_measure_follows_the_root_s_re_exports_and_super_to_the_root(tmp_path: Path) -> None:
+    src = tmp_path / "src"
+    (src / "b").mkdir(parents=True)
+    (src / "lib.rs").write_text("mod a;\nmod b;\nmod c;\npub use b::{inner::X, Y as Z};\npub use c::W;\n")
+    (src / "a.rs").write_text("use crate::X;\nfn f() -> crate::Z { todo!() }\n")
+    (src / "b" / "mod.rs").write_text("pub mod inner;\npub struct Y;\n")
+    (src / "b" / "inner.rs").write_text("pub struct X;\nfn g() { super::super::c::h(); super::Y; }\n")
+    (src / "c.rs").write_text("pub struct W;\npub fn h() {}\n")
+    assert rust_structure.arrows(tmp_path) == {("a", "b"), ("b", "c")}
+    (src / "c.rs").write_text("pub struct W;\npub fn h() { let _ = crate::X; }\n")
+    assert rust_structure.loops(tmp_path) == [["b", "c", "b"]]

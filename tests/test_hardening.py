@@ -209,6 +209,13 @@ def test_wrong_champion_and_deleted_best_json(pristine: Path, tmp_path: Path) ->
     (run / "best.json").unlink()
     assert run_cli("resume", run).returncode == 0
     assert (run / "best.json").read_bytes() == (pristine / "best.json").read_bytes()
+    # A champion that says it was run with another step, or in another precision, than the run.
+    best = dnnevo.Network.load(pristine / "best.json")
+    assert best.integrator is not None
+    best.save(run / "best.json", integrator={**best.integrator, "dt": 1.0})
+    assert_one_line_error(run_cli("assess", run), "best.json", "integrator is")
+    best.save(run / "best.json", meta={"precision": "f32"})
+    assert_one_line_error(run_cli("assess", run), "best.json", "meta.precision is 'f32'")
 
 
 def test_figures_never_follow_symlinks(pristine: Path, tmp_path: Path) -> None:

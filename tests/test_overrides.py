@@ -53,3 +53,31 @@ def test_a_python_task_gets_a_new_nested_table() -> None:
 def test_a_path_that_does_not_fit_is_named(key: str, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         apply_overrides(dnnevo.presets.get("landmark"), [f"{key}=1"])
+
+
+def test_a_list_missing_from_a_partial_table_starts_from_the_task_s_own() -> None:
+    base = apply_overrides(dnnevo.presets.get("landmark"), ["task_params.sim={follower={speed=0.5}}"])
+    assert base.task_params["sim"] == {"follower": {"speed": 0.5}}
+    changed = apply_overrides(base, ["task_params.sim.sonars.0.lobe_deg=10"])
+    sonar = _params(changed)["sim"]["sonars"][0]
+    assert sonar == {**_params(base)["sim"]["sonars"][0], "lobe_deg": 10.0}
+    assert _params(changed)["sim"]["follower"]["speed"] == 0.5
+
+
+def test_an_earlier_bad_override_is_the_error_named() -> None:
+    # The defaults come from the config as given, so a bad earlier value does not hide them, and
+    # the task names it when it is built.
+    both = apply_overrides(dnnevo.presets.get("landmark"),
+                           ["task_params.trials_per_landmark=0", "task_params.sim.sonars.0.lobe_deg=10"])
+    with pytest.raises(ConfigError, match="trials_per_landmark is 0"):
+        _params(both)
+
+
+@pytest.mark.parametrize("preset, key, message", [
+    ("landmark", "task_params.landmark1.boxes.0.size.0.x", "task_params.landmark1.boxes.0.size.0 is 1.2, not a table"),
+    ("sequence-1bit", "task_params.targets.0.x", "task_params.targets.0 is '0', not a table"),
+    ("sequence-1bit", "task_params.nothing.0.x", "task_params.nothing is not a list the config or the task has"),
+])
+def test_a_path_through_a_plain_value_is_named_not_a_traceback(preset: str, key: str, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        apply_overrides(dnnevo.presets.get(preset), [f"{key}=1"])

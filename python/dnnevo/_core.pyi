@@ -132,9 +132,11 @@ class Network:
     def meta(self) -> dict[str, Any]: ...
     @property
     def integrator(self) -> dict[str, Any] | None:
-        """How the network is meant to be run, ``{"method", "dt", "substeps"}``, from its file or
-        the ``save`` that gave it one; None if neither said. ``run`` does not read it:
-        ``net.run(inputs, **net.integrator)`` does."""
+        """How the network is meant to be run, ``{"method", "dt", "substeps"}``, from the file or
+        dict it was read from; None if it had none (``save(integrator=...)`` writes one into the
+        file, not into this network). ``run`` does not read it: ``net.run(inputs,
+        **net.integrator)`` does (with ``precision=net.meta["precision"]`` for a champion
+        evolved in f32)."""
     def reset(self, state: npt.ArrayLike | None = None) -> None: ...
     def run(
         self,
@@ -161,7 +163,7 @@ class Network:
         path: str | PathLike[str],
         *,
         meta: Mapping[str, Any] | None = None,
-        integrator: Mapping[str, Any] | None = None,
+        integrator: dict[str, Any] | None = None,
     ) -> None:
         """Writes the network file atomically; ``meta`` entries are added to the network's own,
         and ``integrator`` (``{"method", "dt", "substeps"}``, all three) replaces its own."""

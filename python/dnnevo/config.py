@@ -299,16 +299,20 @@ def _parse_value(text: str) -> Any:
         return text
 
 
-def _with_key(node: Any, path: list[str], value: Any, key: str) -> Any:
+def _with_key(node: Any, path: list[str], value: Any, key: str, default: Any = None) -> Any:
     """``node`` (a table or a list) with ``path`` set to ``value``: ``task_params.training.cone_deg``
-    reaches into the nested table (made when missing), as in the config file, and a number picks
-    an entry of a list (``task_params.sim.sonars.0.lobe_deg``); ``key`` is the setting's whole
-    name, for the error.
+    reaches into the nested table, as in the config file, and a number picks an entry of a list
+    (``task_params.sim.sonars.0.lobe_deg``); ``key`` is the setting's whole name, for the error.
+    ``default`` is what the task fills in at ``node`` (None when nothing is known): a table or
+    list the path needs and ``node`` lacks starts from it, so its other parts keep their defaults;
+    with no default, a missing table starts empty.
 
     >>> _with_key({"a": 1, "b": {"c": 2}}, ["b", "d"], 3, "task_params.b.d")
     {'a': 1, 'b': {'c': 2, 'd': 3}}
     >>> _with_key({"s": [{"x": 1}, {"x": 2}]}, ["s", "1", "x"], 5, "task_params.s.1.x")
     {'s': [{'x': 1}, {'x': 5}]}
+    >>> _with_key({}, ["s", "0", "x"], 5, "task_params.s.0.x", {"s": [{"x": 1, "y": None}], "t": 2})
+    {'s': [{'x': 5}]}
     >>> _with_key({"a": 1}, ["a", "c"], 3, "task_params.a.c")
     Traceback (most recent call last):
       ...
@@ -319,38 +323,43 @@ def _with_key(node: Any, path: list[str], value: Any, key: str) -> Any:
     dnnevo.errors.ConfigError: task_params.s.2.x cannot be set: task_params.s is a list of 1, so its entries are 0 to 0
     """
     head, rest = path[0], path[1:]
+    here = key[: len(key) - len(".".join(path)) - 1]  # the name of node itself
     if isinstance(node, list):
         if not (head.isdecimal() and int(head) < len(node)):
-            within = key[: len(key) - len(".".join(path)) - 1]
             entries = f"its entries are 0 to {len(node) - 1}" if node else "it has no entry to change"
-            raise ConfigError(f"{key} cannot be set: {within} is a list of {len(node)}, so {entries}")
+            raise ConfigError(f"{key} cannot be set: {here} is a list of {len(node)}, so {entries}")
         i = int(head)
-        return [*node[:i], _with_key(node[i], rest, value, key) if rest else value, *node[i + 1:]]
+        below = default[i] if isinstance(default, list) and i < len(default) else None
+        return [*node[:i], _with_key(node[i], rest, value, key, below) if rest else value, *node[i + 1:]]
+    if not isinstance(node, dict):
+        raise ConfigError(f"{key} cannot be set: {here} is {node!r}, not a table")
     if not rest:
         return {**node, head: value}
-    inner = node.get(head, {})
-    if not isinstance(inner, dict | list):
-        reached = key[: len(key) - len(".".join(rest)) - 1]
-        raise ConfigError(f"{key} cannot be set: {reached} is {inner!r}, not a table")
-    return {**node, head: _with_key(inner, rest, value, key)}
+    below = default.get(head) if isinstance(default, dict) else None
+    inner = node.get(head)
+    if inner is None:
+        inner = _without_nulls(below) if isinstance(below, dict | list) else None
+    if inner is None:
+        if rest[0].isdecimal():
+            raise ConfigError(f"{key} cannot be set: {here}.{head} is not a list the config or the task "
+                              "has; give the whole list")
+        inner = {}
+    return {**node, head: _with_key(inner, rest, value, key, below)}
 
 
-def _task_default(d: dict[str, Any], name: str) -> Any:
-    """The built-in task's whole setting ``name`` (a table or a list) as the core fills it in for
-    the settings ``d``, so that ``--set`` can change one part of it and keep the rest; None for a
-    task written in Python, a setting that is a plain value, or settings the core refuses (the
-    config made at the end says why). TOML has no null, so an unset optional part is left out,
-    as the core reads it."""
+def _task_params(config: EvolutionConfig) -> dict[str, Any] | None:
+    """``config``'s task settings as the core fills them in, every default included; None for a
+    task written in Python, whose settings only it knows."""
     try:
-        params = EvolutionConfig.from_dict(d).native.builtin().params()
+        params: dict[str, Any] = config.native.builtin().params()
     except DnnevoError:
         return None
-    found = params.get(name)
-    return _without_nulls(found) if isinstance(found, dict | list) else None
+    return params
 
 
 def _without_nulls(x: Any) -> Any:
-    """``x`` with every ``None`` entry of its tables left out, at any depth."""
+    """``x`` with every ``None`` entry of its tables left out, at any depth: TOML has no null, and
+    an unset optional part is left out as the core reads it."""
     if isinstance(x, dict):
         return {k: _without_nulls(v) for k, v in x.items() if v is not None}
     if isinstance(x, list):
@@ -362,9 +371,11 @@ def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> Evolutio
     """Applies ``key=value`` overrides, e.g. ``population=50``, ``integrator.dt=0.05``,
     ``ranges.tau=[1, 5]``, ``task_params.targets=["01", "10"]`` or
     ``task_params.sim.sonars.0.lobe_deg=10``. A built-in task's table or list that the config
-    does not hold yet (``sim`` here) starts from the task's own defaults, so that one part of
-    it can be changed and the rest kept."""
+    does not hold (``sim`` here, or ``sonars`` in a ``sim`` that lacks it) starts from what the
+    task fills in for the config as given, so that one part of it changes and the rest is kept."""
     d = config.to_dict()
+    # What the task fills in, read from the config as given (before any override).
+    defaults = _task_params(config) if any(a.strip().startswith("task_params.") for a in assignments) else None
     for item in assignments:
         key, sep, raw = item.partition("=")
         key = key.strip()
@@ -383,12 +394,10 @@ def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> Evolutio
                 raise ConfigError(
                     f"unknown setting {key!r}{hint}; {head} has {', '.join(sorted(d[head]))}"
                 )
-            path = sub.split(".") if head == "task_params" else [sub]
-            if head == "task_params" and len(path) > 1 and path[0] not in d[head]:
-                whole = _task_default(d, path[0])
-                if whole is not None:
-                    d[head] = {**d[head], path[0]: whole}
-            d[head] = _with_key(d[head], path, value, key)
+            if head == "task_params":
+                d[head] = _with_key(d[head], sub.split("."), value, key, defaults)
+            else:
+                d[head] = _with_key(d[head], [sub], value, key)
         else:
             d[head] = value
     return EvolutionConfig.from_dict(d)

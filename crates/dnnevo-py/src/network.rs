@@ -251,9 +251,10 @@ impl PyNetwork {
     fn meta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         json_to_py(py, &Value::Object(self.meta.clone()).to_string())
     }
-    /// How the network is meant to be run, `{"method", "dt", "substeps"}`, from the file it came
-    /// from or the `save` that gave it one; None if neither said. `run` does not read it:
-    /// `net.run(inputs, **net.integrator)` does.
+    /// How the network is meant to be run, `{"method", "dt", "substeps"}`, from the file or dict
+    /// it was read from; None if it had none (`save(integrator=...)` writes one into the file,
+    /// not into this network). `run` does not read it: `net.run(inputs, **net.integrator)` does
+    /// (with `precision=net.meta["precision"]` for a champion evolved in `f32`).
     #[getter]
     fn integrator<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.integrator

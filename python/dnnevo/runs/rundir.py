@@ -352,8 +352,8 @@ class RunDir:
             return rows
 
     def read_best(self, config: EvolutionConfig, run: Mapping[str, Any] | None = None) -> Network:
-        """``best.json``, which must be a network of the run's size and inputs, and, when its
-        meta says, of the run's task and seed."""
+        """``best.json``, which must be a network of the run's size and inputs, and, when it
+        says, of the run's task, seed, integrator and precision."""
         path = self.best
         if not path.exists() and not path.is_symlink():
             raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")
@@ -370,4 +370,11 @@ class RunDir:
                 raise fail(path, f"meta.task is {short(meta['task'])}; the run's task is {config.task!r}")
             if run is not None and "seed" in meta and "seed" in run and meta["seed"] != run["seed"]:
                 raise fail(path, f"meta.seed is {short(meta.get('seed'))}; the run's seed is {run.get('seed')}")
+            integ = config.integrator
+            want = {"method": integ.method, "dt": integ.dt, "substeps": integ.substeps}
+            if net.integrator is not None and net.integrator != want:
+                raise fail(path, f"integrator is {net.integrator}; the run's config.toml has {want}")
+            if "precision" in meta and meta["precision"] != config.precision:
+                raise fail(path, f"meta.precision is {short(meta['precision'])}; the run's precision is "
+                                  f"{config.precision!r}")
             return net

@@ -594,9 +594,8 @@ def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
     if ga.best_validation is not None:
         meta["validation_rate"], meta["validation_score"] = ga.best_validation
     # How the run integrated it, so that the file alone says how to run the champion.
-    integ = ga.config.integrator
     meta["precision"] = ga.config.precision
-    net.save(run.best, meta=meta, integrator={"method": integ.method, "dt": integ.dt, "substeps": integ.substeps})
+    net.save(run.best, meta=meta, integrator=dataclasses.asdict(ga.config.integrator))
 
 
 def _result(

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import dataclasses
 import errno
 import fcntl
 import io
@@ -370,8 +371,7 @@ class RunDir:
                 raise fail(path, f"meta.task is {short(meta['task'])}; the run's task is {config.task!r}")
             if run is not None and "seed" in meta and "seed" in run and meta["seed"] != run["seed"]:
                 raise fail(path, f"meta.seed is {short(meta.get('seed'))}; the run's seed is {run.get('seed')}")
-            integ = config.integrator
-            want = {"method": integ.method, "dt": integ.dt, "substeps": integ.substeps}
+            want = dataclasses.asdict(config.integrator)
             if net.integrator is not None and net.integrator != want:
                 raise fail(path, f"integrator is {net.integrator}; the run's config.toml has {want}")
             if "precision" in meta and meta["precision"] != config.precision:

@@ -42,7 +42,7 @@ pub use evolve::{Evolution, Fill, Stats, Task};
 pub use ga::{GaConfig, Selection};
 pub use genome::{Layout, Ranges};
 pub use integrate::{Integrator, Lanes, Method, Precision, LANES};
-pub use network::{compose, compose_with, Network};
+pub use network::{compose, compose_with, Network, Params};
 pub use population::{Block, Inputs, Population};
 /// The random streams, from the `streams` crate (kept here under their old path).
 pub use streams as rng;

@@ -53,24 +53,17 @@ impl Network {
         sensor_weights: Vec<f64>,
         state: Option<Vec<f64>>,
     ) -> Result<Self> {
-        let size = tau.len();
-        if size == 0 {
-            return Err(Error::InvalidNetwork(
-                "tau is empty; a network needs at least 1 neuron".into(),
-            ));
-        }
-        let n_inputs = sensor_weights.len() / size;
-        let state = state.unwrap_or_else(|| vec![0.0; size]);
-        expect_len("theta", theta.len(), size, "N")?;
-        expect_len("weights", weights.len(), size * size, "N x N")?;
-        if sensor_weights.len() != size * n_inputs {
-            return Err(Error::InvalidNetwork(format!(
-                "sensor_weights has {} values, which is not a multiple of N = {size}; expected N x M",
-                sensor_weights.len()
-            )));
-        }
-        expect_len("state", state.len(), size, "N")?;
-        let net = Network {
+        let state = state.unwrap_or_else(|| vec![0.0; tau.len()]);
+        let params = Params {
+            tau: &tau,
+            theta: &theta,
+            weights: &weights,
+            sensor_weights: &sensor_weights,
+            state: &state,
+        };
+        params.validate()?;
+        let (size, n_inputs) = (params.size(), params.n_inputs());
+        Ok(Network {
             size,
             n_inputs,
             tau,
@@ -78,24 +71,30 @@ impl Network {
             weights,
             sensor_weights,
             state,
-        };
-        net.validate()?;
-        Ok(net)
+        })
     }
 
     /// Checks the values: every one finite and every `tau > 0`.
     pub fn validate(&self) -> Result<()> {
-        check_finite("tau", &self.tau, 0)?;
-        if let Some(i) = self.tau.iter().position(|&t| t <= 0.0) {
-            return Err(Error::InvalidNetwork(format!(
-                "tau[{i}] is {}; every time constant must be > 0",
-                self.tau[i]
-            )));
+        self.params().validate()
+    }
+
+    /// The parameters and state, borrowed.
+    ///
+    /// # Example
+    /// ```
+    /// let net = ctrnn::Network::new(vec![2.0], vec![0.0], vec![1.0], vec![], None)?;
+    /// assert_eq!(net.params().tau, &[2.0]);
+    /// # Ok::<(), ctrnn::Error>(())
+    /// ```
+    pub fn params(&self) -> Params<'_> {
+        Params {
+            tau: &self.tau,
+            theta: &self.theta,
+            weights: &self.weights,
+            sensor_weights: &self.sensor_weights,
+            state: &self.state,
         }
-        check_finite("theta", &self.theta, 0)?;
-        check_finite("weights", &self.weights, self.size)?;
-        check_finite("sensor_weights", &self.sensor_weights, self.n_inputs)?;
-        check_finite("state", &self.state, 0)
     }
 
     /// Number of neurons N.
@@ -150,6 +149,76 @@ impl Network {
     /// Mutable access for the integrator, which keeps values finite only if the inputs are.
     pub(crate) fn state_mut(&mut self) -> &mut [f64] {
         &mut self.state
+    }
+}
+
+/// A network's parameters and state borrowed from elsewhere (stacked arrays, for example), laid
+/// out as [`Network`] holds them, so that a population can be packed without an owned `Network`
+/// per member ([`crate::Population::from_params`]). Nothing is checked until [`validate`](Self::validate).
+#[derive(Clone, Copy, Debug)]
+pub struct Params<'a> {
+    /// Time constants, length N.
+    pub tau: &'a [f64],
+    /// Thresholds, length N.
+    pub theta: &'a [f64],
+    /// Recurrent weights, N x N row-major.
+    pub weights: &'a [f64],
+    /// Sensor weights, N x M row-major.
+    pub sensor_weights: &'a [f64],
+    /// The state v, length N.
+    pub state: &'a [f64],
+}
+
+impl Params<'_> {
+    /// Number of neurons N (the length of `tau`).
+    pub fn size(&self) -> usize {
+        self.tau.len()
+    }
+    /// Number of sensors M (`sensor_weights` over N; 0 for N = 0).
+    pub fn n_inputs(&self) -> usize {
+        self.sensor_weights
+            .len()
+            .checked_div(self.size())
+            .unwrap_or(0)
+    }
+
+    /// Checks what [`Network::new`] checks, with the same messages: at least one neuron, every
+    /// length consistent with N, every value finite and every `tau > 0`.
+    ///
+    /// # Example
+    /// ```
+    /// let p = ctrnn::Params { tau: &[1.0], theta: &[0.0], weights: &[f64::NAN],
+    ///                         sensor_weights: &[], state: &[0.0] };
+    /// assert!(p.validate().unwrap_err().to_string().contains("weights"));
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        let size = self.size();
+        if size == 0 {
+            return Err(Error::InvalidNetwork(
+                "tau is empty; a network needs at least 1 neuron".into(),
+            ));
+        }
+        let n_inputs = self.n_inputs();
+        expect_len("theta", self.theta.len(), size, "N")?;
+        expect_len("weights", self.weights.len(), size * size, "N x N")?;
+        if self.sensor_weights.len() != size * n_inputs {
+            return Err(Error::InvalidNetwork(format!(
+                "sensor_weights has {} values, which is not a multiple of N = {size}; expected N x M",
+                self.sensor_weights.len()
+            )));
+        }
+        expect_len("state", self.state.len(), size, "N")?;
+        check_finite("tau", self.tau, 0)?;
+        if let Some(i) = self.tau.iter().position(|&t| t <= 0.0) {
+            return Err(Error::InvalidNetwork(format!(
+                "tau[{i}] is {}; every time constant must be > 0",
+                self.tau[i]
+            )));
+        }
+        check_finite("theta", self.theta, 0)?;
+        check_finite("weights", self.weights, size)?;
+        check_finite("sensor_weights", self.sensor_weights, n_inputs)?;
+        check_finite("state", self.state, 0)
     }
 }
 

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::integrate::{check_inputs, Integrator, Lanes, Precision, LANES};
 use crate::limits;
-use crate::network::Network;
+use crate::network::{Network, Params};
 use crate::vector::Elem;
 
 /// A block of [`LANES`] networks stepped together.
@@ -40,20 +40,25 @@ pub type Block = Lanes<LANES>;
 /// # Ok::<(), ctrnn::Error>(())
 /// ```
 pub fn pack<E: Elem, N: Borrow<Network>>(networks: &[N]) -> Result<Vec<Lanes<LANES, E>>> {
-    let refs: Vec<&Network> = networks.iter().map(Borrow::borrow).collect();
-    let first = refs
+    let params: Vec<Params> = networks.iter().map(|n| n.borrow().params()).collect();
+    pack_params(&params)
+}
+
+/// [`pack`] from borrowed parameters, which must be valid ([`Params::validate`]).
+fn pack_params<E: Elem>(nets: &[Params]) -> Result<Vec<Lanes<LANES, E>>> {
+    let first = nets
         .first()
         .ok_or_else(|| Error::InvalidArgument("a population needs at least 1 network".into()))?;
     let (n, m) = (first.size(), first.n_inputs());
-    if let Some(p) = refs.iter().position(|x| (x.size(), x.n_inputs()) != (n, m)) {
+    if let Some(p) = nets.iter().position(|x| (x.size(), x.n_inputs()) != (n, m)) {
         return Err(Error::InvalidArgument(format!(
             "network {p} has N = {}, M = {}; every network of a population must have N = {n}, M = {m}",
-            refs[p].size(),
-            refs[p].n_inputs()
+            nets[p].size(),
+            nets[p].n_inputs()
         )));
     }
-    refs.par_chunks(LANES)
-        .map(Lanes::new)
+    nets.par_chunks(LANES)
+        .map(Lanes::from_params)
         .collect::<Result<Vec<_>>>()
 }
 
@@ -106,16 +111,47 @@ impl Population {
         networks: &[N],
         precision: Precision,
     ) -> Result<Self> {
-        let refs: Vec<&Network> = networks.iter().map(Borrow::borrow).collect();
+        let params: Vec<Params> = networks.iter().map(|n| n.borrow().params()).collect();
+        Self::packed(&params, precision)
+    }
+
+    /// A population of networks given by their borrowed parameters (rows of stacked arrays, for
+    /// example), each checked as [`Network::new`] checks it, without an owned [`Network`] per
+    /// member. An invalid member's error names its index: `network 1: tau[0] is -1; ...`.
+    ///
+    /// # Example
+    /// ```
+    /// use ctrnn::{Params, Population, Precision};
+    /// let tau = [1.0, 2.0]; // two networks of one neuron and no sensors
+    /// let rows: Vec<Params> = (0..2)
+    ///     .map(|p| Params { tau: &tau[p..p + 1], theta: &[0.0], weights: &[1.0],
+    ///                       sensor_weights: &[], state: &[0.0] })
+    ///     .collect();
+    /// let pop = Population::from_params(&rows, Precision::F64)?;
+    /// assert_eq!((pop.len(), pop.size(), pop.n_inputs()), (2, 1, 0));
+    /// # Ok::<(), ctrnn::Error>(())
+    /// ```
+    pub fn from_params(networks: &[Params], precision: Precision) -> Result<Self> {
+        for (p, net) in networks.iter().enumerate() {
+            net.validate().map_err(|e| match e {
+                Error::InvalidNetwork(m) => Error::InvalidNetwork(format!("network {p}: {m}")),
+                other => other,
+            })?;
+        }
+        Self::packed(networks, precision)
+    }
+
+    /// Packs valid `networks` in `precision`.
+    fn packed(networks: &[Params], precision: Precision) -> Result<Self> {
         let blocks = match precision {
-            Precision::F64 => Blocks::F64(pack(&refs)?),
-            Precision::F32 => Blocks::F32(pack(&refs)?),
+            Precision::F64 => Blocks::F64(pack_params(networks)?),
+            Precision::F32 => Blocks::F32(pack_params(networks)?),
         };
-        let (n, m) = (refs[0].size(), refs[0].n_inputs());
+        let (n, m) = (networks[0].size(), networks[0].n_inputs());
         Ok(Population {
             size: n,
             n_inputs: m,
-            len: refs.len(),
+            len: networks.len(),
             blocks,
         })
     }

@@ -15,7 +15,27 @@ use crate::network::{integrator, net_err};
 /// Extracts a population: a sequence of Networks, or a dict of stacked parameter arrays.
 pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
     if let Ok(d) = obj.cast::<PyDict>() {
-        return stacked(d);
+        return stacked(d)?
+            .rows()
+            .iter()
+            .enumerate()
+            .map(|(p, row)| {
+                let own = |x: &[f64]| x.to_vec();
+                ctrnn::Network::new(
+                    own(row.tau),
+                    own(row.theta),
+                    own(row.weights),
+                    own(row.sensor_weights),
+                    Some(own(row.state)),
+                )
+                .map_err(|e| {
+                    net_err(format!(
+                        "network {p}: {}",
+                        e.to_string().trim_start_matches("invalid network: ")
+                    ))
+                })
+            })
+            .collect();
     }
     Ok(network_objects(obj)?
         .iter()
@@ -24,10 +44,10 @@ pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
 }
 
 /// Packs a population for the integrator straight from its Python form (as [`networks_from`]),
-/// without copying each `Network` first, to compute in `precision`.
+/// without an owned `Network` per member, to compute in `precision`.
 fn population_from(obj: &Bound<'_, PyAny>, precision: Precision) -> PyResult<Population> {
     if let Ok(d) = obj.cast::<PyDict>() {
-        return Population::with_precision(&stacked(d)?, precision).py_err();
+        return Population::from_params(&stacked(d)?.rows(), precision).py_err();
     }
     let objects = network_objects(obj)?;
     let refs: Vec<&ctrnn::Network> = objects.iter().map(|net| &net.inner).collect();
@@ -62,9 +82,41 @@ fn network_objects<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Vec<PyRef<'py, PyNe
     Ok(nets)
 }
 
+/// A population as stacked arrays, shapes checked, values not yet.
+struct Stacked {
+    tau: Dense,
+    theta: Dense,
+    weights: Dense,
+    sensor: Dense,
+    /// The given states, or zeros.
+    state: Vec<f64>,
+    len: usize,
+    n: usize,
+    m: usize,
+}
+
+impl Stacked {
+    /// Each network's parameters, borrowed.
+    fn rows(&self) -> Vec<ctrnn::Params<'_>> {
+        let (n, m) = (self.n, self.m);
+        fn row(x: &[f64], p: usize, len: usize) -> &[f64] {
+            &x[p * len..(p + 1) * len]
+        }
+        (0..self.len)
+            .map(|p| ctrnn::Params {
+                tau: row(&self.tau.data, p, n),
+                theta: row(&self.theta.data, p, n),
+                weights: row(&self.weights.data, p, n * n),
+                sensor_weights: row(&self.sensor.data, p, n * m),
+                state: row(&self.state, p, n),
+            })
+            .collect()
+    }
+}
+
 /// A population from stacked arrays: tau (P, N), theta (P, N), weights (P, N, N),
 /// sensor_weights (P, N, M) and optionally state (P, N).
-fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
+fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Stacked> {
     const KEYS: [&str; 5] = ["tau", "theta", "weights", "sensor_weights", "state"];
     for key in d.keys() {
         let name = key.str()?.to_string();
@@ -114,24 +166,16 @@ fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Vec<ctrnn::Network>> {
     if let Some(s) = &state {
         check(s, "state", &[p_len, n])?;
     }
-    (0..p_len)
-        .map(|p| {
-            let row = |x: &Dense, len: usize| x.data[p * len..(p + 1) * len].to_vec();
-            ctrnn::Network::new(
-                row(&tau, n),
-                row(&theta, n),
-                row(&weights, n * n),
-                row(&sensor, n * m),
-                state.as_ref().map(|s| row(s, n)),
-            )
-            .map_err(|e| {
-                net_err(format!(
-                    "network {p}: {}",
-                    e.to_string().trim_start_matches("invalid network: ")
-                ))
-            })
-        })
-        .collect()
+    Ok(Stacked {
+        tau,
+        theta,
+        weights,
+        sensor,
+        state: state.map_or_else(|| vec![0.0; p_len * n], |s| s.data),
+        len: p_len,
+        n,
+        m,
+    })
 }
 
 /// Integrates P networks of the same N and M together, each through the same `inputs` (T, M)

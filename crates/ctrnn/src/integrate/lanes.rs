@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::error::{Error, Result};
 use crate::math::sigmoid_of;
-use crate::network::Network;
+use crate::network::{Network, Params};
 use crate::rows::Rows;
 use crate::simd::{self, Kernel};
 #[cfg(target_arch = "x86_64")]
@@ -118,6 +118,12 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
     /// Packs up to `L` networks of the same shape. Unused lanes repeat the first network, so they
     /// stay finite; their results are ignored.
     pub fn new(nets: &[&Network]) -> Result<Self> {
+        let params: Vec<Params> = nets.iter().map(|net| net.params()).collect();
+        Self::from_params(&params)
+    }
+
+    /// [`new`](Self::new) from borrowed parameters, which must be valid ([`Params::validate`]).
+    pub(crate) fn from_params(nets: &[Params]) -> Result<Self> {
         let first = nets.first().ok_or_else(|| {
             Error::InvalidArgument("a population needs at least 1 network".into())
         })?;
@@ -138,7 +144,7 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
             }
         }
         // Row r of an array holds value order[r] of every network; padding lanes repeat the first.
-        let gather = |get: fn(&Network) -> &[f64], order: &[usize]| {
+        let gather = |get: for<'p> fn(&Params<'p>) -> &'p [f64], order: &[usize]| {
             let mut rows = Rows::<L, E>::zeros(order.len());
             for l in 0..L {
                 let source = get(nets.get(l).unwrap_or(first));
@@ -156,11 +162,11 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
             size: n,
             n_inputs: m,
             len: nets.len(),
-            tau: gather(Network::tau, &neurons),
-            theta: gather(Network::theta, &neurons),
-            weights: gather(Network::weights, &weights),
-            sensor_weights: gather(Network::sensor_weights, &sensors),
-            state: gather(Network::state, &neurons),
+            tau: gather(|p| p.tau, &neurons),
+            theta: gather(|p| p.theta, &neurons),
+            weights: gather(|p| p.weights, &weights),
+            sensor_weights: gather(|p| p.sensor_weights, &sensors),
+            state: gather(|p| p.state, &neurons),
             scratch: Scratch {
                 dt: f64::NAN,
                 h: zeros(n),

@@ -1,6 +1,6 @@
 use ctrnn::integrate::{Integrator, Method, Precision};
 use ctrnn::population::*;
-use ctrnn::Network;
+use ctrnn::{Network, Params};
 use proptest::prelude::*;
 
 fn arb_network(n: usize, m: usize) -> impl Strategy<Value = Network> {
@@ -61,6 +61,76 @@ proptest! {
             prop_assert!(single.state().iter().zip(mine).all(|(a, b)| a.to_bits() == b.to_bits()));
         }
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    #[test]
+    fn a_population_of_borrowed_parameters_is_the_population_of_its_networks(
+        (nets, inputs, steps, rk4) in arb_population(),
+        f32 in any::<bool>(),
+    ) {
+        let precision = if f32 { Precision::F32 } else { Precision::F64 };
+        let integ = Integrator { method: if rk4 { Method::Rk4 } else { Method::Euler }, ..Integrator::default() };
+        let params: Vec<Params> = nets.iter().map(Network::params).collect();
+        let run = |mut pop: Population| pop.run(Inputs::PerNetwork(&inputs), steps, &integ, true, None).unwrap();
+        let owned = run(Population::with_precision(&nets, precision).unwrap());
+        let borrowed = run(Population::from_params(&params, precision).unwrap());
+        prop_assert_eq!(
+            owned.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            borrowed.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+    }
+}
+
+#[test]
+fn an_invalid_member_of_borrowed_parameters_is_named_with_its_index() {
+    let ok = Network::new(vec![1.0], vec![0.0], vec![0.5], vec![], None).unwrap();
+    let cases: [(Params, &str); 4] = [
+        (
+            Params {
+                tau: &[-1.0],
+                ..ok.params()
+            },
+            "network 1: tau[0] is -1; every time constant must be > 0",
+        ),
+        (
+            Params {
+                weights: &[f64::NAN],
+                ..ok.params()
+            },
+            "network 1: weights[0][0] is NaN",
+        ),
+        (
+            Params {
+                theta: &[],
+                ..ok.params()
+            },
+            "network 1: theta has 0 values; expected N = 1",
+        ),
+        (
+            Params {
+                tau: &[],
+                ..ok.params()
+            },
+            "network 1: tau is empty; a network needs at least 1 neuron",
+        ),
+    ];
+    for (bad, message) in cases {
+        let err = Population::from_params(&[ok.params(), bad], Precision::F64).unwrap_err();
+        assert!(err.to_string().contains(message), "{err} lacks {message}");
+        // Each message is the one Network::new gives, with the member's index.
+        let own = Network::new(
+            bad.tau.to_vec(),
+            bad.theta.to_vec(),
+            bad.weights.to_vec(),
+            bad.sensor_weights.to_vec(),
+            Some(bad.state.to_vec()),
+        )
+        .unwrap_err();
+        assert_eq!(err.to_string().replace("network 1: ", ""), own.to_string());
+    }
+    assert!(Population::from_params(&[], Precision::F64).is_err());
 }
 
 #[test]

@@ -15,8 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import inspect
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -25,6 +24,7 @@ import numpy.typing as npt
 from dnnevo import _core
 from dnnevo.closedloop.environment import Environment
 from dnnevo.closedloop.loop import DEFAULT_INTEGRATOR, FLAGS, Rollout, as_flags, rollout
+from dnnevo.closedloop.source import fingerprint, plain_source, task_source
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
 from dnnevo.errors import ConfigError, TaskError
 
@@ -105,15 +105,13 @@ class ClosedLoop:
             module, _, qualname = name.removeprefix(PYTHON_TASK).rpartition(".")
         self.__module__, self.__qualname__ = module, qualname
         try:
-            source = inspect.getsource(kind)
-        except (OSError, TypeError):
-            source = kind.__qualname__
-        try:
             attributes = vars(env)
         except TypeError:  # a class with __slots__
             attributes = {k: getattr(env, k) for k in getattr(kind, "__slots__", ()) if hasattr(env, k)}
-        recorded = self._recorded()
-        self.fitness_source = "\n".join([source, fingerprint(attributes), fingerprint(recorded)])
+        settings = [fingerprint(attributes), fingerprint(self._recorded())]
+        self.fitness_source = "\n".join([task_source(kind) or kind.__qualname__, *settings])
+        # Made before digests took in what the class reads from its module (source.py).
+        self._legacy_source = "\n".join([plain_source(kind) or kind.__qualname__, *settings])
 
     def _recorded(self) -> dict[str, Any]:
         """The settings a run records: the rollout's (its precision only when ``"f32"``), the
@@ -131,6 +129,12 @@ class ClosedLoop:
     def digest(self) -> str:
         """SHA-256 of :attr:`fitness_source`, as ``config.toml``'s ``fitness_sha256`` records it."""
         return hashlib.sha256(self.fitness_source.encode()).hexdigest()
+
+    def digests(self) -> tuple[str, ...]:
+        """Every digest a run of this task may record: :meth:`digest`, and the one runs recorded
+        before digests took in what the class reads from its module (which they then could not
+        check)."""
+        return (self.digest(), hashlib.sha256(self._legacy_source.encode()).hexdigest())
 
     def configured(self, config: EvolutionConfig) -> EvolutionConfig:
         """``config`` saying what this fitness function runs: its name as ``task``, the rollout's
@@ -226,25 +230,4 @@ class ClosedLoop:
     def __repr__(self) -> str:
         settings = ", ".join(f"{k}={v!r}" for k, v in self._recorded().items())
         return f"ClosedLoop({type(self.env).__name__}(), {settings})"
-
-
-def fingerprint(value: Any) -> str:
-    """An exact text of ``value`` for the digest: numbers by ``repr`` (exact for floats), arrays
-    by dtype, shape and a hash of their bytes, containers item by item, and any other object by
-    its type alone (an address or a random generator's state would change from run to run)."""
-    if value is None or isinstance(value, bool | int | float | complex | str | bytes):
-        return repr(value)
-    if isinstance(value, np.generic):
-        return f"{value.dtype}:{value.item()!r}"
-    if isinstance(value, np.ndarray):
-        data = np.ascontiguousarray(value)
-        if data.dtype.hasobject:
-            return f"ndarray[{data.dtype}, {data.shape}]"
-        return f"ndarray[{data.dtype}, {data.shape}, {hashlib.sha256(data.tobytes()).hexdigest()}]"
-    if isinstance(value, list | tuple):
-        return f"{type(value).__name__}[{', '.join(fingerprint(v) for v in value)}]"
-    if isinstance(value, Mapping):
-        items = sorted((repr(k), fingerprint(v)) for k, v in value.items())
-        return "{" + ", ".join(f"{k}: {v}" for k, v in items) + "}"
-    return f"<{type(value).__module__}.{type(value).__qualname__}>"
 

@@ -27,6 +27,7 @@ from dnnevo import _core, presets
 from dnnevo._checks import nonnegative
 from dnnevo.closedloop import named
 from dnnevo.closedloop.fitness import ClosedLoop
+from dnnevo.closedloop.source import plain_source, task_source
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError, InvalidArgumentError, did_you_mean
 from dnnevo.evolution.ga import GeneticAlgorithm, Validate, founders_argument
@@ -248,10 +249,11 @@ def resume(
                                   f"precision={ga.config.precision!r})")
             fitness = task
             name = task if isinstance(task, str) else _python_task_name(task)
-            digest = None if isinstance(task, str) else _fitness_digest(task)
+            digests = () if isinstance(task, str) else _fitness_digests(task)
+            digest = digests[0] if digests else None
             # Same name, other source: a different function all the same.
-            edited = digest is not None and table.get("fitness_sha256", digest) != digest
-            if not edited and _moved(task, name, ga.config.task, digest, table):
+            edited = digest is not None and table.get("fitness_sha256", digest) not in digests
+            if not edited and _moved(task, name, ga.config.task, digests, table):
                 name = ga.config.task  # the same source, imported from another module
             if name != ga.config.task or edited:
                 if not new_fitness:
@@ -292,14 +294,14 @@ def _named_fitness(run: RunDir, config: EvolutionConfig, table: Mapping[str, Any
                           "with, or with new_fitness=True") from None
 
 
-def _moved(task: FitnessFn, name: str, recorded: str, digest: str | None,
+def _moved(task: FitnessFn, name: str, recorded: str, digests: tuple[str, ...],
            table: Mapping[str, Any]) -> bool:
     """Whether a fitness function named ``name`` is the run's own (``recorded``) under another
     name: the same source digest, and either the same environment class (a task class reached
     through another module) or one of the two names a script's (``__main__``) with the same
     qualified name after the module. A run started by ``python light.py`` then resumes from a
     script that does ``from light import ...``."""
-    if digest is None or table.get("fitness_sha256") != digest:
+    if table.get("fitness_sha256") not in digests:
         return False
     if not (name.startswith(PYTHON_TASK) and recorded.startswith(PYTHON_TASK)):
         return False
@@ -391,18 +393,27 @@ def _validation(task: str | FitnessFn, ga: GeneticAlgorithm) -> Validate | None:
 
 
 def _fitness_digest(task: FitnessFn) -> str | None:
-    """SHA-256 of a Python fitness function's source, so that resume can tell an edited function
-    from the run's own; None when Python cannot find the source (e.g. typed at a prompt). A
-    callable object can say what identifies it in a ``fitness_source`` text (as
-    :class:`dnnevo.closedloop.ClosedLoop` does: its environment's source and settings)."""
+    """SHA-256 of a Python fitness function's source and of what it reads from its module
+    (:mod:`dnnevo.closedloop.source`), so that resume can tell an edited function from the run's
+    own; None when Python cannot find the source (e.g. typed at a prompt). A callable object can
+    say what identifies it in a ``fitness_source`` text (as :class:`dnnevo.closedloop.ClosedLoop`
+    does: its environment's source and settings)."""
+    digests = _fitness_digests(task)
+    return digests[0] if digests else None
+
+
+def _fitness_digests(task: FitnessFn) -> tuple[str, ...]:
+    """Every digest a run of ``task`` may record: :func:`_fitness_digest`'s, then the one of
+    runs made before digests took in what the function reads from its module; none when Python
+    cannot find the source."""
+    if callable(own := getattr(task, "digests", None)):
+        return tuple(own())
     if isinstance(given := getattr(task, "fitness_source", None), str):
-        return hashlib.sha256(given.encode()).hexdigest()
+        return (hashlib.sha256(given.encode()).hexdigest(),)
     target = task if inspect.isfunction(task) or inspect.ismethod(task) else type(task)
-    try:
-        source = inspect.getsource(target)
-    except (OSError, TypeError):
-        return None
-    return hashlib.sha256(source.encode()).hexdigest()
+    target = getattr(target, "__func__", target)
+    texts = (task_source(target), plain_source(target))
+    return tuple(hashlib.sha256(t.encode()).hexdigest() for t in texts if t is not None)
 
 
 def _run_table(seed: int) -> dict[str, Any]:

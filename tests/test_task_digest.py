@@ -1,0 +1,168 @@
+"""A Python task's digest (``fitness_sha256``) covers what the task reads from its module, so an
+edited constant is an edited task; an ``analysis`` attribute is not part of it; and the digests
+that runs recorded before (the class's or function's source alone) are still accepted."""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import inspect
+import sys
+
+import pytest
+
+import dnnevo
+from dnnevo import ConfigError
+from dnnevo.closedloop import ClosedLoop
+from dnnevo.closedloop.source import plain_source, task_source
+
+MODULE = '''
+import numpy as np
+
+SPEED = 0.1
+LIMITS = {"far": 5.0}
+UNUSED = 7
+
+
+def towards(light, x):
+    return np.sign(light - x)[:, None]
+
+
+def unrelated():
+    return UNUSED
+
+
+class Seeker:
+    observation_size = 1
+    success_rate = 0.9
+
+    def reset(self, episodes, rng):
+        self.light = rng.uniform(-LIMITS["far"], LIMITS["far"], size=len(episodes))
+        self.x = np.zeros(len(episodes))
+        return towards(self.light, self.x)
+
+    def step(self, rates, active):
+        self.x += SPEED * (rates[:, 1] - rates[:, 0])
+        distance = np.abs(self.light - self.x)
+        return towards(self.light, self.x), -distance, distance < 0.05
+
+    def success(self, returns, lengths):
+        return lengths < 50
+
+
+def fitness(networks):
+    return np.full(len(networks), SPEED)
+'''
+
+ANALYSIS = '''    analysis = Analysis(input_names=["light"], conditions={"dark": [0.0]},
+                        main_input=0, output_neuron=0)
+'''
+
+
+def load(tmp_path, name: str, text: str):
+    """Writes ``text`` as module ``name`` in ``tmp_path`` and imports it afresh."""
+    (tmp_path / f"{name}.py").write_text(text)
+    sys.path.insert(0, str(tmp_path))
+    try:
+        sys.modules.pop(name, None)
+        importlib.invalidate_caches()
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(str(tmp_path))
+
+
+def test_the_text_holds_the_constants_and_functions_the_task_reads_and_nothing_else(tmp_path) -> None:
+    module = load(tmp_path, "digest_reads", MODULE)
+    text = task_source(module.Seeker)
+    assert text.startswith("class Seeker:")
+    assert "# SPEED\n0.1" in text and "# LIMITS\n{'far': 5.0}" in text
+    assert "# towards\ndef towards" in text
+    assert "UNUSED" not in text and "unrelated" not in text and "import numpy" not in text
+    assert "# SPEED\n0.1" in task_source(module.fitness)
+
+
+@pytest.mark.parametrize("edit, seeker_changes, fitness_changes", [
+    (("SPEED = 0.1", "SPEED = 0.25"), True, True),
+    (('LIMITS = {"far": 5.0}', 'LIMITS = {"far": 6.0}'), True, False),
+    (("return np.sign(light - x)[:, None]", "return np.sign(x - light)[:, None]"), True, False),
+    (("UNUSED = 7", "UNUSED = 8"), False, False),
+    (("return UNUSED", "return UNUSED + 1"), False, False),
+])
+def test_an_edit_of_what_the_task_reads_changes_its_digest_and_no_other_edit_does(
+        tmp_path, edit, seeker_changes, fitness_changes) -> None:
+    before = load(tmp_path, "digest_edit_a", MODULE)
+    after = load(tmp_path, "digest_edit_b", MODULE.replace(*edit))
+    for task, changes in (("Seeker", seeker_changes), ("fitness", fitness_changes)):
+        old, new = (task_source(getattr(m, task)) for m in (before, after))
+        assert (old != new) == changes, (edit, task)
+
+
+def test_an_analysis_attribute_is_not_part_of_the_task(tmp_path) -> None:
+    plain = load(tmp_path, "digest_plain", MODULE)
+    declared = MODULE.replace("    success_rate = 0.9\n", "    success_rate = 0.9\n" + ANALYSIS)
+    declared = declared.replace("import numpy as np\n",
+                                "import numpy as np\nfrom dnnevo.tasks.protocol import Analysis\n", 1)
+    with_analysis = load(tmp_path, "digest_analysis", declared)
+    assert with_analysis.Seeker.analysis.main_input == 0
+    assert task_source(with_analysis.Seeker) == task_source(plain.Seeker)
+    assert plain_source(with_analysis.Seeker) != plain_source(plain.Seeker)
+
+
+def test_a_run_of_a_task_class_refuses_an_edited_constant_and_keeps_an_added_analysis(tmp_path) -> None:
+    original = load(tmp_path, "digest_run", MODULE)
+    config = dnnevo.EvolutionConfig(population=12, generations=2, size=3, n_inputs=1, selection="rank")
+    out = tmp_path / "run"
+    dnnevo.evolve(ClosedLoop(original.Seeker(), episodes=2, max_steps=50), config, out=out, progress=False)
+    declared = MODULE.replace("    success_rate = 0.9\n", "    success_rate = 0.9\n" + ANALYSIS).replace(
+        "import numpy as np\n", "import numpy as np\nfrom dnnevo.tasks.protocol import Analysis\n", 1)
+    analysed = load(tmp_path, "digest_run", declared)
+    result = dnnevo.resume(out, ClosedLoop(analysed.Seeker(), episodes=2, max_steps=50),
+                           generations=3, progress=False)
+    assert len(result.history["best"]) == 3
+    edited = load(tmp_path, "digest_run", declared.replace("SPEED = 0.1", "SPEED = 0.25"))
+    with pytest.raises(ConfigError, match="not an edited python:digest_run.Seeker"):
+        dnnevo.resume(out, ClosedLoop(edited.Seeker(), episodes=2, max_steps=50), generations=4,
+                      progress=False)
+
+
+def test_a_run_of_a_fitness_function_refuses_an_edited_constant(tmp_path) -> None:
+    original = load(tmp_path, "digest_function", MODULE)
+    config = dnnevo.EvolutionConfig(population=12, generations=2, size=2, n_inputs=1, selection="rank")
+    out = tmp_path / "run"
+    dnnevo.evolve(original.fitness, config, out=out, progress=False)
+    edited = load(tmp_path, "digest_function", MODULE.replace("SPEED = 0.1", "SPEED = 0.25"))
+    with pytest.raises(ConfigError, match="not an edited python:digest_function.fitness"):
+        dnnevo.resume(out, edited.fitness, generations=3, progress=False)
+
+
+def test_runs_that_recorded_the_source_alone_are_still_accepted(tmp_path) -> None:
+    module = load(tmp_path, "digest_legacy", MODULE)
+    config = dnnevo.EvolutionConfig(population=12, generations=2, size=2, n_inputs=1, selection="rank")
+    for task, target in ((module.fitness, module.fitness),
+                         (ClosedLoop(module.Seeker(), episodes=2, max_steps=50), module.Seeker)):
+        out = tmp_path / f"run-{target.__name__}"
+        size = 3 if target is module.Seeker else 2
+        dnnevo.evolve(task, dataclasses_replace(config, size=size), out=out, progress=False)
+        toml = out / "config.toml"
+        recorded = toml.read_text()
+        current = next(line for line in recorded.splitlines() if line.startswith("fitness_sha256"))
+        legacy = legacy_digest(task, target)
+        assert legacy not in current
+        toml.write_text(recorded.replace(current, f'fitness_sha256 = "{legacy}"'))
+        checkpoint = out / "checkpoint.json"
+        checkpoint.write_text(checkpoint.read_text().replace(current.split('"')[1], legacy))
+        result = dnnevo.resume(out, task, generations=3, progress=False)
+        assert len(result.history["best"]) == 3
+
+
+def dataclasses_replace(config, **changes):
+    import dataclasses
+    return dataclasses.replace(config, **changes)
+
+
+def legacy_digest(task, target) -> str:
+    """The digest a run made before recorded: the source alone (and, for a task class, the
+    environment's attributes and the rollout's settings, as now)."""
+    if isinstance(task, ClosedLoop):
+        return task.digests()[1]
+    return hashlib.sha256(inspect.getsource(target).encode()).hexdigest()

@@ -25,11 +25,15 @@ def make(n: int = 3, m: int = 2, seed: int = 0) -> dnnevo.Network:
     )
 
 
-def test_properties_are_numpy_copies() -> None:
+def test_properties_are_read_only_numpy_copies() -> None:
     net = make()
     assert (net.size, net.n_inputs) == (3, 2)
     assert net.weights.shape == (3, 3) and net.sensor_weights.shape == (3, 2)
-    w = net.weights
+    # Writing to one fails loudly rather than changing nothing; a copy of it is the user's.
+    for name in ("tau", "theta", "weights", "sensor_weights", "state", "outputs"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(net, name)[0] = 123.0
+    w = net.weights.copy()
     w[0, 0] = 123.0
     assert net.weights[0, 0] != 123.0
     assert np.array_equal(net.state, np.zeros(3))

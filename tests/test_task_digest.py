@@ -9,6 +9,7 @@ import importlib
 import inspect
 import sys
 
+import numpy as np
 import pytest
 
 import dnnevo
@@ -166,3 +167,19 @@ def legacy_digest(task, target) -> str:
     if isinstance(task, ClosedLoop):
         return task.digests()[1]
     return hashlib.sha256(inspect.getsource(target).encode()).hexdigest()
+
+
+@pytest.mark.parametrize("setting, message", [
+    (dict(max_steps=0), "max_steps is 0; expected a whole number, at least 1"),
+    (dict(max_steps=-1), "max_steps is -1; expected a whole number, at least 1"),
+    (dict(max_steps=10, episodes=0), "episodes is 0; expected a whole number, at least 1"),
+    (dict(max_steps=10, substeps=0), "substeps is 0; it must be >= 1"),
+    (dict(max_steps=10, dt=-0.1), "dt is -0.1; it must be finite and > 0"),
+    (dict(max_steps=10, method="rk5"), 'method is "rk5"; expected "euler" or "rk4"'),
+])
+def test_a_closed_loop_with_bad_settings_is_refused_when_made(tmp_path, setting, message) -> None:
+    module = load(tmp_path, "digest_settings", MODULE)
+    with pytest.raises(dnnevo.DnnevoError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        ClosedLoop(module.Seeker(), **setting)
+    assert np.isfinite(ClosedLoop(module.Seeker(), max_steps=10)(
+        [dnnevo.Network.random(3, 1, seed=0)])).all()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import inspect
 import json
 import math
 import tomllib
@@ -46,6 +47,25 @@ def with_later_defaults(stored: Any) -> Any:
     return {**{name: _DEFAULTS[name] for name in LATER_SETTINGS}, **stored}
 
 
+def _known_keywords(cls: type) -> type:
+    """``cls`` (a dataclass) whose constructor names a misspelt keyword in a
+    :class:`~dnnevo.ConfigError`, with the closest setting, instead of Python's TypeError."""
+    init = cls.__init__  # type: ignore[misc]
+    names = [f.name for f in fields(cls)]
+
+    def checked(self: Any, *args: Any, **kwargs: Any) -> None:
+        for key in kwargs:
+            if key not in names:
+                hint = did_you_mean(key, names) or f"; its settings: {', '.join(names)}"
+                raise ConfigError(f"{cls.__name__} has no setting {key!r}{hint}")
+        init(self, *args, **kwargs)
+
+    checked.__doc__, checked.__signature__ = init.__doc__, inspect.signature(init)  # type: ignore[attr-defined]
+    cls.__init__ = checked  # type: ignore[misc]
+    return cls
+
+
+@_known_keywords
 @dataclass(frozen=True)
 class Ranges:
     """Allowed interval of each parameter kind; genes are drawn and resampled uniformly in it."""
@@ -70,6 +90,7 @@ class Ranges:
 PYTHON_TASK = "python:"
 
 
+@_known_keywords
 @dataclass(frozen=True)
 class IntegratorConfig:
     """How networks are integrated: each input row is held for ``substeps`` steps of ``dt``."""
@@ -85,6 +106,7 @@ class IntegratorConfig:
         _check_type(self, "substeps", int, "integrator.")
 
 
+@_known_keywords
 @dataclass(frozen=True)
 class EvolutionConfig:
     """Everything an evolution run needs besides its seed.

@@ -332,8 +332,10 @@ def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -
     try:
         preset = PRESETS[name]
     except KeyError:
-        raise ConfigError(f"unknown preset {name!r}{did_you_mean(name, names())}; "
-                          f"presets: {', '.join(names())}") from None
+        hint = did_you_mean(name, names())
+        if not hint and "." in name:  # module.Class: a task written in Python
+            hint = f" (a task written in Python is named {PYTHON_TASK}{name})"
+        raise ConfigError(f"unknown preset {name!r}{hint}; presets: {', '.join(names())}") from None
     config = preset.config
     if quick:
         config = EvolutionConfig.from_dict({**config.to_dict(), **preset.quick})

@@ -76,6 +76,18 @@ pub fn to_numpy<'py>(
     PyArray1::from_vec(py, data).reshape(shape.to_vec())
 }
 
+/// [`to_numpy`], read-only: a copy of a value the caller cannot change through it, so that
+/// writing to it fails loudly instead of changing nothing.
+pub fn to_numpy_read_only<'py>(
+    py: Python<'py>,
+    data: Vec<f64>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let array = to_numpy(py, data, shape)?;
+    array.getattr("flags")?.setattr("writeable", false)?;
+    Ok(array)
+}
+
 /// The error for a malformed argument that is not a network parameter.
 pub fn arg_err(msg: String) -> PyErr {
     InvalidArgumentError::new_err(msg)

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict, PyTuple};
 use serde_json::{Map, Value};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, uint, AnyInt, Dense};
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, to_numpy_read_only, uint, AnyInt, Dense};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FormatError, IntoPy, InvalidNetworkError};
 use crate::pyjson::{dict_to_map, json_to_py};
@@ -217,34 +217,34 @@ impl PyNetwork {
     /// Time constants, shape (N,).
     #[getter]
     fn tau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        to_numpy(py, self.inner.tau().to_vec(), &[self.inner.size()])
+        to_numpy_read_only(py, self.inner.tau().to_vec(), &[self.inner.size()])
     }
     /// Thresholds, shape (N,).
     #[getter]
     fn theta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        to_numpy(py, self.inner.theta().to_vec(), &[self.inner.size()])
+        to_numpy_read_only(py, self.inner.theta().to_vec(), &[self.inner.size()])
     }
     /// Weights, shape (N, N); `weights[i][j]` is from neuron j to neuron i.
     #[getter]
     fn weights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let n = self.inner.size();
-        to_numpy(py, self.inner.weights().to_vec(), &[n, n])
+        to_numpy_read_only(py, self.inner.weights().to_vec(), &[n, n])
     }
     /// Sensor weights, shape (N, M).
     #[getter]
     fn sensor_weights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let shape = [self.inner.size(), self.inner.n_inputs()];
-        to_numpy(py, self.inner.sensor_weights().to_vec(), &shape)
+        to_numpy_read_only(py, self.inner.sensor_weights().to_vec(), &shape)
     }
     /// The state v, shape (N,).
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        to_numpy(py, self.inner.state().to_vec(), &[self.inner.size()])
+        to_numpy_read_only(py, self.inner.state().to_vec(), &[self.inner.size()])
     }
     /// Firing rates f(v - theta) of the current state, shape (N,).
     #[getter]
     fn outputs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        to_numpy(py, self.inner.outputs(), &[self.inner.size()])
+        to_numpy_read_only(py, self.inner.outputs(), &[self.inner.size()])
     }
     /// The `meta` object of the file the network came from (a copy).
     #[getter]

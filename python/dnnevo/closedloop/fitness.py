@@ -85,6 +85,13 @@ class ClosedLoop:
                 or validation_episodes < 1:
             raise ConfigError(f"validation_episodes is {validation_episodes!r}; expected a whole "
                               "number of episodes, at least 1")
+        for key, value in (("episodes", episodes), ("max_steps", max_steps)):
+            if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+                raise ConfigError(f"{key} is {value!r}; expected a whole number, at least 1")
+        # The integration's settings are checked where they are used, by the binding.
+        integration: dict[str, Any] = dict(dt=dt, substeps=substeps, method=method)
+        _core.Batch([_core.Network(tau=[1.0], theta=[0.0], weights=[[0.0]], sensor_weights=[[]])],
+                    replicas=1, **integration)
         self.env = env
         if precision not in ("f64", "f32"):
             raise ConfigError(f"precision is {precision!r}; expected 'f64' or 'f32'")

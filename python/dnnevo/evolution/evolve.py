@@ -115,6 +115,20 @@ def evaluate(
     )
 
 
+def _check_task(task: object) -> None:
+    """A :class:`~dnnevo.ConfigError` unless ``task`` is a name or a callable; it names an
+    environment passed without its :class:`~dnnevo.closedloop.ClosedLoop`."""
+    if isinstance(task, str) or callable(task):
+        return
+    kind = type(task).__name__
+    environment = all(callable(getattr(task, m, None)) for m in ("reset", "step"))
+    raise ConfigError(
+        f"task has type {kind}; expected a task or preset name, a fitness function "
+        "fitness(networks) -> array, or a ClosedLoop"
+        + (f" ({kind} looks like an environment: wrap it, ClosedLoop({kind}(...), max_steps=...))"
+           if environment else ""))
+
+
 def _task_config(task: str, config: EvolutionConfig | None) -> EvolutionConfig:
     """The config for a built-in task name or preset name."""
     if task not in presets.names() and task not in _core.task_names():
@@ -161,6 +175,7 @@ def evolve(
     ``seeds``, its old name, is deprecated). ``run_info`` adds entries to the ``[run]`` table of
     ``config.toml``, e.g. where the founders came from.
     """
+    _check_task(task)
     if isinstance(task, str) and task in presets.names() and named.is_python_task(presets.get(task).task):
         config = _task_config(task, config)  # a preset of a task written in Python
         task = config.task
@@ -222,6 +237,8 @@ def resume(
     by a killed write are removed, and a successful resume leaves best.json, log.csv, config.toml
     and the checkpoint in agreement.
     """
+    if task is not None:
+        _check_task(task)
     run = RunDir(run_dir)
     with run.writing(create=False):
         run.remove_stale()
@@ -497,7 +514,11 @@ def _loop(
                         scores = task(networks, generation=ga.generation, seed=ga.seed)
                     else:
                         scores = task(networks)
-                    fitness = np.asarray(scores, dtype=np.float64)
+                    try:
+                        fitness = np.asarray(scores, dtype=np.float64)
+                    except (TypeError, ValueError) as e:
+                        raise FitnessError(f"the fitness function returned values that are not "
+                                           f"numbers ({type(e).__name__}: {e})") from None
                     if fitness.shape != (config.population,):
                         raise FitnessError(
                             f"the fitness function returned shape {fitness.shape}; "

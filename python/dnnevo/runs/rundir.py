@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo._core import Network
-from dnnevo.config import EvolutionConfig
+from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FormatError, WriteError
 from dnnevo.runs.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint
 from dnnevo.runs.files import (FILE_MODE, RunFileError, checked, fail, load_json, read_json, read_text,
@@ -172,10 +172,23 @@ class RunDir:
         if contents:
             raise DnnevoError(self._occupied(contents))
 
+    def _resume_command(self) -> str:
+        """How to resume the run here: from Python when it was evolved with a fitness function
+        the command line cannot build (``resume`` says the same)."""
+        try:
+            stored = tomllib.loads(self.config.read_text())
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+            stored = {}
+        task, params = stored.get("task"), stored.get("task_params")
+        if isinstance(task, str) and task.startswith(PYTHON_TASK) and \
+                not (isinstance(params, Mapping) and "max_steps" in params):
+            return f"dnnevo.resume({str(self.path)!r}, task=fitness) from Python"
+        return f"'dnnevo resume {self.path}'"
+
     def _occupied(self, contents: list[Path]) -> str:
         names = sorted(p.name for p in contents)
         if "checkpoint.json" in names or "config.toml" in names:
-            what = f"it holds a run: resume it with 'dnnevo resume {self.path}'"
+            what = f"it holds a run: resume it with {self._resume_command()}"
         elif "sweep.json" in names:
             what = "it holds a sweep: continue it with the same 'dnnevo sweep' command"
         elif "reproduce.json" in names:
@@ -357,6 +370,9 @@ class RunDir:
         says, of the run's task, seed, integrator and precision."""
         path = self.best
         if not path.exists() and not path.is_symlink():
+            if self.checkpoint.exists():
+                raise RunFileError(f"{self.path} has no best.json, though it has a checkpoint; "
+                                   f"{self._resume_command()} writes it again")
             raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")
         with checked(path):
             try:

@@ -1,22 +1,31 @@
-"""How fast could dnnevo's integrator be with a free sigmoid? A ceiling for any cheaper one.
+"""How fast could dnnevo's integrator be with a cheaper sigmoid? Two cheaper exponentials, and a
+free sigmoid as the ceiling for any.
 
 dnnevo's sigmoid is exact (its own exponential within 2 ulp, then a correctly rounded division),
 so that every result has the same bits on every CPU. Issue #14 asks for 1.25x the hand-written C
-anchor (../shared/anchors; libmvec's vector exp, -ffast-math) at N = 5, 10 and 30. This script
-asks whether any cheaper sigmoid could get there: it builds a throwaway copy of this checkout's
-HEAD whose sigmoid is replaced by a clamp to [0, 1] (about the cheapest function a step could
-call; its RESULTS ARE WRONG and are never compared), installs it into a temporary virtual
-environment, and times, on the same networks, the C anchor, dnnevo as installed here, and the
-copy. Each round runs both builds in turn, each in its own process, which times the C anchor and
-then dnnevo on each size (each warmed up, then the median of 5 calls, much as anchor.py does);
-each ratio is to the C anchor timed in the same process, and the medians over rounds are
-printed.
+anchor (../shared/anchors; libmvec's vector exp, -ffast-math) at N = 5, 10 and 30, and issue 49
+parity with it from a cheaper exponential that keeps the same bits on every kernel. This script
+builds throwaway copies of this checkout's HEAD, each installed into a temporary virtual
+environment:
+
+- "free sigmoid": the sigmoid replaced by a clamp to [0, 1] (about the cheapest function a step
+  could call; its RESULTS ARE WRONG and are never compared): the ceiling for any cheaper sigmoid;
+- "exp table16" and "exp table256": the exponential of bench/patches/exp_table16.patch and
+  exp_table256.patch (a table of 2^(j/16) or 2^(j/256) and a polynomial of degree 7 or 4
+  instead of 13; each patch's header says what it does). Their results are exact to 2^-52 and
+  the same on every x86 kernel, but they are not the shipped bits.
+
+It times, on the same networks, the C anchor, dnnevo as installed here ("exact") and each copy.
+Each round runs every build in turn, each in its own process, which times the C anchor and then
+dnnevo on each size (each warmed up, then the median of 5 calls, much as anchor.py does); each
+ratio is to the C anchor timed in the same process, and the medians over rounds are printed.
 
     python bench/sigmoid_ceiling.py [--rounds 7] [--one-thread] [--kernel avx2] [--anchor DIR]
+                                    [--builds "free sigmoid" "exp table16" ...]
 
-A ratio below 1.25 for the free sigmoid means no cheaper sigmoid can meet the goal with the rest
-of the kernel as it is. The build takes 1-2 minutes and needs the package registries (maturin,
-numpy); `--keep DIR` builds into DIR once and reuses it.
+A ratio below the goal for the free sigmoid means no cheaper sigmoid can meet it with the rest
+of the kernel as it is. Each build takes 1-3 minutes and needs the package registries (maturin,
+numpy); `--keep DIR` builds into DIR once and reuses the builds.
 """
 
 from __future__ import annotations
@@ -34,13 +43,16 @@ from pathlib import Path
 import _anchor
 import dnnevo
 from _common import interleaved_medians
-from integrate import ANCHOR_TARGET, DT, POPULATION, SIZES, STEPS, pulse_inputs, random_population
+from integrate import ANCHOR_TARGET, ANCHOR_TARGET_SIZES, DT, POPULATION, SIZES, STEPS, pulse_inputs, random_population
 
 REPO = Path(__file__).resolve().parent.parent
 REPEATS = 5  # timed calls per contender and size in one process
 MATH = "crates/ctrnn/src/math.rs"
 EXACT_SIGMOID = "    one / (one + exp_lanes(-x))\n"
 FREE_SIGMOID = "    let _ = one;\n    x.clamp(0.0, 1.0)\n"
+PATCHES = REPO / "bench" / "patches"
+COPIES = ("free sigmoid", "exp table16", "exp table256")
+"""The throwaway builds, each made by `change_source` from HEAD."""
 
 
 def free_sigmoid(source: str) -> str:
@@ -51,8 +63,25 @@ def free_sigmoid(source: str) -> str:
     return source.replace(EXACT_SIGMOID, FREE_SIGMOID)
 
 
-def build_free_copy(into: Path) -> Path:
-    """Builds HEAD with the free sigmoid into `into` (unless already there); its python."""
+def change_source(name: str, source: Path) -> None:
+    """Turns the copy of HEAD in `source` into the build `name` (one of COPIES)."""
+    if name == "free sigmoid":
+        math = source / MATH
+        math.write_text(free_sigmoid(math.read_text()))
+        return
+    patch = PATCHES / f"{name.replace(' ', '_')}.patch"
+    before = (source / MATH).read_text()
+    # Outside any repository, so that git applies the patch here even when `source` lies inside one.
+    env = {**os.environ, "GIT_CEILING_DIRECTORIES": str(source.resolve().parent)}
+    done = subprocess.run(["git", "apply", str(patch)], cwd=source, capture_output=True, text=True,
+                          env=env)
+    if done.returncode != 0 or (source / MATH).read_text() == before:
+        raise SystemExit(f"error: {patch.name} no longer applies to HEAD "
+                         f"({done.stderr.strip() or 'nothing changed'}); update it")
+
+
+def build_copy(name: str, into: Path) -> Path:
+    """Builds HEAD changed into `name` in `into` (unless already there); its python."""
     python = into / "venv" / "bin" / "python"
     if python.exists():
         return python
@@ -61,10 +90,9 @@ def build_free_copy(into: Path) -> Path:
     archive = subprocess.run(["git", "-C", str(REPO), "archive", "HEAD"], check=True,
                              capture_output=True).stdout
     subprocess.run(["tar", "-x", "-C", str(source)], input=archive, check=True)
-    math = source / MATH
-    math.write_text(free_sigmoid(math.read_text()))
+    change_source(name, source)
     subprocess.run([sys.executable, "-m", "venv", str(into / "venv")], check=True)
-    print(f"building the free-sigmoid copy of HEAD in {into} (1-2 min) ...", flush=True)
+    print(f"building the {name!r} copy of HEAD in {into} (1-3 min) ...", flush=True)
     subprocess.run([str(python), "-m", "pip", "install", "-q", str(source)], check=True)
     return python
 
@@ -98,7 +126,9 @@ def main(argv=None) -> int:
                          "built for x86-64-v3 too")
     ap.add_argument("--anchor", metavar="DIR", help="the C anchor's folder (default: "
                     "$DNNEVO_ANCHOR, else ../shared/anchors next to the repository)")
-    ap.add_argument("--keep", metavar="DIR", help="build the free-sigmoid copy here and reuse it")
+    ap.add_argument("--keep", metavar="DIR", help="build the copies here and reuse them")
+    ap.add_argument("--builds", nargs="+", choices=COPIES, default=list(COPIES), metavar="BUILD",
+                    help=f"the copies to time beside the exact build (default: all of {', '.join(map(repr, COPIES))})")
     ap.add_argument("--measure", metavar="DIR", help=argparse.SUPPRESS)  # child process
     args = ap.parse_args(argv)
     if args.measure:
@@ -121,8 +151,9 @@ def main(argv=None) -> int:
         env["RAYON_NUM_THREADS"] = "1"
     work = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="dnnevo-ceiling-"))
     try:
-        free = build_free_copy(work)
-        builds = {"exact": sys.executable, "free sigmoid": str(free)}
+        builds = {"exact": sys.executable}
+        for name in args.builds:
+            builds[name] = str(build_copy(name, work / name.replace(" ", "-")))
         rounds = {name: [] for name in builds}
         for r in range(args.rounds):
             for name, python in builds.items():
@@ -144,8 +175,8 @@ def report(rounds: dict, args) -> None:
     threads = "one thread each" if args.one_thread else "every core"
     print(f"kernel {kernel}, {threads}; P = {POPULATION}, T = {STEPS}; medians of "
           f"{args.rounds} rounds, network-steps/s; ratios to the C anchor of the same process")
-    print(f"{'N':>3}  {'C anchor':>9}  {'exact':>9}  {'vs C':>5}  {'free sigmoid':>12}  "
-          f"{'vs C':>5}  {'goal':>5}")
+    names = list(rounds)
+    print(f"{'N':>3}  {'C anchor':>9}  " + "  ".join(f"{name:>12}  {'vs C':>5}" for name in names))
     for n in SIZES:
         def rate(name, who):
             return statistics.median(POPULATION * STEPS / x[str(n)][who] for x in rounds[name])
@@ -154,9 +185,10 @@ def report(rounds: dict, args) -> None:
             return statistics.median(x[str(n)]["c"] / x[str(n)]["dnnevo"] for x in rounds[name])
         c = statistics.median(POPULATION * STEPS / x[str(n)]["c"]
                               for name in rounds for x in rounds[name])
-        print(f"{n:>3}  {c:>9.3g}  {rate('exact', 'dnnevo'):>9.3g}  {ratio('exact'):>5.2f}  "
-              f"{rate('free sigmoid', 'dnnevo'):>12.3g}  {ratio('free sigmoid'):>5.2f}  "
-              f"{ANCHOR_TARGET:>5.2f}")
+        print(f"{n:>3}  {c:>9.3g}  " + "  ".join(
+            f"{rate(name, 'dnnevo'):>12.3g}  {ratio(name):>5.2f}" for name in names))
+    print(f"goal (issue 49): at least {ANCHOR_TARGET:.2f}x the C anchor at N = "
+          f"{', '.join(map(str, ANCHOR_TARGET_SIZES))}")
 
 
 if __name__ == "__main__":

@@ -51,6 +51,10 @@ class Seeker:
         return lengths < 50
 
 
+class Ruleless(Seeker):
+    success_rate = None
+
+
 def fitness(networks):
     return np.full(len(networks), SPEED)
 '''
@@ -80,6 +84,10 @@ def test_the_text_holds_the_constants_and_functions_the_task_reads_and_nothing_e
     assert "# towards\ndef towards" in text
     assert "UNUSED" not in text and "unrelated" not in text and "import numpy" not in text
     assert "# SPEED\n0.1" in task_source(module.fitness)
+    # A subclass is its base class too.
+    inherited = task_source(module.Ruleless)
+    assert inherited.startswith("class Ruleless(Seeker):") and "# Seeker\nclass Seeker:" in inherited
+    assert "# SPEED\n0.1" in inherited
 
 
 @pytest.mark.parametrize("edit, seeker_changes, fitness_changes", [
@@ -93,7 +101,8 @@ def test_an_edit_of_what_the_task_reads_changes_its_digest_and_no_other_edit_doe
         tmp_path, edit, seeker_changes, fitness_changes) -> None:
     before = load(tmp_path, "digest_edit_a", MODULE)
     after = load(tmp_path, "digest_edit_b", MODULE.replace(*edit))
-    for task, changes in (("Seeker", seeker_changes), ("fitness", fitness_changes)):
+    for task, changes in (("Seeker", seeker_changes), ("Ruleless", seeker_changes),
+                          ("fitness", fitness_changes)):
         old, new = (task_source(getattr(m, task)) for m in (before, after))
         assert (old != new) == changes, (edit, task)
 

@@ -4,7 +4,8 @@ A run records the SHA-256 of its task's text so that ``resume``, ``assess``, ``p
 ``analyze`` refuse a task edited since. The text of a function or class is its own source and
 what it reads from its module: the source of the functions and classes defined there that it
 names (and what those name, in turn), and the values of the module's data that it names
-(numbers, strings, arrays, containers; see :func:`fingerprint`). So an edited constant at the top
+(numbers, strings, arrays, containers; see :func:`fingerprint`); a class's base classes from
+its module count as named. So an edited constant at the top
 of the task's file is an edited task.
 
 A class's ``analysis = ...`` attribute (:class:`dnnevo.tasks.protocol.Analysis`) is left out: it
@@ -88,8 +89,15 @@ def task_source(target: Any) -> str | None:
 def _dependencies(target: Any, seen: set[int]) -> Iterator[tuple[str, Any]]:
     """The module-level names that ``target``'s code reads, with their values, depth first and
     each once: data, and functions and classes of ``target``'s own module (whose own names
-    follow them). Modules, builtins and code from other modules are left out."""
+    follow them); for a class, first its base classes of that module. Modules, builtins and code
+    from other modules are left out."""
     namespace = _module_namespace(target)
+    if inspect.isclass(target):  # what a subclass inherits from its module is its too
+        for base in target.__mro__[1:]:
+            if _defined_alongside(base, target) and id(base) not in seen:
+                seen.add(id(base))
+                yield base.__qualname__, base
+                yield from _dependencies(base, seen)
     for name in sorted(_names_read(target)):
         if name not in namespace:
             continue

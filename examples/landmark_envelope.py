@@ -13,6 +13,15 @@ held-out worlds' (more than 85% right, the 95% Wilson interval's lower end above
     python examples/landmark_envelope.py /root/dnnevo-reference/landmark-robust \\
         /root/dnnevo-reference/landmark-wide --record docs/results/examples/landmark-envelope.json
 
+With ``--bounds`` it judges no champion and asks instead whether one rule can tell the landmarks
+apart at every end at once, as a champion must: at each end, an observer fitted at that end
+alone, one linear observer fitted on every end's trials together, and a nearest-neighbour rule
+fitted on them (:func:`dnnevo.tasks.landmark_transfer.pooled_bounds`), each fitted on ``--trials``
+trials per landmark from ``FIT_SEED`` and judged on as many from ``TEST_SEED``::
+
+    python examples/landmark_envelope.py /root/dnnevo-reference/landmark-wide --bounds \\
+        --record docs/results/examples/landmark-envelope-bounds.json
+
 Each FOLDER is a run folder or a folder of ``seed-N`` run folders, as for
 ``examples/landmark_transfer.py``, whose runs share one training envelope; its name labels its
 champions. Without any, the reference reproduction's ``landmark-robust`` and ``landmark-wide``
@@ -68,6 +77,34 @@ def judge_family(label: str, folder: Path, trials: int) -> tuple[list[str], dict
     return edges, judged, validation
 
 
+BOUNDS_COLUMNS = ["envelope", "end", "observer fitted at that end %", "one linear observer for every end %",
+                  "one nearest-neighbour rule for every end %"]
+
+
+def bounds_table(folders: dict[str, Path], trials: int) -> tuple[list[list[str]], list[str]]:
+    """For the envelope of each folder's first run: each end's bounds (the rows) and a summary."""
+    rows, summary = [], [
+        f"Fitted on {trials} trials per landmark per end (seed {transfer.FIT_SEED}), judged on {trials} "
+        f"fresh ones (seed {TEST_SEED}). The observers are logistic regressions on the sonar stream's "
+        "summary features; the nearest-neighbour rule also sees its distribution and time course "
+        "(dnnevo.evaluation.observer.profile). The sonar does not depend on the network."]
+    for label, folder in folders.items():
+        (_, run), *_ = champions(folder)
+        config, net = load(run)
+        places = [Place(w.name, w) for w in landmark_worlds.envelope_edges(config)]
+        if not places:
+            raise DnnevoError(f"{run}'s training varies none of the follower's speed and distance and the "
+                              "sonar's cone and axis, so its envelope has no ends")
+        found = transfer.pooled_bounds(config, net, trials, trials, places)
+        for end, b in found.items():
+            rows.append([label, end, *(f"{100 * b[k] / b['n']:.1f}" for k in ("own", "one linear", "one nearest"))])
+        failing = [end for end, b in found.items() if not meets(b["one linear"], b["n"])]
+        summary.append(f"{label}: one linear observer meets the goal at {len(found) - len(failing)} of "
+                       f"{len(found)} ends; the nearest-neighbour rule at "
+                       f"{sum(meets(b['one nearest'], b['n']) for b in found.values())} of {len(found)}.")
+    return rows, summary
+
+
 def table(families: dict[str, tuple[list[str], dict[str, dict[str, int]], list[float]]],
           trials: int) -> tuple[list[list[str]], list[str]]:
     """The record's rows, one per family and end of its envelope, and the summary lines."""
@@ -93,22 +130,30 @@ def main(argv: Sequence[str] | None = None) -> None:
                    help="run folders, or folders of seed-N run folders (default: "
                         + " and ".join(map(str, REFERENCE)) + ")")
     p.add_argument("--trials", type=int, default=100, help="fresh test trials per landmark (default 100)")
+    p.add_argument("--bounds", action="store_true",
+                   help="judge no champion: fit one rule for every end of each folder's envelope, to see "
+                        "whether one can tell the landmarks apart at all of them")
     p.add_argument("--record", type=Path, metavar="JSON",
                    help="also write the table here, for the docs (docs/results/examples/landmark-envelope.json)")
     args = p.parse_args(argv)
     if args.trials < 1:
         p.error("--trials must be at least 1")
     folders = checked_folders(p, args.folders or REFERENCE, "examples/landmark_envelope.py runs/sweep-landmark-robust")
+    named = dict(zip(labels(folders), folders, strict=True))
     try:
-        families = {label: judge_family(label, folder, args.trials)
-                    for label, folder in zip(labels(folders), folders, strict=True)}
+        if args.bounds:
+            columns = BOUNDS_COLUMNS
+            rows, summary = bounds_table(named, args.trials)
+        else:
+            columns = COLUMNS
+            rows, summary = table({label: judge_family(label, folder, args.trials)
+                                   for label, folder in named.items()}, args.trials)
     except DnnevoError as e:  # a run folder that cannot be read, not a landmark run, or no envelope
         sys.exit(f"error: {e}")
-    rows, summary = table(families, args.trials)
-    show(COLUMNS, rows, summary)
+    show(columns, rows, summary)
     if args.record:
         examples.write(args.record, command=examples.command("examples/landmark_envelope.py", argv),
-                       columns=COLUMNS, rows=rows, summary=summary)
+                       columns=columns, rows=rows, summary=summary)
 
 
 if __name__ == "__main__":

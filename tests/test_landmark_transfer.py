@@ -313,3 +313,26 @@ def test_the_envelope_example_records_each_end_and_refuses_a_run_without_an_enve
     assert r.returncode == 0, r.stderr
     with pytest.raises(SystemExit, match="vary none of the follower's speed"):
         landmark_envelope.main([str(plain), "--trials", "2"])
+    # --bounds: one row per end with its three rules, and the same refusal without an envelope.
+    bounds = tmp_path / "bounds.json"
+    landmark_envelope.main([str(runs), "--bounds", "--trials", "4", "--record", str(bounds)])
+    doc = examples.read(bounds)
+    assert doc["columns"] == landmark_envelope.BOUNDS_COLUMNS
+    assert [row[1] for row in doc["rows"]] == [w.name for w in landmark_worlds.envelope_edges(
+        presets.get("landmark-robust", quick=True))]
+    assert all(0.0 <= float(x) <= 100.0 for row in doc["rows"] for x in row[2:])
+    assert doc["summary"][1].startswith("robust: one linear observer meets the goal at ")
+    with pytest.raises(SystemExit, match="varies none of the follower's speed"):
+        landmark_envelope.main([str(plain), "--bounds", "--trials", "2"])
+
+
+def test_one_rule_for_every_place_is_judged_in_each_against_the_place_s_own() -> None:
+    """pooled_bounds: a place's own observer, one linear observer and one nearest-neighbour rule
+    for all places together, each counted on the place's own test trials."""
+    config = presets.get("landmark-wide", quick=True)
+    net = dnnevo.Network.random(config.size, config.n_inputs, seed=0)
+    places = [transfer.Place(w.name, w) for w in landmark_worlds.envelope_edges(config)[:2]]
+    found = transfer.pooled_bounds(config, net, 6, 5, places)
+    assert list(found) == [p.name for p in places]
+    for b in found.values():
+        assert b["n"] == 10 and all(0 <= b[k] <= 10 for k in ("own", "one linear", "one nearest"))

@@ -1,6 +1,9 @@
 """Bounds for a classifier of one input stream: simple features of the stream, the best
 single-threshold rule on one of them (a lower bound a network should beat) and logistic regression
-on all of them (an observer that sees the whole trial, an upper reference). NumPy only.
+on all of them (an observer that sees the whole trial, an upper reference). For trials drawn from
+several conditions at once, a stream's :func:`profile` (its features, distribution and time
+course) and the nearest fitted trial (:func:`fit_nearest`) ask whether any rule, not only a linear
+one, tells the classes apart in every condition. NumPy only.
 
 Both are fitted on one set of trials and judged on another: :func:`fit_threshold` and
 :func:`fit_logistic` see only the fitting set's features and labels.
@@ -22,7 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["FEATURES", "Logistic", "Threshold", "features", "fit_logistic", "fit_threshold"]
+__all__ = ["FEATURES", "Logistic", "Nearest", "Threshold", "features", "fit_logistic", "fit_nearest",
+           "fit_threshold", "profile"]
 
 FEATURES = ["mean", "sd", "max", "fraction near", "near episodes", "longest near run",
             "mean near run"]
@@ -119,3 +123,55 @@ def fit_logistic(x: npt.ArrayLike, y: npt.ArrayLike, *, ridge: float = 1e-2, ste
         if np.max(np.abs(step)) < 1e-10:
             break
     return Logistic(mu, sd, beta[:-1], float(beta[-1]))
+
+
+PROFILE_QUANTILES = 33
+"""Quantiles of the stream in :func:`profile` (its minimum, maximum and 31 between)."""
+PROFILE_BINS = 24
+"""Equal time bins of the stream in :func:`profile`."""
+
+
+def profile(stream: npt.ArrayLike, near: float) -> npt.NDArray[np.float64]:
+    """A fuller description of one trial's ``stream`` than :func:`features`: those features, the
+    stream's :data:`PROFILE_QUANTILES` quantiles (its distribution, whatever its timing) and its
+    mean in :data:`PROFILE_BINS` equal time bins (its time course).
+
+    >>> profile(np.arange(48.0), 10.0).shape
+    (64,)
+    """
+    x = np.asarray(stream, dtype=float)
+    quantiles = np.quantile(x, np.linspace(0.0, 1.0, PROFILE_QUANTILES))
+    course = np.array([part.mean() for part in np.array_split(x, PROFILE_BINS)])
+    return np.concatenate([features(x, near), quantiles, course])
+
+
+@dataclass(frozen=True)
+class Nearest:
+    """The label of the nearest fitted trial, in features standardized on the fitted ones."""
+
+    mu: npt.NDArray[np.float64]
+    sd: npt.NDArray[np.float64]
+    z: npt.NDArray[np.float64]
+    y: npt.NDArray[np.int64]
+
+    def predict(self, x: npt.ArrayLike) -> npt.NDArray[np.int64]:
+        """The labels of the rows of ``x``: each the label of its nearest fitted row (the first
+        of equally near ones)."""
+        z = (np.asarray(x, dtype=float) - self.mu) / self.sd
+        distance = ((z[:, None, :] - self.z[None, :, :]) ** 2).sum(axis=-1)
+        return self.y[distance.argmin(axis=1)]
+
+
+def fit_nearest(x: npt.ArrayLike, y: npt.ArrayLike) -> Nearest:
+    """A nearest-neighbour classifier of the rows of ``x`` (n, features) labelled ``y``: any
+    boundary, however bent, that the fitted trials draw. Columns are standardized on ``x`` (a
+    constant column is left at 0).
+
+    >>> rule = fit_nearest([[0.0], [1.0], [5.0]], [0, 1, 0])
+    >>> rule.predict([[0.9], [4.0]]).tolist()
+    [1, 0]
+    """
+    x = np.asarray(x, dtype=float)
+    mu, sd = x.mean(axis=0), x.std(axis=0)
+    sd = np.where(sd > 0, sd, 1.0)
+    return Nearest(mu, sd, (x - mu) / sd, np.asarray(y, dtype=np.int64))

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -47,7 +47,7 @@ from dnnevo.evaluation.stats import wilson
 from dnnevo.tasks import landmark, landmark_worlds
 
 __all__ = ["FIT_SEED", "TEST_SEED", "NEAR", "THRESHOLD_COLUMNS", "GOAL_RATE", "GOAL_LOWER", "Place", "PLACES",
-           "held_out", "worlds_digest", "place", "sonar_features", "bounds", "judge", "meets"]
+           "held_out", "worlds_digest", "place", "sonar_features", "bounds", "pooled_bounds", "judge", "meets"]
 
 FIT_SEED = 47_001
 """The seed of the trials the threshold rule and the observer are fitted on."""
@@ -133,17 +133,49 @@ def _places(places: Sequence[Place | str] | None) -> list[Place]:
 
 
 def sonar_features(config: EvolutionConfig, net: _core.Network, per_landmark: int, seed: int,
-                   robot_like: bool) -> tuple[np.ndarray, np.ndarray]:
+                   robot_like: bool, describe: Callable[[Any, float], np.ndarray] = observer.features,
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """Features and labels (0: landmark 1, 1: landmark 2) of the trials ``assess`` draws from
     ``seed``: trial t of ``2 per_landmark``, landmark 1 first (the sonar does not depend on the
-    network, which the recorder only needs to run)."""
+    network, which the recorder only needs to run). ``describe(stream, NEAR)`` makes a trial's
+    features: :func:`observer.features`, or :func:`observer.profile` for more."""
     rows, labels = [], []
     for t in range(2 * per_landmark):
         which = 1 if t < per_landmark else 2
         rec = landmark.record(config, net, which, seed=seed, trial=t, robot_like=robot_like)
-        rows.append(observer.features(rec.input, NEAR))
+        rows.append(describe(rec.input, NEAR))
         labels.append(which - 1)
     return np.array(rows), np.array(labels)
+
+
+def pooled_bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,
+                  places: Sequence[Place | str]) -> dict[str, dict[str, int]]:
+    """Whether one rule tells the landmarks apart in all ``places`` at once, as a champion
+    trained on all of them must. In each place, trials right of ``test`` per landmark (from
+    TEST_SEED) of: ``"own"``, the observer fitted on that place alone (``fit`` per landmark, from
+    FIT_SEED); ``"one linear"``, one observer (logistic regression on the same features) fitted
+    on every place's trials together; ``"one nearest"``, the nearest of every place's fitted
+    trials in their :func:`observer.profile`, which draws any boundary. ``n`` is the trials per
+    place."""
+    bounded_count("fit", fit)
+    bounded_count("test", test)
+    summary = len(observer.FEATURES)  # a profile starts with the features
+    data = {}
+    for p in _places(places):
+        cfg = landmark_worlds.config(base, p.world)
+        data[p.name] = (sonar_features(cfg, net, fit, FIT_SEED, p.robot_like, observer.profile),
+                        sonar_features(cfg, net, test, TEST_SEED, p.robot_like, observer.profile))
+    x = np.vstack([xf for (xf, _), _ in data.values()])
+    y = np.concatenate([yf for (_, yf), _ in data.values()])
+    linear = observer.fit_logistic(x[:, :summary], y)
+    nearest = observer.fit_nearest(x, y)
+    out = {}
+    for name, ((xf, yf), (xt, yt)) in data.items():
+        own = observer.fit_logistic(xf[:, :summary], yf)
+        out[name] = {"own": int(np.sum(own.predict(xt[:, :summary]) == yt)),
+                     "one linear": int(np.sum(linear.predict(xt[:, :summary]) == yt)),
+                     "one nearest": int(np.sum(nearest.predict(xt) == yt)), "n": len(yt)}
+    return out
 
 
 def bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int,

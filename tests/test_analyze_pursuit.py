@@ -137,8 +137,9 @@ def test_the_analysis_declaration_leaves_the_runs_digest_alone() -> None:
     from dnnevo.closedloop import named
 
     config = presets.get("predator-avoidance")
-    digest = named.closed_loop(config).digest()
-    assert digest == "9cd751a8cf583ae73f4345f0bbc6415a4e8386ae9044bfb5529ef83ddd52f7f4"
+    # Recorded before digests took in what the class reads from its module: still accepted.
+    digests = named.closed_loop(config).digests()
+    assert "9cd751a8cf583ae73f4345f0bbc6415a4e8386ae9044bfb5529ef83ddd52f7f4" in digests
 
 
 def test_a_task_that_breaks_the_protocol_while_recorded_is_one_line(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -7,6 +7,8 @@ from __future__ import annotations
 import hashlib
 import importlib
 import inspect
+import os
+import subprocess
 import sys
 
 import numpy as np
@@ -192,3 +194,111 @@ def test_a_closed_loop_with_bad_settings_is_refused_when_made(tmp_path, setting,
         ClosedLoop(module.Seeker(), **setting)
     assert np.isfinite(ClosedLoop(module.Seeker(), max_steps=10)(
         [dnnevo.Network.random(3, 1, seed=0)])).all()
+
+
+EDGES = '''
+import dataclasses
+import functools
+
+STEPS = 200
+GAIN = 2.0
+steps = 50  # a script's variable, named like an attribute the class reads
+
+
+@dataclasses.dataclass(frozen=True)
+class Params:
+    speed: float = 0.1
+
+
+PARAMS = Params(speed=0.1)
+
+
+def double(x):
+    return 2 * x
+
+
+HANDLERS = {double: "x2"}
+TREE = {"leaf": 1}
+TREE["self"] = TREE
+
+
+@functools.lru_cache(maxsize=None)
+def cached(x):
+    return x * GAIN
+
+
+def decorate(function):
+    @functools.wraps(function)
+    def wrapper(*args):
+        return function(*args)
+    return wrapper
+
+
+@decorate
+def wrapped_fitness(networks):
+    return [GAIN] * len(networks)
+
+
+def fitness(networks, horizon=STEPS):
+    return [horizon + cached(1) + PARAMS.speed + len(HANDLERS) + len(TREE)] * len(networks)
+
+
+class Task:
+    horizon = STEPS
+
+    def __init__(self):
+        self.steps = 3
+
+    @property
+    def level(self):
+        return self._level
+
+    @level.setter
+    def level(self, value):
+        self._level = value * GAIN
+'''
+
+
+@pytest.mark.parametrize("edit, task", [
+    (("STEPS = 200", "STEPS = 100"), "fitness"),     # a default argument
+    (("STEPS = 200", "STEPS = 100"), "Task"),        # a class's data attribute
+    (("return x * GAIN", "return x * GAIN * 2"), "fitness"),  # a helper behind lru_cache
+    (("GAIN = 2.0", "GAIN = 3.0"), "wrapped_fitness"),        # a decorated task
+    (("GAIN = 2.0", "GAIN = 3.0"), "Task"),          # a property's setter
+    (("PARAMS = Params(speed=0.1)", "PARAMS = Params(speed=0.2)"), "fitness"),  # a dataclass
+])
+def test_what_a_task_reads_besides_its_body_is_covered(tmp_path, edit, task) -> None:
+    before = load(tmp_path, "digest_edges_a", EDGES)
+    after = load(tmp_path, "digest_edges_b", EDGES.replace(*edit))
+    assert task_source(getattr(before, task)) != task_source(getattr(after, task)), edit
+
+
+def test_an_attribute_is_not_a_global_and_a_container_may_hold_itself(tmp_path) -> None:
+    module = load(tmp_path, "digest_edges_c", EDGES)
+    text = task_source(module.Task)
+    assert "# steps" not in text  # self.steps is an attribute; the module's steps is not read
+    assert "<itself>" in task_source(module.fitness)
+    assert task_source(module.Task) == task_source(load(tmp_path, "digest_edges_d",
+                                                        EDGES.replace("steps = 50", "steps = 60")).Task)
+
+
+def test_the_digest_is_the_same_in_every_process(tmp_path) -> None:
+    (tmp_path / "digest_edges_e.py").write_text(EDGES)
+    code = ("import hashlib, digest_edges_e as m; from dnnevo.closedloop.source import task_source; "
+            "print(hashlib.sha256(task_source(m.fitness).encode()).hexdigest())")
+    digests = {subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                              env={**os.environ, "PYTHONHASHSEED": seed}, check=True).stdout
+               for seed in ("0", "1", "2")}
+    assert len(digests) == 1, digests
+
+
+def test_old_runs_keep_their_task_when_an_analysis_attribute_is_added(tmp_path) -> None:
+    plain = load(tmp_path, "digest_old_a", MODULE)
+    recorded = ClosedLoop(plain.Seeker(), max_steps=50).digests()[1]  # how a run recorded it before
+    declared = MODULE.replace("    success_rate = 0.9\n", "    success_rate = 0.9\n" + ANALYSIS).replace(
+        "import numpy as np\n", "import numpy as np\nfrom dnnevo.tasks.protocol import Analysis\n", 1)
+    analysed = load(tmp_path, "digest_old_a", declared)
+    assert recorded in ClosedLoop(analysed.Seeker(), max_steps=50).digests()
+    # And an analysis attribute on a base class leaves its subclasses' tasks as they were.
+    assert task_source(analysed.Ruleless).replace("digest_old_a", "") == \
+        task_source(plain.Ruleless).replace("digest_old_a", "")

@@ -24,7 +24,7 @@ import numpy.typing as npt
 from dnnevo import _core
 from dnnevo.closedloop.environment import Environment
 from dnnevo.closedloop.loop import DEFAULT_INTEGRATOR, FLAGS, Rollout, as_flags, rollout
-from dnnevo.closedloop.source import fingerprint, plain_source, task_source
+from dnnevo.closedloop.source import fingerprint, legacy_fingerprint, plain_source, task_source
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
 from dnnevo.errors import ConfigError, TaskError
 
@@ -115,10 +115,14 @@ class ClosedLoop:
             attributes = vars(env)
         except TypeError:  # a class with __slots__
             attributes = {k: getattr(env, k) for k in getattr(kind, "__slots__", ()) if hasattr(env, k)}
-        settings = [fingerprint(attributes), fingerprint(self._recorded())]
-        self.fitness_source = "\n".join([task_source(kind) or kind.__qualname__, *settings])
-        # Made before digests took in what the class reads from its module (source.py).
-        self._legacy_source = "\n".join([plain_source(kind) or kind.__qualname__, *settings])
+        recorded = self._recorded()
+        self.fitness_source = "\n".join([task_source(kind) or kind.__qualname__, fingerprint(attributes),
+                                         fingerprint(recorded)])
+        # As made before digests took in what the class reads from its module (source.py): the
+        # class's source as it was then, and without an analysis attribute added since.
+        legacy = [legacy_fingerprint(attributes), legacy_fingerprint(recorded)]
+        self._legacy_sources = ["\n".join([text or kind.__qualname__, *legacy])
+                                for text in (plain_source(kind), plain_source(kind, ignored=True))]
 
     def _recorded(self) -> dict[str, Any]:
         """The settings a run records: the rollout's (its precision only when ``"f32"``), the
@@ -141,7 +145,7 @@ class ClosedLoop:
         """Every digest a run of this task may record: :meth:`digest`, and the one runs recorded
         before digests took in what the class reads from its module (which they then could not
         check)."""
-        return (self.digest(), hashlib.sha256(self._legacy_source.encode()).hexdigest())
+        return (self.digest(), *(hashlib.sha256(t.encode()).hexdigest() for t in self._legacy_sources))
 
     def configured(self, config: EvolutionConfig) -> EvolutionConfig:
         """``config`` saying what this fitness function runs: its name as ``task``, the rollout's

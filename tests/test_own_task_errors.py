@@ -45,9 +45,15 @@ def test_the_configs_still_take_their_settings_by_name_and_position() -> None:
     assert dnnevo.IntegratorConfig("rk4", 0.05, 2) == dnnevo.IntegratorConfig(method="rk4", dt=0.05, substeps=2)
 
 
-def test_a_fitness_function_that_returns_no_numbers_is_a_fitness_error() -> None:
+@pytest.mark.parametrize("value", ["good", "1.5", None, object()])
+def test_a_fitness_function_that_returns_no_numbers_is_a_fitness_error(value) -> None:
     with pytest.raises(FitnessError, match="the fitness function returned values that are not numbers"):
-        dnnevo.evolve(lambda networks: ["good"] * len(networks), SMALL, progress=False)
+        dnnevo.evolve(lambda networks: [value] * len(networks), SMALL, progress=False)
+
+
+def test_an_environment_class_not_object_is_named() -> None:
+    with pytest.raises(ConfigError, match=r"task is the class FarSeeker; .*ClosedLoop\(FarSeeker\(\.\.\.\)"):
+        dnnevo.evolve(FarSeeker, SMALL, progress=False)
 
 
 def test_network_attributes_cannot_be_written_to() -> None:
@@ -78,6 +84,20 @@ def test_a_run_of_a_fitness_function_says_to_resume_it_from_python(tmp_path: Pat
     assert_one_line_error(r, "has no best.json, though it has a checkpoint; dnnevo.resume(")
     dnnevo.resume(out, fitness, progress=False)
     assert (out / "best.json").exists()
+
+
+def test_a_run_of_a_script_s_class_says_to_resume_it_from_python(tmp_path: Path) -> None:
+    (tmp_path / "light.py").write_text(
+        "import dnnevo\nfrom dnnevo.closedloop import ClosedLoop, FarSeeker\n\n"
+        "class Seeker(FarSeeker):\n    pass\n\n"
+        "config = dnnevo.EvolutionConfig(population=8, generations=1, size=5, n_inputs=1, selection='rank')\n"
+        "dnnevo.evolve(ClosedLoop(Seeker(), max_steps=30), config, out='run', progress=False)\n")
+    import subprocess
+    import sys
+    subprocess.run([sys.executable, "light.py"], cwd=tmp_path, check=True, capture_output=True)
+    with pytest.raises(dnnevo.DnnevoError, match=r"resume it with dnnevo.resume\('.*run', "
+                                                 r"task=ClosedLoop\(\.\.\.\)\) from Python"):
+        dnnevo.evolve(fitness, SMALL, out=tmp_path / "run", progress=False)
 
 
 def test_a_run_of_a_task_class_missing_its_champion_says_to_resume_it(tmp_path: Path) -> None:

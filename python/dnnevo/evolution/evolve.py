@@ -115,13 +115,29 @@ def evaluate(
     )
 
 
+def _numbers(scores: Any) -> npt.NDArray[np.float64]:
+    """A fitness function's return as float64, or a :class:`~dnnevo.FitnessError` when it holds
+    anything but numbers (strings, even of numbers, None, objects)."""
+    try:
+        given = np.asarray(scores)
+    except (TypeError, ValueError) as e:
+        raise FitnessError(f"the fitness function returned values that are not numbers ({e})") from None
+    if given.dtype.kind not in "biuf":
+        raise FitnessError(f"the fitness function returned values that are not numbers (of type "
+                           f"{given.dtype}); return one number per network")
+    return given.astype(np.float64)
+
+
 def _check_task(task: object) -> None:
     """A :class:`~dnnevo.ConfigError` unless ``task`` is a name or a callable; it names an
     environment passed without its :class:`~dnnevo.closedloop.ClosedLoop`."""
+    environment = all(callable(getattr(task, m, None)) for m in ("reset", "step"))
+    if inspect.isclass(task) and environment:
+        raise ConfigError(f"task is the class {task.__name__}; an environment is given as an object "
+                          f"wrapped in a ClosedLoop: ClosedLoop({task.__name__}(...), max_steps=...)")
     if isinstance(task, str) or callable(task):
         return
     kind = type(task).__name__
-    environment = all(callable(getattr(task, m, None)) for m in ("reset", "step"))
     raise ConfigError(
         f"task has type {kind}; expected a task or preset name, a fitness function "
         "fitness(networks) -> array, or a ClosedLoop"
@@ -514,11 +530,7 @@ def _loop(
                         scores = task(networks, generation=ga.generation, seed=ga.seed)
                     else:
                         scores = task(networks)
-                    try:
-                        fitness = np.asarray(scores, dtype=np.float64)
-                    except (TypeError, ValueError) as e:
-                        raise FitnessError(f"the fitness function returned values that are not "
-                                           f"numbers ({type(e).__name__}: {e})") from None
+                    fitness = _numbers(scores)
                     if fitness.shape != (config.population,):
                         raise FitnessError(
                             f"the fitness function returned shape {fitness.shape}; "

@@ -174,14 +174,18 @@ class RunDir:
 
     def _resume_command(self) -> str:
         """How to resume the run here: from Python when it was evolved with a fitness function
-        the command line cannot build (``resume`` says the same)."""
+        or a class defined in a script, which the command line cannot build (``resume`` says
+        the same)."""
         try:
             stored = tomllib.loads(self.config.read_text())
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
             stored = {}
         task, params = stored.get("task"), stored.get("task_params")
-        if isinstance(task, str) and task.startswith(PYTHON_TASK) and \
-                not (isinstance(params, Mapping) and "max_steps" in params):
+        if not (isinstance(task, str) and task.startswith(PYTHON_TASK)):
+            return f"'dnnevo resume {self.path}'"
+        if task.startswith(f"{PYTHON_TASK}__main__."):  # a script's class: no other process imports it
+            return f"dnnevo.resume({str(self.path)!r}, task=ClosedLoop(...)) from Python"
+        if not (isinstance(params, Mapping) and "max_steps" in params):  # a fitness function
             return f"dnnevo.resume({str(self.path)!r}, task=fitness) from Python"
         return f"'dnnevo resume {self.path}'"
 

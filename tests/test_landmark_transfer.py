@@ -321,7 +321,7 @@ def test_the_envelope_example_records_each_end_and_refuses_a_run_without_an_enve
     assert [row[1] for row in doc["rows"]] == [w.name for w in landmark_worlds.envelope_edges(
         presets.get("landmark-robust", quick=True))]
     assert all(0.0 <= float(x) <= 100.0 for row in doc["rows"] for x in row[2:])
-    assert doc["summary"][1].startswith("robust: one linear observer meets the goal at ")
+    assert doc["summary"][1].startswith("robust: the goal is met by one linear observer at ")
     with pytest.raises(SystemExit, match="varies none of the follower's speed"):
         landmark_envelope.main([str(plain), "--bounds", "--trials", "2"])
 
@@ -335,4 +335,18 @@ def test_one_rule_for_every_place_is_judged_in_each_against_the_place_s_own() ->
     found = transfer.pooled_bounds(config, net, 6, 5, places)
     assert list(found) == [p.name for p in places]
     for b in found.values():
-        assert b["n"] == 10 and all(0 <= b[k] <= 10 for k in ("own", "one linear", "one nearest"))
+        assert b["n"] == 10 and all(0 <= b[k] <= 10 for k in ("own", "one linear", "one linear, profile",
+                                                               "one nearest"))
+
+
+def test_the_nearest_neighbour_rule_is_the_brute_force_one_and_a_profile_needs_its_bins() -> None:
+    rng = np.random.default_rng(3)
+    x, y = rng.normal(size=(300, 6)), rng.integers(0, 2, 300)
+    test = rng.normal(size=(observer.NEAREST_CHUNK + 17, 6))
+    rule = observer.fit_nearest(x, y)
+    z, zt = (x - rule.mu) / rule.sd, (test - rule.mu) / rule.sd
+    brute = y[((zt[:, None, :] - z[None, :, :]) ** 2).sum(-1).argmin(1)]
+    assert np.array_equal(rule.predict(test), brute)
+    assert observer.profile(np.linspace(0, 1, observer.PROFILE_BINS), 0.5).shape == (64,)
+    with pytest.raises(ValueError, match="at least 24 steps"):
+        observer.profile(np.arange(10.0), 1.0)

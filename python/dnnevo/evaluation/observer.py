@@ -140,9 +140,17 @@ def profile(stream: npt.ArrayLike, near: float) -> npt.NDArray[np.float64]:
     (64,)
     """
     x = np.asarray(stream, dtype=float)
+    if x.ndim != 1 or len(x) < PROFILE_BINS:
+        raise ValueError(f"the stream has shape {x.shape}; a profile needs one stream of at least "
+                         f"{PROFILE_BINS} steps, one per time bin")
     quantiles = np.quantile(x, np.linspace(0.0, 1.0, PROFILE_QUANTILES))
     course = np.array([part.mean() for part in np.array_split(x, PROFILE_BINS)])
     return np.concatenate([features(x, near), quantiles, course])
+
+
+NEAREST_CHUNK = 256
+"""Rows whose distances :meth:`Nearest.predict` computes at once (memory: this many times the
+fitted rows)."""
 
 
 @dataclass(frozen=True)
@@ -158,8 +166,13 @@ class Nearest:
         """The labels of the rows of ``x``: each the label of its nearest fitted row (the first
         of equally near ones)."""
         z = (np.asarray(x, dtype=float) - self.mu) / self.sd
-        distance = ((z[:, None, :] - self.z[None, :, :]) ** 2).sum(axis=-1)
-        return self.y[distance.argmin(axis=1)]
+        fitted = (self.z ** 2).sum(axis=1)
+        labels = np.empty(len(z), dtype=np.int64)
+        for start in range(0, len(z), NEAREST_CHUNK):  # distances of a chunk of rows at a time
+            part = z[start:start + NEAREST_CHUNK]
+            distance = (part ** 2).sum(axis=1)[:, None] - 2.0 * part @ self.z.T + fitted[None, :]
+            labels[start:start + len(part)] = self.y[distance.argmin(axis=1)]
+        return labels
 
 
 def fit_nearest(x: npt.ArrayLike, y: npt.ArrayLike) -> Nearest:

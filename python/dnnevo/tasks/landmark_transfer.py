@@ -154,9 +154,10 @@ def pooled_bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int
     trained on all of them must. In each place, trials right of ``test`` per landmark (from
     TEST_SEED) of: ``"own"``, the observer fitted on that place alone (``fit`` per landmark, from
     FIT_SEED); ``"one linear"``, one observer (logistic regression on the same features) fitted
-    on every place's trials together; ``"one nearest"``, the nearest of every place's fitted
-    trials in their :func:`observer.profile`, which draws any boundary. ``n`` is the trials per
-    place."""
+    on every place's trials together; ``"one linear, profile"``, the same on the trials'
+    :func:`observer.profile` (the features, the stream's distribution and its time course);
+    ``"one nearest"``, the nearest of every place's fitted trials in their profile, which draws
+    any boundary. ``n`` is the trials per place."""
     bounded_count("fit", fit)
     bounded_count("test", test)
     summary = len(observer.FEATURES)  # a profile starts with the features
@@ -168,12 +169,14 @@ def pooled_bounds(base: EvolutionConfig, net: _core.Network, fit: int, test: int
     x = np.vstack([xf for (xf, _), _ in data.values()])
     y = np.concatenate([yf for (_, yf), _ in data.values()])
     linear = observer.fit_logistic(x[:, :summary], y)
+    profiled = observer.fit_logistic(x, y)
     nearest = observer.fit_nearest(x, y)
     out = {}
     for name, ((xf, yf), (xt, yt)) in data.items():
         own = observer.fit_logistic(xf[:, :summary], yf)
         out[name] = {"own": int(np.sum(own.predict(xt[:, :summary]) == yt)),
                      "one linear": int(np.sum(linear.predict(xt[:, :summary]) == yt)),
+                     "one linear, profile": int(np.sum(profiled.predict(xt) == yt)),
                      "one nearest": int(np.sum(nearest.predict(xt) == yt)), "n": len(yt)}
     return out
 

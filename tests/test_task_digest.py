@@ -16,7 +16,7 @@ import pytest
 
 import dnnevo
 from dnnevo import ConfigError
-from dnnevo.closedloop import ClosedLoop
+from dnnevo.closedloop import ClosedLoop, FarSeeker
 from dnnevo.closedloop.source import plain_source, task_source
 
 MODULE = '''
@@ -82,14 +82,14 @@ def test_the_text_holds_the_constants_and_functions_the_task_reads_and_nothing_e
     module = load(tmp_path, "digest_reads", MODULE)
     text = task_source(module.Seeker)
     assert text.startswith("class Seeker:")
-    assert "# SPEED\n0.1" in text and "# LIMITS\n{'far': 5.0}" in text
+    assert "# SPEED\nSPEED = 0.1" in text and '# LIMITS\nLIMITS = {"far": 5.0}' in text
     assert "# towards\ndef towards" in text
     assert "UNUSED" not in text and "unrelated" not in text and "import numpy" not in text
-    assert "# SPEED\n0.1" in task_source(module.fitness)
+    assert "# SPEED\nSPEED = 0.1" in task_source(module.fitness)
     # A subclass is its base class too.
     inherited = task_source(module.Ruleless)
     assert inherited.startswith("class Ruleless(Seeker):") and "# Seeker\nclass Seeker:" in inherited
-    assert "# SPEED\n0.1" in inherited
+    assert "# SPEED\nSPEED = 0.1" in inherited
 
 
 @pytest.mark.parametrize("edit, seeker_changes, fitness_changes", [
@@ -277,7 +277,7 @@ def test_an_attribute_is_not_a_global_and_a_container_may_hold_itself(tmp_path) 
     module = load(tmp_path, "digest_edges_c", EDGES)
     text = task_source(module.Task)
     assert "# steps" not in text  # self.steps is an attribute; the module's steps is not read
-    assert "<itself>" in task_source(module.fitness)
+    assert 'TREE["self"] = TREE' in task_source(module.fitness)  # its statements, no endless walk
     assert task_source(module.Task) == task_source(load(tmp_path, "digest_edges_d",
                                                         EDGES.replace("steps = 50", "steps = 60")).Task)
 
@@ -302,3 +302,96 @@ def test_old_runs_keep_their_task_when_an_analysis_attribute_is_added(tmp_path) 
     # And an analysis attribute on a base class leaves its subclasses' tasks as they were.
     assert task_source(analysed.Ruleless).replace("digest_old_a", "") == \
         task_source(plain.Ruleless).replace("digest_old_a", "")
+
+
+RUNTIME = '''
+import enum
+import functools
+
+import numpy as np
+
+PENALTY = 1.0
+CACHE = {}
+
+
+class Color(enum.Enum):
+    RED = 1
+    BLUE = 2
+
+
+MODE = Color.RED
+
+
+def scale(x, k):
+    return k * x
+
+
+HALF = functools.partial(scale, k=0.5)
+
+
+def make(gain):
+    def apply(x):
+        return gain * x
+    return apply
+
+
+AMPLIFY = make(2.0)
+PICK = (scale, make)
+
+
+class Raising:
+    def __getattr__(self, name):
+        raise RuntimeError("no attributes here")
+
+
+ODD = Raising()
+
+
+def penalised(function):
+    @functools.wraps(function)
+    def wrapper(networks):
+        return [v - PENALTY for v in function(networks)]
+    return wrapper
+
+
+@penalised
+def fitness(networks):
+    CACHE[len(networks)] = True
+    return [HALF(AMPLIFY(1.0)) + (MODE is Color.RED) + len(PICK) + (ODD is not None)] * len(networks)
+
+
+class Counted:
+    made = 0
+
+    def __init__(self):
+        type(self).made += 1
+'''
+
+
+@pytest.mark.parametrize("edit", [
+    ("PENALTY = 1.0", "PENALTY = 2.0"),        # read by the decorator's wrapper
+    ("MODE = Color.RED", "MODE = Color.BLUE"),  # an enum constant
+    ("HALF = functools.partial(scale, k=0.5)", "HALF = functools.partial(scale, k=0.25)"),
+    ("AMPLIFY = make(2.0)", "AMPLIFY = make(3.0)"),  # a closure
+    ("PICK = (scale, make)", "PICK = (make, scale)"),
+])
+def test_what_a_module_s_statements_make_is_covered(tmp_path, edit) -> None:
+    before = load(tmp_path, "digest_runtime_a", RUNTIME)
+    after = load(tmp_path, "digest_runtime_b", RUNTIME.replace(*edit))
+    assert task_source(before.fitness) != task_source(after.fitness), edit
+
+
+def test_what_a_task_holds_at_run_time_is_not_an_edit(tmp_path) -> None:
+    module = load(tmp_path, "digest_runtime_c", RUNTIME)
+    before, counted = task_source(module.fitness), task_source(module.Counted)
+    module.fitness([1, 2, 3])  # fills the cache
+    module.Counted(), module.Counted()  # counts
+    assert task_source(module.fitness) == before and task_source(module.Counted) == counted
+    assert "CACHE = {}" in before and "# ODD" in before  # an object that refuses lookups is read safely
+
+
+def test_an_environment_that_holds_itself_is_wrapped() -> None:
+    env = FarSeeker()
+    env.graph = {"leaf": 1}
+    env.graph["parent"] = env.graph
+    assert len(ClosedLoop(env, max_steps=10).digests()) == 3

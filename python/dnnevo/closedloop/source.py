@@ -4,15 +4,17 @@ A run records the SHA-256 of its task's text so that ``resume``, ``assess``, ``p
 ``analyze`` refuse a task edited since. The text of a function or class is its own source and
 what it reads from its module:
 
-- the source of the functions and classes defined there that its code names as globals (and
-  what those name, in turn), a class's base classes from its module among them;
-- the values of the module's data that its code names as globals (numbers, strings, arrays,
-  containers, dataclasses; see :func:`fingerprint`);
-- the values of its default arguments, and of a class's data attributes (``horizon = STEPS``).
+- the source of the functions and classes defined there that it names as globals (in its
+  code, its default arguments, its decorators or a class body's ``horizon = STEPS``), and of
+  what those name in turn, a class's base classes from its module among them;
+- for the module's other names that it reads, the source of the module's top-level statements
+  that make them (``SPEED = 0.1``, ``TABLE["x"] = 2``): what the data is made of, not what it
+  holds at run time, so a cache the task fills or a counter it keeps changes nothing; a name no
+  statement makes (``globals()[...] = ...``) by its value (see :func:`fingerprint`).
 
-Decorated functions are read through their ``__wrapped__``, properties through their getter,
-setter and deleter. So an edited constant at the top of the task's file is an edited task. What
-the task reads from other modules, files or objects' hidden state is not covered.
+Decorated functions are read layer by layer, properties through their getter, setter and
+deleter. So an edited constant at the top of the task's file is an edited task. What the task
+reads from other modules, files or objects' hidden state is not covered.
 
 A class's ``analysis = ...`` attribute (:class:`dnnevo.tasks.protocol.Analysis`) is left out: it
 says how to analyse a champion, not what the task asks, so adding one to a task class keeps the
@@ -36,7 +38,7 @@ import inspect
 import sys
 import textwrap
 import types
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -78,15 +80,19 @@ def fingerprint(value: Any, _walking: frozenset[int] = frozenset()) -> str:
     return f"<{type(value).__module__}.{type(value).__qualname__}>"
 
 
-def legacy_fingerprint(value: Any) -> str:
+def legacy_fingerprint(value: Any, _walking: frozenset[int] = frozenset()) -> str:
     """:func:`fingerprint` as digests were made before it read dataclasses and the keys of
-    mappings item by item, so that runs recorded then are still recognised."""
+    mappings item by item, so that runs recorded then are still recognised (a container that
+    holds itself, which then recursed without end, gets a marker)."""
     if value is None or isinstance(value, bool | int | float | complex | str | bytes | np.generic | np.ndarray):
         return fingerprint(value)
+    if id(value) in _walking:
+        return "<itself>"
+    inner = _walking | {id(value)}
     if isinstance(value, list | tuple):
-        return f"{type(value).__name__}[{', '.join(legacy_fingerprint(v) for v in value)}]"
+        return f"{type(value).__name__}[{', '.join(legacy_fingerprint(v, inner) for v in value)}]"
     if isinstance(value, Mapping):
-        items = sorted((repr(k), legacy_fingerprint(v)) for k, v in value.items())
+        items = sorted((repr(k), legacy_fingerprint(v, inner)) for k, v in value.items())
         return "{" + ", ".join(f"{k}: {v}" for k, v in items) + "}"
     return f"<{type(value).__module__}.{type(value).__qualname__}>"
 
@@ -105,70 +111,114 @@ def plain_source(target: Any, *, ignored: bool = False) -> str | None:
 def task_source(target: Any) -> str | None:
     """The text of a function or class for its digest (see the module docs); None when Python
     cannot find its source."""
-    target = inspect.unwrap(target) if callable(target) and not inspect.isclass(target) else target
     own = plain_source(target, ignored=True)
     if own is None:
         return None
-    parts = [own, *(f"# {label}\n{text}" for label, text in _own_values(target))]
-    seen = {id(target)}
-    for name, value in _dependencies(target, seen):
-        text = (plain_source(value, ignored=True) if _defined_alongside(value, target)
-                else fingerprint(value))
+    statements = _module_statements(target)
+    namespace = _module_namespace(target)
+    parts = [own]
+    seen: set[str] = set()
+    pending = sorted(_names_used(target, own))
+    while pending:
+        name = pending.pop(0)
+        if name in seen or name not in namespace or isinstance(namespace[name], types.ModuleType):
+            continue
+        seen.add(name)
+        value = namespace[name]
+        function = _function_of(value)
+        if name in statements:  # made by a statement (even a function: AMPLIFY = make(2.0))
+            text = "\n".join(statements[name])
+            used = _loaded_names(text)
+        elif (function is not None or inspect.isclass(value)) and _defined_alongside(function or value, target):
+            text = plain_source(function or value, ignored=True) or ""
+            used = _names_used(function or value, text)
+        elif not callable(value):
+            text, used = fingerprint(value), set()
+        else:
+            continue  # code from another module
         parts.append(f"# {name}\n{text}")
-        parts.extend(f"# {name}: {label}\n{extra}" for label, extra in _own_values(value)
-                     if _defined_alongside(value, target))
+        pending.extend(sorted(used - seen))
     return "\n".join(parts)
 
 
-def _own_values(target: Any) -> Iterator[tuple[str, str]]:
-    """The values a function or class holds besides its code: default arguments, and a class's
-    data attributes (not its methods, nor :data:`IGNORED_ATTRIBUTES`)."""
-    for function in _functions(target):
-        if function.__defaults__:
-            yield f"{function.__qualname__} defaults", fingerprint(function.__defaults__)
-        if function.__kwdefaults__:
-            yield f"{function.__qualname__} keyword defaults", fingerprint(function.__kwdefaults__)
-    if inspect.isclass(target):
-        for name, value in sorted(vars(target).items()):
-            if name.startswith("__") or name in IGNORED_ATTRIBUTES or _function_of(value) is not None \
-                    or isinstance(value, property | staticmethod | classmethod | functools.cached_property):
-                continue
-            yield f"{target.__qualname__}.{name}", fingerprint(value)
+def _names_used(target: Any, source: str) -> set[str]:
+    """The global names that ``target`` reads: those its code (every layer of a decorated
+    function, a class's methods and properties) loads as globals, and those its source loads
+    outside function bodies (a class body's ``horizon = STEPS``, default arguments, decorators,
+    base classes)."""
+    names: set[str] = set()
+    codes = [f.__code__ for f in _functions(target)]
+    while codes:
+        code = codes.pop()
+        names.update(str(i.argval) for i in dis.get_instructions(code)
+                     if i.opname in ("LOAD_GLOBAL", "LOAD_NAME"))
+        codes.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
+    return names | _loaded_names(source, outside_bodies=True)
 
 
-def _dependencies(target: Any, seen: set[int]) -> Iterator[tuple[str, Any]]:
-    """The module-level names that ``target``'s code reads as globals, with their values, depth
-    first and each once: data, and functions and classes of ``target``'s own module (whose own
-    names follow them); for a class, first its base classes of that module. Modules, builtins and
-    code from other modules are left out."""
-    namespace = _module_namespace(target)
-    if inspect.isclass(target):  # what a subclass inherits from its module is its too
-        for base in target.__mro__[1:]:
-            if _defined_alongside(base, target) and id(base) not in seen:
-                seen.add(id(base))
-                yield base.__qualname__, base
-                yield from _dependencies(base, seen)
-    for name in sorted(_globals_read(target)):
-        if name not in namespace:
-            continue
-        value = namespace[name]
-        unwrapped = _function_of(value) or value
-        if id(value) in seen or isinstance(value, types.ModuleType):
-            continue
-        if inspect.isfunction(unwrapped) or inspect.isclass(unwrapped):
-            if not _defined_alongside(unwrapped, target):
+def _loaded_names(source: str, *, outside_bodies: bool = False) -> set[str]:
+    """The names ``source`` loads; with ``outside_bodies``, not those inside the bodies of the
+    functions it defines (their code says which of them are globals)."""
+    try:
+        tree = ast.parse(textwrap.dedent(source))
+    except SyntaxError:
+        return set()
+    names: set[str] = set()
+
+    def visit(node: ast.AST) -> None:
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load):
+            names.add(node.id)
+        for field, child in ast.iter_fields(node):
+            if outside_bodies and field == "body" and isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda):
                 continue
-            seen.add(id(value))
-            yield name, unwrapped
-            yield from _dependencies(unwrapped, seen)
-        elif not callable(value):
-            seen.add(id(value))
-            yield name, value
+            for item in child if isinstance(child, list) else [child]:
+                if isinstance(item, ast.AST):
+                    visit(item)
+    visit(tree)
+    return names
+
+
+def _module_statements(target: Any) -> dict[str, list[str]]:
+    """The source of each top-level statement of ``target``'s module that stores a name (an
+    assignment, also to an item or attribute of it, an augmented assignment, a ``for`` or a
+    ``with``), by name: what the module's data is made of, whatever it holds at run time (a
+    cache filled by the task, a counter)."""
+    module = sys.modules.get(getattr(target, "__module__", ""), None)
+    try:
+        source = inspect.getsource(module) if module is not None else ""
+        tree = ast.parse(source)
+    except (OSError, TypeError, SyntaxError):
+        return {}
+    found: dict[str, list[str]] = {}
+    for statement in tree.body:
+        if isinstance(statement, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef | ast.Import
+                      | ast.ImportFrom):
+            continue
+        for node in ast.walk(statement):
+            if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+                stored = node.id
+            elif isinstance(node, ast.Subscript | ast.Attribute) and isinstance(node.ctx, ast.Store) \
+                    and isinstance(base := _base_name(node), str):
+                stored = base
+            else:
+                continue
+            text = ast.get_source_segment(source, statement) or ""
+            if text not in found.setdefault(stored, []):
+                found[stored].append(text)
+    return found
+
+
+def _base_name(node: ast.AST) -> str | None:
+    """The name at the root of ``x[...]`` or ``x.y``."""
+    while isinstance(node, ast.Subscript | ast.Attribute):
+        node = node.value
+    return node.id if isinstance(node, ast.Name) else None
 
 
 def _module_namespace(target: Any) -> Mapping[str, Any]:
-    if inspect.isfunction(target):
-        return target.__globals__
+    function = _function_of(target)
+    if function is not None:
+        return function.__globals__
     module = sys.modules.get(getattr(target, "__module__", ""), None)
     return vars(module) if module is not None else {}
 
@@ -180,40 +230,43 @@ def _defined_alongside(value: Any, target: Any) -> bool:
 
 
 def _function_of(value: Any) -> types.FunctionType | None:
-    """The plain function behind ``value`` (a function, a method, a decorated function, a
-    static or class method, a cached property), or None."""
-    value = getattr(value, "__func__", value)  # staticmethod, classmethod, bound method
-    value = getattr(value, "func", value) if isinstance(value, functools.cached_property) else value
-    if callable(value) and hasattr(value, "__wrapped__"):
-        value = inspect.unwrap(value)
+    """The plain function behind ``value`` (a function, a method, a static or class method, a
+    cached property, the outermost layer of a decorated function), or None, also for an object
+    whose attributes cannot be read."""
+    try:
+        value = inspect.getattr_static(value, "__func__", value)  # staticmethod, classmethod
+        if isinstance(value, types.MethodType):
+            value = value.__func__
+        if isinstance(value, functools.cached_property):
+            value = value.func
+        if not inspect.isfunction(value):  # a callable wrapper (functools.lru_cache)
+            value = inspect.getattr_static(value, "__wrapped__", None)
+    except Exception:  # an object whose lookups raise is no function
+        return None
     return value if inspect.isfunction(value) else None
 
 
 def _functions(target: Any) -> list[types.FunctionType]:
-    """The functions whose code is ``target``'s: itself, or a class's methods and its
-    properties' getters, setters and deleters."""
-    if not inspect.isclass(target):
-        function = _function_of(target)
-        return [function] if function is not None else []
+    """The functions whose code is ``target``'s: every layer of a decorated function (the
+    decorator's wrapper and what it wraps), or a class's methods and its properties' getters,
+    setters and deleters (each with its layers)."""
+    parts = [target]
+    if inspect.isclass(target):
+        parts = []
+        for attribute in vars(target).values():
+            parts.extend([attribute.fget, attribute.fset, attribute.fdel] if isinstance(attribute, property)
+                         else [attribute])
     found: list[types.FunctionType] = []
-    for attribute in vars(target).values():
-        parts = [attribute.fget, attribute.fset, attribute.fdel] if isinstance(attribute, property) \
-            else [attribute]
-        found.extend(f for f in map(_function_of, parts) if f is not None)
+    for part in parts:
+        function = _function_of(part)
+        while function is not None and function not in found:
+            found.append(function)
+            try:
+                inner = inspect.getattr_static(function, "__wrapped__", None)
+            except Exception:
+                inner = None
+            function = _function_of(inner)
     return found
-
-
-def _globals_read(target: Any) -> set[str]:
-    """Every name that the code of a function, or of a class's functions, loads as a global
-    (nested functions and comprehensions included); attribute names are not globals."""
-    codes = [f.__code__ for f in _functions(target)]
-    names: set[str] = set()
-    while codes:
-        code = codes.pop()
-        names.update(str(i.argval) for i in dis.get_instructions(code)
-                     if i.opname in ("LOAD_GLOBAL", "LOAD_NAME"))
-        codes.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
-    return names
 
 
 def _without_ignored(source: str) -> str:

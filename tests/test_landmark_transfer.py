@@ -347,6 +347,9 @@ def test_the_nearest_neighbour_rule_is_the_brute_force_one_and_a_profile_needs_i
     z, zt = (x - rule.mu) / rule.sd, (test - rule.mu) / rule.sd
     brute = y[((zt[:, None, :] - z[None, :, :]) ** 2).sum(-1).argmin(1)]
     assert np.array_equal(rule.predict(test), brute)
+    # Exact ties go to the first of the equally near fitted rows.
+    grid = observer.fit_nearest([[0.0], [1.0], [2.0], [3.0], [4.0]], [0, 1, 0, 1, 0])
+    assert grid.predict([[0.5], [1.5], [2.5], [3.5]]).tolist() == [0, 1, 0, 1]
     assert observer.profile(np.linspace(0, 1, observer.PROFILE_BINS), 0.5).shape == (64,)
     with pytest.raises(ValueError, match="at least 24 steps"):
         observer.profile(np.arange(10.0), 1.0)

@@ -100,6 +100,18 @@ def test_a_run_of_a_script_s_class_says_to_resume_it_from_python(tmp_path: Path)
         dnnevo.evolve(fitness, SMALL, out=tmp_path / "run", progress=False)
 
 
+def test_a_run_of_a_script_s_fitness_function_says_to_resume_it_with_the_function(tmp_path: Path) -> None:
+    (tmp_path / "fit.py").write_text(
+        "import dnnevo\n\ndef fitness(networks):\n    return [n.tau[0] for n in networks]\n\n"
+        "config = dnnevo.EvolutionConfig(population=8, generations=1, size=2, n_inputs=1)\n"
+        "dnnevo.evolve(fitness, config, out='run', progress=False)\n")
+    import subprocess
+    import sys
+    subprocess.run([sys.executable, "fit.py"], cwd=tmp_path, check=True, capture_output=True)
+    with pytest.raises(dnnevo.DnnevoError, match=r"resume it with dnnevo.resume\('.*run', task=fitness\) from Python"):
+        dnnevo.evolve(fitness, SMALL, out=tmp_path / "run", progress=False)
+
+
 def test_a_run_of_a_task_class_missing_its_champion_says_to_resume_it(tmp_path: Path) -> None:
     out = tmp_path / "run"
     dnnevo.evolve(ClosedLoop(FarSeeker(), max_steps=50), SMALL, out=out, progress=False)

@@ -148,9 +148,9 @@ def profile(stream: npt.ArrayLike, near: float) -> npt.NDArray[np.float64]:
     return np.concatenate([features(x, near), quantiles, course])
 
 
-NEAREST_CHUNK = 256
+NEAREST_CHUNK = 16
 """Rows whose distances :meth:`Nearest.predict` computes at once (memory: this many times the
-fitted rows)."""
+fitted rows times the features)."""
 
 
 @dataclass(frozen=True)
@@ -166,11 +166,10 @@ class Nearest:
         """The labels of the rows of ``x``: each the label of its nearest fitted row (the first
         of equally near ones)."""
         z = (np.asarray(x, dtype=float) - self.mu) / self.sd
-        fitted = (self.z ** 2).sum(axis=1)
         labels = np.empty(len(z), dtype=np.int64)
         for start in range(0, len(z), NEAREST_CHUNK):  # distances of a chunk of rows at a time
             part = z[start:start + NEAREST_CHUNK]
-            distance = (part ** 2).sum(axis=1)[:, None] - 2.0 * part @ self.z.T + fitted[None, :]
+            distance = ((part[:, None, :] - self.z[None, :, :]) ** 2).sum(axis=-1)
             labels[start:start + len(part)] = self.y[distance.argmin(axis=1)]
         return labels
 

@@ -11,6 +11,7 @@ import contextlib
 import dataclasses
 import hashlib
 import inspect
+import numbers
 import signal
 import sys
 import threading
@@ -122,7 +123,9 @@ def _numbers(scores: Any) -> npt.NDArray[np.float64]:
         given = np.asarray(scores)
     except (TypeError, ValueError) as e:
         raise FitnessError(f"the fitness function returned values that are not numbers ({e})") from None
-    if given.dtype.kind not in "biuf":
+    numeric = given.dtype.kind in "biuf" or (
+        given.dtype.kind == "O" and all(isinstance(v, numbers.Real) for v in given.ravel()))
+    if not numeric:  # strings (even of numbers), None, other objects
         raise FitnessError(f"the fitness function returned values that are not numbers (of type "
                            f"{given.dtype}); return one number per network")
     return given.astype(np.float64)

@@ -183,10 +183,10 @@ class RunDir:
         task, params = stored.get("task"), stored.get("task_params")
         if not (isinstance(task, str) and task.startswith(PYTHON_TASK)):
             return f"'dnnevo resume {self.path}'"
-        if task.startswith(f"{PYTHON_TASK}__main__."):  # a script's class: no other process imports it
-            return f"dnnevo.resume({str(self.path)!r}, task=ClosedLoop(...)) from Python"
         if not (isinstance(params, Mapping) and "max_steps" in params):  # a fitness function
             return f"dnnevo.resume({str(self.path)!r}, task=fitness) from Python"
+        if task.startswith(f"{PYTHON_TASK}__main__."):  # a script's class: no other process imports it
+            return f"dnnevo.resume({str(self.path)!r}, task=ClosedLoop(...)) from Python"
         return f"'dnnevo resume {self.path}'"
 
     def _occupied(self, contents: list[Path]) -> str:

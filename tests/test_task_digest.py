@@ -4,6 +4,7 @@ that runs recorded before (the class's or function's source alone) are still acc
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import importlib
 import inspect
@@ -154,7 +155,7 @@ def test_runs_that_recorded_the_source_alone_are_still_accepted(tmp_path) -> Non
                          (ClosedLoop(module.Seeker(), episodes=2, max_steps=50), module.Seeker)):
         out = tmp_path / f"run-{target.__name__}"
         size = 3 if target is module.Seeker else 2
-        dnnevo.evolve(task, dataclasses_replace(config, size=size), out=out, progress=False)
+        dnnevo.evolve(task, dataclasses.replace(config, size=size), out=out, progress=False)
         toml = out / "config.toml"
         recorded = toml.read_text()
         current = next(line for line in recorded.splitlines() if line.startswith("fitness_sha256"))
@@ -165,11 +166,6 @@ def test_runs_that_recorded_the_source_alone_are_still_accepted(tmp_path) -> Non
         checkpoint.write_text(checkpoint.read_text().replace(current.split('"')[1], legacy))
         result = dnnevo.resume(out, task, generations=3, progress=False)
         assert len(result.history["best"]) == 3
-
-
-def dataclasses_replace(config, **changes):
-    import dataclasses
-    return dataclasses.replace(config, **changes)
 
 
 def legacy_digest(task, target) -> str:

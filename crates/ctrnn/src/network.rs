@@ -222,6 +222,31 @@ impl Params<'_> {
     }
 }
 
+impl Params<'_> {
+    /// [`validate`](Self::validate) for each of `rows`, the members of a population: an invalid
+    /// member's error names its index (`network 1: tau[0] is -1; ...`).
+    pub fn validate_each(rows: &[Params]) -> Result<()> {
+        for (p, row) in rows.iter().enumerate() {
+            row.validate().map_err(|e| match e {
+                Error::InvalidNetwork(m) => Error::InvalidNetwork(format!("network {p}: {m}")),
+                other => other,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// An owned [`Network`] of these parameters, checked as [`Network::new`] checks them.
+    pub fn to_network(&self) -> Result<Network> {
+        Network::new(
+            self.tau.to_vec(),
+            self.theta.to_vec(),
+            self.weights.to_vec(),
+            self.sensor_weights.to_vec(),
+            Some(self.state.to_vec()),
+        )
+    }
+}
+
 fn expect_len(field: &str, got: usize, want: usize, shape: &str) -> Result<()> {
     if got == want {
         Ok(())

@@ -132,12 +132,7 @@ impl Population {
     /// # Ok::<(), ctrnn::Error>(())
     /// ```
     pub fn from_params(networks: &[Params], precision: Precision) -> Result<Self> {
-        for (p, net) in networks.iter().enumerate() {
-            net.validate().map_err(|e| match e {
-                Error::InvalidNetwork(m) => Error::InvalidNetwork(format!("network {p}: {m}")),
-                other => other,
-            })?;
-        }
+        Params::validate_each(networks)?;
         Self::packed(networks, precision)
     }
 

@@ -15,27 +15,10 @@ use crate::network::{integrator, net_err};
 /// Extracts a population: a sequence of Networks, or a dict of stacked parameter arrays.
 pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
     if let Ok(d) = obj.cast::<PyDict>() {
-        return stacked(d)?
-            .rows()
-            .iter()
-            .enumerate()
-            .map(|(p, row)| {
-                let own = |x: &[f64]| x.to_vec();
-                ctrnn::Network::new(
-                    own(row.tau),
-                    own(row.theta),
-                    own(row.weights),
-                    own(row.sensor_weights),
-                    Some(own(row.state)),
-                )
-                .map_err(|e| {
-                    net_err(format!(
-                        "network {p}: {}",
-                        e.to_string().trim_start_matches("invalid network: ")
-                    ))
-                })
-            })
-            .collect();
+        let arrays = stacked(d)?;
+        let rows = arrays.rows();
+        ctrnn::Params::validate_each(&rows).py_err()?;
+        return rows.iter().map(|row| row.to_network().py_err()).collect();
     }
     Ok(network_objects(obj)?
         .iter()

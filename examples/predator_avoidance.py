@@ -323,36 +323,18 @@ def trace(network: dnnevo.Network, cfg: EvolutionConfig, label: str, *, episodes
 
 
 def _room(ax: Any, env: Pursuit) -> None:
-    from matplotlib.patches import Rectangle
-
-    w, h = env.world["room"]
-    ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2, color="k"))
-    for b in env.world.get("boxes", []):
-        (cx, cy), (bw, bh), angle = b["center"], b["size"], b.get("angle_deg", 0.0)
-        a = np.deg2rad(angle)
-        corner = (cx - 0.5 * (bw * np.cos(a) - bh * np.sin(a)), cy - 0.5 * (bw * np.sin(a) + bh * np.cos(a)))
-        ax.add_patch(Rectangle(corner, bw, bh, angle=angle, color="0.45"))
-    ax.set_xlim(-0.1, w + 0.1)
-    ax.set_ylim(-0.1, h + 0.1)
-    ax.set_aspect("equal")
+    plot.plot_room(env.world, ax)
     ax.set_xticks([])
     ax.set_yticks([])
 
 
 def draw_paths(path: Path, shown: Shown) -> None:
     """The top-down view: the room, the robot's and the pursuers' paths."""
-    robot, chasers = shown.robot, shown.chasers
     fig, ax = plot.subplots(figsize=(7, 5.6), layout="constrained")
-    _room(ax, shown.env)
-    ax.plot(robot[:, 0], robot[:, 1], color="tab:blue", lw=1.5, label="robot")
-    ax.plot(*robot[0, :2], "o", color="tab:blue", ms=7)
-    ax.plot(*robot[-1, :2], "s", color="tab:blue", ms=7)
-    for k in range(chasers.shape[1]):
-        ax.plot(chasers[:, k, 0], chasers[:, k, 1], color="tab:red", lw=1, ls="--",
-                label="pursuers" if k == 0 else None)
-        ax.plot(*chasers[0, k, :2], "o", color="tab:red", ms=5)
-        ax.plot(*chasers[-1, k, :2], "s", color="tab:red", ms=5)
-    ax.set_title(shown.title + "\n(circle: start, square: end)", fontsize=9)
+    plot.plot_paths(shown.env.world, shown.robot, ax, pursuers=shown.chasers,
+                    title=shown.title + "\n(circle: start, square: end)")
+    ax.set_xticks([])
+    ax.set_yticks([])
     ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
     save_figure(fig, path)
     plot.close(fig)

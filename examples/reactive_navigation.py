@@ -158,21 +158,16 @@ def paths(world: str, detectors: bool, starts: int, steps: int = 1200) -> tuple[
 def figure(out: Path, starts: int) -> None:
     """The U-trap seen from above: the first ``starts`` fresh starts' paths without and with the
     detectors."""
-    from matplotlib.patches import Circle, Rectangle
+    from matplotlib.patches import Circle
     fig, axes = plot.subplots(1, 2, figsize=(10, 4.2), sharey=True)
     for ax, detectors in zip(axes, (False, True)):
         env, tracks, arrived = paths("u-trap", detectors, starts)
         w, h = env.world["room"]
-        ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2))
-        for box in env.world.get("boxes", []):
-            (cx, cy), (bw, bh) = box["center"], box["size"]
-            ax.add_patch(Rectangle((cx - bw / 2, cy - bh / 2), bw, bh, angle=box.get("angle_deg", 0.0),
-                                   rotation_point="center", color="0.4"))
+        plot.plot_room(env.world, ax)
         ax.add_patch(Circle(tuple(env.goal), env.goal_radius, color="tab:green", alpha=0.4))
         for track, ok in zip(tracks, arrived):
             ax.plot(track[:, 0], track[:, 1], lw=0.9, color="tab:blue" if ok else "tab:red", alpha=0.8)
             ax.plot(*track[0], "k.", ms=4)
-        ax.set_aspect("equal")
         ax.set_xlim(0, w)
         ax.set_ylim(0, h)
         ax.set_title(f"{'with' if detectors else 'without'} detectors: {arrived.sum()} of {starts} arrive")

@@ -192,7 +192,9 @@ def test_non_empty_out_is_refused(tmp_path: Path) -> None:
                                   ("show", "--debug", "no-such-folder")])
 def test_debug_shows_traceback_before_or_after_the_command(tmp_path: Path, args: tuple[str, ...]) -> None:
     r = dnnevo(*args, cwd=tmp_path)
-    assert r.returncode != 0 and "Traceback" in r.stderr
+    # The same exit status as without --debug: 1 would be assess's "fail".
+    assert r.returncode == 2 and "Traceback" in r.stderr, r.stderr
+    assert r.stderr.strip().splitlines()[-1].startswith("dnnevo: error: ")
 
 
 def test_without_debug_an_error_is_one_line(tmp_path: Path) -> None:
@@ -301,3 +303,16 @@ def test_a_sweep_seeds_every_run_from_earlier_runs(tmp_path: Path) -> None:
         assert run["seeded_with"] == "populations" and run["cross_scale"] == 0.5
     info = json.loads((tmp_path / "s" / "summary.json").read_text())
     assert json.dumps(info).count(str(tmp_path / "a")) >= 1
+
+
+def test_nav1d_system_names_a_bad_count_and_a_bad_out_before_any_work(tmp_path: Path) -> None:
+    parts = ["--classifier", "c", "--far", "f", "--near", "n"]
+    r = dnnevo("nav1d-system", *parts, "--trials", "0", cwd=tmp_path)
+    assert r.returncode == 2 and "--trials is 0; it must be >= 1" in r.stderr, r.stderr
+    (tmp_path / "file").write_text("")
+    r = dnnevo("nav1d-system", *parts, "--out", "file", cwd=tmp_path)
+    assert r.returncode == 2 and "--out file is a file" in r.stderr, r.stderr
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "config.toml").write_text("")
+    r = dnnevo("nav1d-system", *parts, "--out", "run", cwd=tmp_path)
+    assert r.returncode == 2 and "is a run folder" in r.stderr, r.stderr

@@ -15,7 +15,7 @@ import reference as ref
 
 import dnnevo
 from dnnevo import Batch, InvalidArgumentError, TaskError
-from dnnevo.closedloop import FarSeeker, rollout
+from dnnevo.closedloop import ClosedLoop, FarSeeker, rollout
 
 
 def networks(count: int, n: int = 4, m: int = 2, seed: int = 0) -> list[dnnevo.Network]:
@@ -108,7 +108,7 @@ def test_reset_set_states_and_rates() -> None:
 @pytest.mark.parametrize("call, message", [
     (lambda b: b.step(np.ones((5, 2))), r"inputs has shape \(5, 2\); expected \(B, M\) = \(4, 2\)"),
     (lambda b: b.step(np.full((4, 2), np.nan)), r"inputs\[0, 0\] is NaN"),
-    (lambda b: b.step(np.ones((4, 2)), active=[1, 0, 1, 1]), "active is a int64 array"),
+    (lambda b: b.step(np.ones((4, 2)), active=[1, 0, 1, 1]), "active is an array of dtype int64"),
     (lambda b: b.step(np.ones((4, 2)), active=np.ones(3, bool)), r"expected booleans of shape \(4,\)"),
     (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 4), np.float32)), "out is array"),
     (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 3))), r"out has shape \(4, 3\)"),
@@ -631,30 +631,40 @@ def test_naming_the_task_or_passing_it_evolves_the_same(tmp_path, monkeypatch) -
 
 
 def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path, monkeypatch) -> None:
-    """config.toml cannot record an environment object's arguments: a command that builds the
-    task from it builds Seeker() with its defaults, and the digest says when that is another
-    task."""
+    """config.toml records an environment object's arguments only when they can be told from
+    it (ClosedLoop.arguments): else a command that builds the task from it builds Seeker() with
+    its defaults, and the digest says that is another task."""
     from dnnevo.closedloop import ClosedLoop
 
     (tmp_path / "seeker_arg.py").write_text(SEEKER)
     monkeypatch.syspath_prepend(str(tmp_path))
     import seeker_arg
 
+    def seeker(speed: float, tagged: bool):
+        env = seeker_arg.Seeker(speed=speed)
+        if tagged:
+            env.tag = 1  # set after it was made: no arguments make it again
+        return env
+
     config = dnnevo.EvolutionConfig(population=10, generations=2, size=3, n_inputs=1, selection="rank")
-    for speed, folder in [(0.1, "same"), (0.2, "other")]:
-        loop = ClosedLoop(seeker_arg.Seeker(speed=speed), episodes=2, max_steps=50)
+    for speed, tagged, folder in [(0.1, False, "same"), (0.2, False, "told"), (0.2, True, "other")]:
+        loop = ClosedLoop(seeker(speed, tagged), episodes=2, max_steps=50)
         dnnevo.evolve(loop, config, out=tmp_path / folder, progress=False)
-    same = dnnevo_command(tmp_path, "assess", "same", "--trials", "20")
-    assert same.returncode in (0, 1, 3) and "20 fresh episodes" in same.stdout, same.stderr
+    for folder in ("same", "told"):
+        judged = dnnevo_command(tmp_path, "assess", folder, "--trials", "20")
+        assert judged.returncode in (0, 1, 3) and "20 fresh episodes" in judged.stdout, judged.stderr
+    assert "speed = 0.2" in (tmp_path / "told" / "config.toml").read_text()
+    assert "speed" not in (tmp_path / "other" / "config.toml").read_text()
     other = dnnevo_command(tmp_path, "assess", "other")
     assert other.returncode == 2 and "another version of python:seeker_arg.Seeker" in other.stderr
     resumed = dnnevo_command(tmp_path, "resume", "other", "--generations", "3")
     assert resumed.returncode == 2 and "another version" in resumed.stderr
-    # From Python, with the environment it began with, and by its name for the other.
-    loop = ClosedLoop(seeker_arg.Seeker(speed=0.2), episodes=2, max_steps=50)
+    # From Python, with the environment it began with, and by its name for the others.
+    loop = ClosedLoop(seeker(0.2, True), episodes=2, max_steps=50)
     assert len(dnnevo.resume(tmp_path / "other", loop, generations=3, progress=False).history["best"]) == 3
-    by_name = dnnevo.resume(tmp_path / "same", "python:seeker_arg.Seeker", generations=3, progress=False)
-    assert len(by_name.history["best"]) == 3
+    for folder in ("same", "told"):
+        by_name = dnnevo.resume(tmp_path / folder, "python:seeker_arg.Seeker", generations=3, progress=False)
+        assert len(by_name.history["best"]) == 3
 
 
 def test_a_fitness_function_run_is_neither_resumed_nor_judged_by_the_command_line(tmp_path) -> None:
@@ -687,8 +697,14 @@ def test_the_environment_sees_read_only_arrays_and_may_return_the_rates() -> Non
 
 def test_a_diverging_integration_is_not_blamed_on_the_task() -> None:
     fast = dnnevo.Network(tau=[0.01], theta=[0.0], weights=[[0.0]], sensor_weights=[[1.0]])
-    with pytest.raises(InvalidArgumentError, match="integration diverged") as caught:
+    with pytest.raises(InvalidArgumentError, match=r"dt / tau is 10 for tau\[0\]") as caught:
         rollout([fast], Drift(length=1000), max_steps=1000, dt=0.1, substeps=100)
+    assert not isinstance(caught.value, TaskError)
+    # Two neurons always firing, each weighing 1e308 on both: the sum is past the largest f64.
+    loud = dnnevo.Network(tau=[1.0, 1.0], theta=[-1e3, -1e3], weights=np.full((2, 2), 1e308),
+                          sensor_weights=np.zeros((2, 1)))
+    with pytest.raises(InvalidArgumentError, match="integration diverged") as caught:
+        rollout([loud], Drift(length=1000), max_steps=1000, dt=0.1, substeps=100)
     assert not isinstance(caught.value, TaskError)
 
 
@@ -752,3 +768,52 @@ def test_a_sweep_of_a_task_class_on_dask_workers_matches_one_in_process(tmp_path
 def test_large_finite_returns_are_not_an_error() -> None:
     result = rollout(networks(4, m=1), Broken("large once"), episodes=2, max_steps=10)
     assert np.isfinite(result.returns).all() and (result.returns > 1e307).all()
+
+
+DIAL = '''
+import numpy as np
+
+
+class Dial:
+    observation_size = 1
+    success_rate = 0.5
+
+    def __init__(self, speed=0.1, label="a", *, hidden=3):
+        self.speed = speed
+        self.label = label
+        self._hidden = hidden
+
+    def reset(self, episodes, rng):
+        self.x = np.zeros(len(episodes))
+        return np.ones((len(episodes), 1))
+
+    def step(self, rates, active):
+        self.x += self.speed * rates[:, 0]
+        return np.ones((len(self.x), 1)), self.x.copy(), self.x > 3
+
+    def success(self, returns, lengths):
+        return returns > 0
+'''
+
+
+def test_a_run_begun_from_python_records_the_arguments_it_can_tell_and_the_command_line_judges_it(
+        tmp_path) -> None:
+    import sys
+
+    (tmp_path / "dial.py").write_text(DIAL)
+    sys.path.insert(0, str(tmp_path))
+    try:
+        import dial
+    finally:
+        sys.path.remove(str(tmp_path))
+    assert ClosedLoop(dial.Dial(speed=0.2, label="b"), max_steps=5).arguments() == {"speed": 0.2, "label": "b"}
+    assert ClosedLoop(dial.Dial(), max_steps=5).arguments() == {}
+    # hidden is kept under another name: an object made from what can be told differs, so nothing
+    # is recorded, not a part.
+    assert ClosedLoop(dial.Dial(speed=0.2, hidden=4), max_steps=5).arguments() == {}
+    config = dnnevo.EvolutionConfig(population=8, generations=2, size=2, n_inputs=1, selection="rank")
+    dnnevo.evolve(ClosedLoop(dial.Dial(speed=0.2), max_steps=20), config, out=tmp_path / "run", progress=False)
+    assert "speed = 0.2" in (tmp_path / "run" / "config.toml").read_text()
+    judged = dnnevo_command(tmp_path, "assess", "run", "--trials", "20")
+    assert judged.returncode in (0, 1, 3), judged.stderr
+    assert "fresh episodes" in judged.stdout

@@ -354,6 +354,68 @@ def test_a_log_written_with_float_generations_reads_shows_and_resumes(pristine: 
     assert (run / "best.json").read_text() == (longer / "best.json").read_text()
 
 
+def test_a_run_whose_checkpoint_is_gone_is_not_quietly_started_again(pristine: Path, tmp_path: Path) -> None:
+    """Without checkpoint.json, resume would start from generation 0: refused while log.csv or
+    best.json shows work it would lose; a folder with only config.toml starts again."""
+    run = copy(pristine, tmp_path / "run")
+    (run / "checkpoint.json").unlink()
+    before = {p.name: p.read_bytes() for p in run.iterdir()}
+    r = run_cli("resume", run)
+    assert_one_line_error(r, "has no checkpoint.json, but log.csv records 6 generations",
+                          "restore checkpoint.json")
+    assert {p.name: p.read_bytes() for p in run.iterdir()} == before
+    (run / "log.csv").unlink()
+    assert_one_line_error(run_cli("resume", run), "records 0 generations and best.json a champion")
+    (run / "best.json").unlink()
+    r = run_cli("resume", run)
+    assert r.returncode == 0, r.stderr
+    assert (run / "log.csv").read_text() .count("\n") == 7
+
+
+def test_a_run_that_failed_in_its_first_generation_is_not_sent_round_to_resume(pristine: Path,
+                                                                               tmp_path: Path) -> None:
+    run = copy(pristine, tmp_path / "run")
+    (run / "best.json").unlink()
+    header = (run / "log.csv").read_text().splitlines()[0]
+    (run / "log.csv").write_text(header + "\n")
+    assert_one_line_error(run_cli("assess", run), "no generation has finished: its run stopped in generation 0")
+
+
+def test_an_edited_seed_is_blamed_on_config_toml(pristine: Path, tmp_path: Path) -> None:
+    run = copy(pristine, tmp_path / "run")
+    text = (run / "config.toml").read_text()
+    assert "seed = 3\n" in text
+    (run / "config.toml").write_text(text.replace("seed = 3\n", "seed = 4\n"))
+    for command in ("show", "assess"):
+        assert_one_line_error(run_cli(command, run), "config.toml was edited after the run: run.seed is 4 "
+                              "in config.toml and 3 in checkpoint.json")
+
+
+def test_a_folder_being_written_is_named_as_such_by_show_and_run(pristine: Path, tmp_path: Path) -> None:
+    run = copy(pristine, tmp_path / "run")
+    assert RunDir(run).writer() is None
+    with RunDir(run).writing(create=False):
+        assert RunDir(run).writer() == str(os.getpid())
+        shown = run_cli("show", run)
+        assert shown.returncode == 0 and f"the run is going on (PID {os.getpid()})" in shown.stdout, shown.stdout
+        assert_one_line_error(run_cli("run", "sequence-1bit", "--quick", "--out", run),
+                              f"is in use by another dnnevo process (PID {os.getpid()})")
+    assert RunDir(run).writer() is None
+
+
+def test_resume_says_which_damaged_file_it_writes_again(pristine: Path, tmp_path: Path) -> None:
+    run = copy(pristine, tmp_path / "run")
+    (run / "log.csv").write_text("garbled\n1,2\n")
+    (run / "best.json").unlink()
+    r = run_cli("resume", run, "--generations", "7")
+    assert r.returncode == 0, r.stderr
+    assert "log.csv was damaged" in r.stderr and "best.json was gone" in r.stderr, r.stderr
+    assert "written again from checkpoint.json" in r.stderr
+    assert_consistent(run)
+    r = run_cli("resume", run, "--generations", "8")
+    assert r.returncode == 0 and "written again" not in r.stderr, r.stderr
+
+
 KILLS = 30 if FULL else 8
 KILL_GENERATIONS = 100
 KILL_RUN = ["sequence-1bit", "--quick", "--set", "population=40", "--set", f"generations={KILL_GENERATIONS}"]

@@ -108,3 +108,11 @@ def test_landmark_assessment_stops_on_ctrl_c() -> None:
     net = dnnevo.Network.random(config.size, config.n_inputs, seed=3)
     trials = sized(lambda n: landmark.assess(config, net, n, 1), 200, 200_000)
     assert interrupted_after(lambda: landmark.assess(config, net, trials, 1)) < LATENCY
+
+
+def test_the_equilibrium_search_stops_on_ctrl_c() -> None:
+    from dnnevo import analysis
+
+    net = dnnevo.Network.random(12, 2, seed=4)
+    starts = sized(lambda n: analysis.equilibria(net, [0.0, 0.0], starts=n), 2048, 1 << 24)
+    assert interrupted_after(lambda: analysis.equilibria(net, [0.0, 0.0], starts=starts)) < LATENCY

@@ -120,10 +120,27 @@ def test_a_count_that_is_no_integer_is_a_type_error_naming_the_argument(substeps
     assert make().run(np.ones((5, 2)), substeps=np.int64(2)).states.shape == (5, 3)
 
 
-def test_divergent_euler_is_an_error_not_infinities() -> None:
-    net = dnnevo.Network([0.5], [0.0], [[0.0]], [[0.0]], state=[1.0])
-    with pytest.raises(InvalidArgumentError, match="diverged"):
-        net.run(np.zeros((1000, 1)), dt=5.0)
+def test_a_step_too_long_for_a_time_constant_is_refused_not_integrated() -> None:
+    """From dt / tau = 2 on (2.785 with RK4) a neuron's own decay grows at every step: the
+    numbers would be a flicker, then overflow, not the network's dynamics."""
+    net = dnnevo.Network([0.5, 0.04], [0.0, 0.0], np.zeros((2, 2)), np.ones((2, 1)))
+    with pytest.raises(InvalidArgumentError, match=r"dt / tau is 2.5 for tau\[1\] = 0.04 \(dt 0.1\); "
+                                                   r"from 2 on, Euler steps .* use dt < 0.08, or method rk4"):
+        net.run(np.ones((100, 1)), dt=0.1)
+    assert np.isfinite(net.run(np.ones((100, 1)), dt=0.1, method="rk4").states).all()
+    with pytest.raises(InvalidArgumentError, match=r"from 2.785 on, RK4 steps"):
+        net.run(np.ones((100, 1)), dt=0.12, method="rk4")
+    with pytest.raises(InvalidArgumentError, match=r"network 1's tau\[1\] = 0.04"):
+        dnnevo.Batch([dnnevo.Network.random(2, 1, seed=0), net], dt=0.1)
+    with pytest.raises(InvalidArgumentError, match=r"network 1's tau\[1\]"):
+        dnnevo.run_population([dnnevo.Network.random(2, 1, seed=0), net], np.ones((5, 1)), dt=0.1)
+
+
+def test_an_overflow_at_a_short_step_is_not_blamed_on_the_step() -> None:
+    # Two neurons always firing, each weighing 1e308 on both: the sum is past the largest f64.
+    net = dnnevo.Network([1.0, 1.0], [-1e3, -1e3], np.full((2, 2), 1e308), np.zeros((2, 1)))
+    with pytest.raises(InvalidArgumentError, match="diverged: .* dt / tau is 0.1 here, so the step is not the cause"):
+        net.run(np.ones((3, 1)))
 
 
 def test_file_round_trip_is_exact(tmp_path: Path) -> None:
@@ -178,7 +195,7 @@ def test_non_finite_in_dict_is_a_format_error() -> None:
         dnnevo.Network.from_dict(d)
     d = make().to_dict()
     d["meta"] = {"labels": [object()]}
-    with pytest.raises(FormatError, match=r"meta.labels\[0\] is a object"):
+    with pytest.raises(FormatError, match=r"meta.labels\[0\] is of type object"):
         dnnevo.Network.from_dict(d)
     # NumPy arrays and scalars are accepted where lists and floats are.
     d = {k: np.asarray(v) if isinstance(v, list) else v for k, v in make().to_dict().items()}
@@ -243,7 +260,7 @@ def test_population_from_stacked_arrays() -> None:
     ("networks", "inputs", "error", "fragment"),
     [
         ([], np.ones((3, 1)), InvalidArgumentError, "at least 1 network"),
-        ([1, 2], np.ones((3, 1)), InvalidArgumentError, "networks[0] is a int"),
+        ([1, 2], np.ones((3, 1)), InvalidArgumentError, "networks[0] is of type int"),
         (None, np.ones((3, 1)), InvalidArgumentError, "sequence of Network"),
         ("mixed", np.ones((3, 1)), InvalidArgumentError, "network 1 has N = 2"),
         ("ok", np.ones((3, 2)), InvalidArgumentError, "expected (T, M) or (P, T, M)"),
@@ -300,3 +317,17 @@ def test_save_refuses_meta_that_load_would_refuse(tmp_path: Path) -> None:
         assert not path.exists()
     make().save(path, meta={"seed": 2.0, "notes": [None, {"x": 1}]})  # the schema's integer; free keys
     assert dnnevo.Network.load(path).meta["notes"] == [None, {"x": 1}]
+
+
+def test_random_takes_ranges_as_config_toml_and_the_config_hold_them() -> None:
+    from dnnevo import ConfigError, EvolutionConfig
+
+    as_tuples = dnnevo.Network.random(3, 1, seed=4, ranges={"tau": (1.0, 2.0)})
+    assert dnnevo.Network.random(3, 1, seed=4, ranges={"tau": [1.0, 2.0]}) == as_tuples
+    assert ((as_tuples.tau >= 1.0) & (as_tuples.tau <= 2.0)).all()
+    config = EvolutionConfig()
+    assert dnnevo.Network.random(3, 1, seed=4, ranges=config.ranges) == dnnevo.Network.random(3, 1, seed=4)
+    with pytest.raises(ConfigError, match=r'ranges\["tau"\] must be a pair \[low, high\]; it is \[1.0, 2.0, 3.0\]'):
+        dnnevo.Network.random(3, 1, seed=4, ranges={"tau": [1.0, 2.0, 3.0]})
+    with pytest.raises(ConfigError, match="ranges must be a dict"):
+        dnnevo.Network.random(3, 1, seed=4, ranges=[1.0, 2.0])

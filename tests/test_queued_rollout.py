@@ -179,7 +179,7 @@ def test_a_batch_of_fewer_rows_hands_rows_to_other_networks() -> None:
         (([0, 0], [1, 2]), "row 0 is named twice"),
         (([0], [0, 1]), "1 rows and 2 networks"),
         (([-1], [0]), r"rows holds -1; indices are >= 0"),
-        (([0.5], [0]), "rows is a float64 array of 1 dimensions; expected a 1-D array of indices"),
+        (([0.5], [0]), "rows is an array of dtype float64 and 1 dimensions; expected a 1-D array of indices"),
     ]:
         with pytest.raises(InvalidArgumentError, match=message):
             batch.assign(*args)

@@ -16,7 +16,7 @@ import dnnevo
 import reference as ref
 from dnnevo import _core
 from dnnevo.closedloop import ClosedLoop, rollout
-from dnnevo.errors import InvalidArgumentError
+from dnnevo.errors import InvalidArgumentError, TaskError
 from dnnevo.robots import Avoid, RobotWorld
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -240,8 +240,8 @@ def fleet(rows: int = 2) -> _core.Fleet:
     ([[0.1, 0.1], [np.inf, 0.1]], None, r"wheels\[1, 0\] is inf"),
     ([0.1, 0.1], None, r"wheels has shape \(2,\); expected \(2, 2\)"),
     ([["a", "b"], ["c", "d"]], None, "wheels is not a numeric array"),
-    ([[0.1, 0.1], [0.1, 0.1]], [1, 0], "active is a int64 array of shape"),
-    ([[0.1, 0.1], [0.1, 0.1]], [True], r"active is a bool array of shape \(1,\); expected"),
+    ([[0.1, 0.1], [0.1, 0.1]], [1, 0], "active is an array of dtype int64 and shape"),
+    ([[0.1, 0.1], [0.1, 0.1]], [True], r"active is an array of dtype bool and shape \(1,\); expected"),
 ])
 def test_a_bad_step_names_its_argument_and_moves_nothing(wheels, active, message) -> None:
     f = fleet()
@@ -278,14 +278,19 @@ def test_bad_settings_name_the_field(settings, message) -> None:
 def test_bad_worlds_resets_and_placements_name_the_argument(tmp_path: Path) -> None:
     with pytest.raises(InvalidArgumentError, match="world is 'landmark3'; expected one of 'landmark1'"):
         RobotWorld("landmark3")
-    with pytest.raises(InvalidArgumentError, match="world file .*missing.toml cannot be read"):
+    with pytest.raises(FileNotFoundError, match="world file .*missing.toml does not exist"):
         RobotWorld(tmp_path / "missing.toml")
+    (tmp_path / "latin.toml").write_bytes(b"room = [6.0, 5.0] # \xff\n")
+    with pytest.raises(InvalidArgumentError, match="latin.toml is not UTF-8 text"):
+        RobotWorld(tmp_path / "latin.toml")
+    with pytest.raises(InvalidArgumentError, match=r"a world file's name ends in .toml, not .TOML"):
+        RobotWorld("my_world.TOML")
     (tmp_path / "bad.toml").write_text("room = [-4.0, 3.0]\nstart = { min = [0, 0], max = [1, 1] }\n")
     with pytest.raises(InvalidArgumentError, match=r"room\[0\] is -4"):
         RobotWorld(tmp_path / "bad.toml")
     with pytest.raises(InvalidArgumentError, match="world file: line 1"):
         _core.Fleet("rooms = [1, 2]")
-    with pytest.raises(InvalidArgumentError, match="world is a int"):
+    with pytest.raises(InvalidArgumentError, match="world is of type int"):
         _core.Fleet(3)
     with pytest.raises(InvalidArgumentError, match="robot is 0.3; expected a dict of settings"):
         RobotWorld(robot=0.3)
@@ -298,7 +303,7 @@ def test_bad_worlds_resets_and_placements_name_the_argument(tmp_path: Path) -> N
     f = fleet()
     with pytest.raises(InvalidArgumentError, match=r"episodes\[1\] is -2; it must be an integer"):
         f.reset([0, -2], 0)
-    with pytest.raises(InvalidArgumentError, match="episodes is a float64 array"):
+    with pytest.raises(InvalidArgumentError, match="episodes is an array of dtype float64"):
         f.reset([0.5], 0)
     with pytest.raises(InvalidArgumentError, match="seed is -1"):
         f.reset([0], -1)
@@ -346,6 +351,11 @@ def test_avoid_evolves_and_resumes_to_the_end_of_an_unbroken_run(tmp_path: Path)
                                                           validation_episodes=4), progress=False)
     assert np.array_equal(resumed.history["best"], whole.history["best"])
     assert resumed.best == whole.best
+    # dnnevo plot draws a robot task's paths: the room, and the champion's robot in it.
+    from dnnevo.figures import draw_run
+
+    assert draw_run(tmp_path / "whole", seed=3) == ["fitness.png", "episodes.png", "paths.png"]
+    assert (tmp_path / "whole" / "paths.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_avoid_pays_for_speed_and_charges_for_contacts() -> None:
@@ -365,3 +375,48 @@ def test_the_example_script_runs(capsys: pytest.CaptureFixture[str]) -> None:
     assert lines[0].startswith("seed") and len(lines) == 1 + 2 + 1
     assert lines[1].split()[0] == "0" and "/10 (" in lines[1]
     assert "of 2 seeds" in lines[-1] and "95% interval" in lines[-1]
+
+
+def test_a_world_file_array_of_three_numbers_is_refused_not_cut_to_two(tmp_path: Path) -> None:
+    world = tmp_path / "room.toml"
+    world.write_text("room = [5.0, 4.0, 3.0]\nstart = { min = [0.5, 0.5], max = [4.5, 3.5] }\n")
+    with pytest.raises(InvalidArgumentError, match=r"line 1: room: invalid length 3, expected an array of 2"):
+        RobotWorld(world)
+
+
+def test_a_world_dict_error_names_the_field() -> None:
+    world = {"room": [6.0, 5.0], "start": {"min": [0.4, 0.4], "max": [5.6, 4.6]},
+             "boxes": [{"center": [3.0, 2.0], "size": [1.0, 1.0]}, {"center": [1.0, 1.0], "colour": 1}]}
+    with pytest.raises(InvalidArgumentError, match=r"world.boxes\[1\].colour: unknown field `colour`"):
+        RobotWorld(world)
+    world["boxes"] = [{"center": [3.0, 2.0], "size": [1.0]}]
+    with pytest.raises(InvalidArgumentError, match=r"world.boxes\[0\].size: invalid length 1"):
+        RobotWorld(world)
+
+
+def test_a_start_region_with_too_little_room_is_refused_when_the_world_is_made() -> None:
+    # A 1.2 m box in a 2 m room leaves a robot of radius 0.265 no place 0.05 m from everything.
+    crowded = {"room": [2.0, 2.0], "start": {"min": [0.3, 0.3], "max": [1.7, 1.7]},
+               "boxes": [{"center": [1.0, 1.0], "size": [1.2, 1.2]}]}
+    with pytest.raises(InvalidArgumentError, match=r"start region is free .* at 0.00% of its points"):
+        RobotWorld(crowded)
+
+
+def test_networks_too_small_for_the_wheels_are_named() -> None:
+    with pytest.raises(TaskError, match=r"wheels \(left, right\) read neurons \[0, 1\]; the networks have "
+                                        r"1 neuron: give them at least 2"):
+        rollout([dnnevo.Network.random(1, 8, seed=1)], RobotWorld("landmark1"), max_steps=3)
+    with pytest.raises(TaskError, match=r"read neurons \[0, 7\]; the networks have 4 neurons"):
+        rollout([dnnevo.Network.random(4, 8, seed=1)], RobotWorld("landmark1", right=7), max_steps=3)
+
+
+def test_the_command_line_takes_n_inputs_from_the_instance_not_the_class() -> None:
+    from dnnevo import presets
+    config = presets.get("python:dnnevo.robots.RobotWorld",
+                         overrides=["task_params.max_steps=50", "task_params.sonar={angles_deg=[0, 90]}"])
+    assert config.n_inputs == 2
+    config = presets.get("python:dnnevo.robots.RobotWorld",
+                         overrides=["task_params.max_steps=50", "task_params.sectors={count=4}"])
+    assert config.n_inputs == 12
+    assert presets.get("python:dnnevo.robots.RobotWorld",
+                       overrides=["task_params.max_steps=50", "n_inputs=3"]).n_inputs == 3

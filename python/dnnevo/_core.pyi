@@ -110,8 +110,11 @@ class Network:
         n_inputs: int,
         *,
         seed: int,
-        ranges: Mapping[str, tuple[float, float]] | None = None,
-    ) -> Network: ...
+        ranges: Mapping[str, Sequence[float]] | Any | None = None,
+    ) -> Network:
+        """A network with every parameter uniform in its range (``ranges``: a dict of
+        ``[low, high]`` pairs by kind, ``tau``, ``theta``, ``weights`` and ``sensor_weights``, or a
+        ``dnnevo.Ranges``; a kind left out keeps its default), drawn from ``seed``."""
     @property
     def size(self) -> int: ...
     @property

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 
-__all__ = ["axes", "close", "plot_fitness", "plot_fitness_seeds",
+__all__ = ["axes", "close", "plot_fitness", "plot_fitness_seeds", "plot_paths", "plot_room",
            "plot_traces", "pyplot", "subplots"]
 
 
@@ -130,4 +130,55 @@ def plot_traces(
     ax.set_xlabel("time step")
     if title:
         ax.set_title(title, fontsize=10)
+    return ax
+
+
+def plot_room(world: Mapping[str, Any], ax: Axes | None = None) -> Axes:
+    """A 2-D world seen from above: its walls and its boxes (a world as a dict, as
+    ``RobotWorld.world`` holds it; docs/worlds.md), with equal scales on both axes, in metres."""
+    Rectangle = pyplot().Rectangle  # noqa: N806 - matplotlib's class
+    ax = axes(ax)
+    w, h = world["room"]
+    ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=2, color="k"))
+    for b in world.get("boxes", []):
+        (cx, cy), (bw, bh), angle = b["center"], b["size"], b.get("angle_deg", 0.0)
+        a = np.deg2rad(angle)
+        corner = (cx - 0.5 * (bw * np.cos(a) - bh * np.sin(a)), cy - 0.5 * (bw * np.sin(a) + bh * np.cos(a)))
+        ax.add_patch(Rectangle(corner, bw, bh, angle=angle, color="0.45"))
+    ax.set_xlim(-0.1, w + 0.1)
+    ax.set_ylim(-0.1, h + 0.1)
+    ax.set_aspect("equal")
+    return ax
+
+
+def plot_paths(world: Mapping[str, Any], robot: npt.ArrayLike, ax: Axes | None = None, *,
+               pursuers: npt.ArrayLike | None = None, title: str | None = None) -> Axes:
+    """A robot's path through ``world`` (:func:`plot_room`): ``robot`` holds its poses, (T, 3)
+    rows of x, y and heading (or (T, 2) positions), ``pursuers`` theirs, (T, K, 3); a circle
+    marks each start and a square each end.
+
+    >>> ax = plot_paths({"room": [4.0, 3.0]}, [[1.0, 1.0, 0.0], [2.0, 1.5, 0.3]])
+    >>> print(*(round(float(v), 1) for v in ax.get_xlim()))
+    -0.1 4.1
+    >>> close(ax.figure)
+    """
+    path = np.asarray(robot, dtype=float)
+    if path.ndim != 2 or path.shape[1] not in (2, 3) or len(path) == 0:
+        raise InvalidArgumentError(f"robot has shape {path.shape}; expected (T, 3) poses or (T, 2) "
+                                   "positions, T >= 1")
+    chasers = np.zeros((len(path), 0, 2)) if pursuers is None else np.asarray(pursuers, dtype=float)
+    if chasers.ndim != 3 or chasers.shape[0] != len(path) or chasers.shape[2] < 2:
+        raise InvalidArgumentError(f"pursuers has shape {chasers.shape}; expected ({len(path)}, K, 3), "
+                                   "one row of poses per robot pose")
+    ax = plot_room(world, ax)
+    ax.plot(path[:, 0], path[:, 1], color="tab:blue", lw=1.5, label="robot")
+    ax.plot(*path[0, :2], "o", color="tab:blue", ms=7)
+    ax.plot(*path[-1, :2], "s", color="tab:blue", ms=7)
+    for k in range(chasers.shape[1]):
+        ax.plot(chasers[:, k, 0], chasers[:, k, 1], color="tab:red", lw=1, ls="--",
+                label="pursuers" if k == 0 else None)
+        ax.plot(*chasers[0, k, :2], "o", color="tab:red", ms=5)
+        ax.plot(*chasers[-1, k, :2], "s", color="tab:red", ms=5)
+    if title:
+        ax.set_title(title, fontsize=9)
     return ax

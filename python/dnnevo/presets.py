@@ -319,16 +319,18 @@ def unseeded_warning(name: str, seeded: bool) -> str | None:
 def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -> EvolutionConfig:
     """The config of preset ``name``, optionally its quick variant, with ``key=value`` overrides.
     A task written in Python (``"python:module.Class"``) has no preset: its config is the
-    defaults with that task, its ``n_inputs`` the class's ``observation_size`` (which imports
-    the class's module) unless an override sets it, and its other settings come from the
-    overrides alone."""
+    defaults with that task, its ``n_inputs`` the environment's ``observation_size`` (which
+    imports the class's module and makes one with the overrides' ``task_params``) unless an
+    override sets it, and its other settings come from the overrides alone."""
     if name.startswith(PYTHON_TASK):
         start: dict[str, Any] = {"task": name, **(PYTHON_QUICK if quick else {})}
-        if not any(o.partition("=")[0].strip() == "n_inputs" for o in overrides or []):
-            size = named.observation_size(name)
-            if size is not None:  # else the run's own check names what is wrong with it
-                start["n_inputs"] = size
-        return apply_overrides(EvolutionConfig.from_dict(start), overrides or [])
+        config = apply_overrides(EvolutionConfig.from_dict(start), overrides or [])
+        if any(o.partition("=")[0].strip() == "n_inputs" for o in overrides or []):
+            return config
+        size = named.observation_size(name, config.task_params)
+        if size is None:  # the run's own check names what is wrong with the task
+            return config
+        return EvolutionConfig.from_dict({**config.to_dict(), "n_inputs": size})
     try:
         preset = PRESETS[name]
     except KeyError:

@@ -21,9 +21,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrate::{Integrator, Lanes, Precision, CANCEL_CHECK_STEPS, LANES};
+use crate::integrate::{
+    check_step, diverged, Integrator, Lanes, Precision, CANCEL_CHECK_STEPS, LANES,
+};
 use crate::limits::{check_work, MAX_BATCH_ROWS};
-use crate::network::Network;
+use crate::network::{Network, Params};
 use crate::spin;
 use crate::vector::Elem;
 
@@ -175,6 +177,8 @@ impl Batch {
                 "a batch needs at least 1 network".into(),
             ));
         }
+        let params: Vec<Params> = networks.iter().map(|n| n.borrow().params()).collect();
+        check_step(&params, &integ)?;
         let all = (networks.len() as u128).saturating_mul(replicas as u128);
         if rows as u128 > MAX_BATCH_ROWS {
             let what = if rows as u128 == all {
@@ -689,11 +693,12 @@ fn check_finite<E: Elem>(
         }
         for l in 0..block.len() {
             if let Some(r) = row(l).filter(|_| !state[l].finite()) {
-                return Err(Error::InvalidArgument(format!(
-                    "integration diverged: state[{i}] of row {r} became {}; use a smaller dt \
-                     (Euler needs dt / tau well below 2)",
-                    state[l]
-                )));
+                return Err(diverged(
+                    &format!("row {r}"),
+                    i,
+                    state[l].to_f64(),
+                    block.step_size(i, l),
+                ));
             }
         }
     }

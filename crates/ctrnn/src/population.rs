@@ -15,7 +15,7 @@ use std::sync::atomic::AtomicBool;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrate::{check_inputs, Integrator, Lanes, Precision, LANES};
+use crate::integrate::{check_inputs, Integrator, Lanes, Precision, Shortest, LANES};
 use crate::limits;
 use crate::network::{Network, Params};
 use crate::vector::Elem;
@@ -78,6 +78,8 @@ pub struct Population {
     n_inputs: usize,
     len: usize,
     blocks: Blocks,
+    /// The shortest time constant, which limits the step ([`Integrator::check_step`]).
+    shortest: Option<Shortest>,
 }
 
 /// The blocks of a population, in the precision it computes in.
@@ -148,6 +150,7 @@ impl Population {
             n_inputs: m,
             len: networks.len(),
             blocks,
+            shortest: Shortest::of(networks),
         })
     }
 
@@ -199,6 +202,9 @@ impl Population {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<f64>> {
         integ.validate()?;
+        if let Some(shortest) = self.shortest {
+            shortest.check(integ)?;
+        }
         let (m, p_len) = (self.n_inputs, self.len);
         limits::check_work(p_len, steps, integ.substeps)?;
         match inputs {

@@ -62,7 +62,9 @@ pub fn analysis_equilibria<'py>(
     let starts = settings.starts + settings.retry_starts;
     let cost = starts as f64 * settings.max_iterations as f64 * n * n * n;
     let net = &net.inner;
-    let found = detached(py, cost, |_| analysis::equilibria(net, &input, &settings))?;
+    let found = detached(py, cost, |cancel| {
+        analysis::equilibria_cancellable(net, &input, &settings, Some(cancel))
+    })?;
     found
         .into_iter()
         .map(|e| PyEquilibrium::new(py, e))

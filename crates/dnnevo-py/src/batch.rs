@@ -126,7 +126,7 @@ fn mask(obj: &Bound<'_, PyAny>, name: &str, rows: usize) -> PyResult<Vec<bool>> 
     let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
     if kind != "b" || shape != [rows] {
         return Err(arg_err(format!(
-            "{name} is a {} array of shape {}; expected booleans of shape ({rows},), one per row",
+            "{name} is an array of dtype {} and shape {}; expected booleans of shape ({rows},), one per row",
             arr.getattr("dtype")?.str()?,
             shape_str(&shape)
         )));
@@ -153,7 +153,7 @@ fn chosen_rows(obj: Option<&Bound<'_, PyAny>>, rows: usize) -> PyResult<Option<V
     let integers = kind == "i" || kind == "u" || size == 0;
     if ndim != 1 || !integers {
         return Err(arg_err(format!(
-            "rows is a {} array of {ndim} dimensions; expected a boolean mask of shape ({rows},) \
+            "rows is an array of dtype {} and {ndim} dimensions; expected a boolean mask of shape ({rows},) \
              or a 1-D array of row indices",
             arr.getattr("dtype")?.str()?
         )));
@@ -182,7 +182,7 @@ fn indices(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<usize>> {
     let size: usize = arr.getattr("size")?.extract()?;
     if ndim != 1 || !(kind == "i" || kind == "u" || size == 0) {
         return Err(arg_err(format!(
-            "{name} is a {} array of {ndim} dimensions; expected a 1-D array of indices",
+            "{name} is an array of dtype {} and {ndim} dimensions; expected a 1-D array of indices",
             arr.getattr("dtype")?.str()?
         )));
     }

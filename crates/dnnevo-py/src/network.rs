@@ -97,20 +97,47 @@ fn integrator_from_dict(d: &Bound<'_, PyAny>) -> PyResult<Integrator> {
     Ok(integ)
 }
 
-/// Parameter ranges from a dict such as `{"tau": (0.5, 10.0)}`; missing kinds keep their default.
+/// The kinds of parameter a range bounds.
+const RANGE_KINDS: [&str; 4] = ["tau", "theta", "weights", "sensor_weights"];
+
+/// Parameter ranges from a dict such as `{"tau": (0.5, 10.0)}` (a pair as a tuple or a list, as
+/// config.toml's `[ranges]` reads), or from an object with those four attributes, such as
+/// `dnnevo.Ranges`; missing kinds keep their default.
 pub fn ranges_from(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Ranges> {
     let mut ranges = Ranges::default();
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(ranges);
     };
-    let dict = obj.cast::<PyDict>().map_err(|_| {
-        ConfigError::new_err("ranges must be a dict such as {\"tau\": (0.5, 10.0)}")
-    })?;
+    let dict = match obj.cast::<PyDict>() {
+        Ok(d) => d.clone(),
+        Err(_) if RANGE_KINDS.iter().all(|k| obj.hasattr(*k).unwrap_or(false)) => {
+            let d = PyDict::new(obj.py());
+            for k in RANGE_KINDS {
+                d.set_item(k, obj.getattr(k)?)?;
+            }
+            d
+        }
+        Err(_) => {
+            return Err(ConfigError::new_err(
+                "ranges must be a dict such as {\"tau\": (0.5, 10.0)} or a dnnevo.Ranges",
+            ))
+        }
+    };
     for (key, value) in dict.iter() {
         let key: String = key.extract()?;
-        let pair: (f64, f64) = value.extract().map_err(|_| {
-            ConfigError::new_err(format!("ranges[{key:?}] must be a pair (low, high)"))
-        })?;
+        let pair = value
+            .extract::<(f64, f64)>()
+            .ok()
+            .or_else(|| match value.extract::<Vec<f64>>() {
+                Ok(v) if v.len() == 2 => Some((v[0], v[1])),
+                _ => None,
+            })
+            .ok_or_else(|| {
+                ConfigError::new_err(format!(
+                    "ranges[{key:?}] must be a pair [low, high]; it is {}",
+                    value.repr().map(|r| r.to_string()).unwrap_or_default()
+                ))
+            })?;
         match key.as_str() {
             "tau" => ranges.tau = pair,
             "theta" => ranges.theta = pair,

@@ -48,7 +48,7 @@ fn network_objects<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Vec<PyRef<'py, PyNe
         let item = item?;
         let net = item.cast::<PyNetwork>().map_err(|_| {
             arg_err(format!(
-                "networks[{p}] is a {}; expected a dnnevo.Network",
+                "networks[{p}] is of type {}; expected a dnnevo.Network",
                 item.get_type()
                     .name()
                     .map(|n| n.to_string())

@@ -94,7 +94,10 @@ fn to_value(obj: &Bound<'_, PyAny>, path: String, depth: usize) -> Result<Value,
             .name()
             .map(|n| n.to_string())
             .unwrap_or_default();
-        Err(format!("{} is a {kind}, which JSON cannot hold", at(&path)))
+        Err(format!(
+            "{} is of type {kind}, which JSON cannot hold",
+            at(&path)
+        ))
     }
 }
 

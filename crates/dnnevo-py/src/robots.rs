@@ -54,7 +54,7 @@ fn world_spec(world: &Bound<'_, PyAny>) -> PyResult<sim2d::WorldSpec> {
     }
     let map = dict_to_map(world, "world").map_err(|e| {
         arg_err(format!(
-            "world is a {}; expected a world file's TOML text or a dict ({})",
+            "world is of type {}; expected a world file's TOML text or a dict ({})",
             world
                 .get_type()
                 .name()
@@ -63,7 +63,14 @@ fn world_spec(world: &Bound<'_, PyAny>) -> PyResult<sim2d::WorldSpec> {
             e.value(world.py())
         ))
     })?;
-    serde_json::from_value(Value::Object(map)).map_err(|e| arg_err(format!("world: {e}")))
+    // An error names the field, as a world file's does: `world.boxes[0].size: ...`.
+    serde_path_to_error::deserialize(Value::Object(map)).map_err(|e| {
+        let path = e.path().to_string();
+        match path.as_str() {
+            "." => arg_err(format!("world: {}", e.inner())),
+            _ => arg_err(format!("world.{path}: {}", e.inner())),
+        }
+    })
 }
 
 /// The settings from a dict; an error names the field (`settings.robot.radius: ...`).
@@ -144,7 +151,7 @@ fn mask(obj: &Bound<'_, PyAny>, name: &str, rows: usize) -> PyResult<Vec<bool>> 
     let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
     if kind != "b" || shape != [rows] {
         return Err(arg_err(format!(
-            "{name} is a {} array of shape {}; expected booleans of shape ({rows},), one per row",
+            "{name} is an array of dtype {} and shape {}; expected booleans of shape ({rows},), one per row",
             arr.getattr("dtype")?.str()?,
             shape_str(&shape)
         )));
@@ -161,7 +168,7 @@ fn episodes(obj: &Bound<'_, PyAny>) -> PyResult<Vec<u64>> {
     let empty = shape == [0];
     if shape.len() != 1 || !(kind == "i" || kind == "u" || empty) {
         return Err(arg_err(format!(
-            "episodes is a {} array of shape {}; expected a 1-D array of episode numbers >= 0",
+            "episodes is an array of dtype {} and shape {}; expected a 1-D array of episode numbers >= 0",
             arr.getattr("dtype")?.str()?,
             shape_str(&shape)
         )));

@@ -36,6 +36,24 @@ pub enum Error {
         /// The clearance that was required, in metres.
         clearance: f64,
     },
+    /// Too little of the start region keeps a robot clear of every wall and box for starts to
+    /// be drawn reliably ([`World::check_start`](crate::World::check_start)).
+    #[error(
+        "the start region is free for a robot of radius {radius} m, {clearance} m from every wall \
+         and box, at {:.2}% of its points; at least {:.0}% must be: enlarge start or move the boxes",
+        100.0 * share,
+        100.0 * needed
+    )]
+    StartBlocked {
+        /// The free share of the start region, in [0, 1).
+        share: f64,
+        /// The share needed.
+        needed: f64,
+        /// The robot's radius in metres.
+        radius: f64,
+        /// The clearance that was required, in metres.
+        clearance: f64,
+    },
 }
 
 impl Error {
@@ -80,7 +98,18 @@ pub fn check_range(
             if hi_closed { ']' } else { ')' }
         ),
     };
-    Err(Error::invalid(field, value, &allowed))
+    Err(Error::invalid(field, number(value), &allowed))
+}
+
+/// `x` for a message: as Rust writes it, or in exponent form when that would take more than a
+/// line (`1e300`, not three hundred digits).
+fn number(x: f64) -> String {
+    let plain = x.to_string();
+    if plain.len() > 20 {
+        format!("{x:e}")
+    } else {
+        plain
+    }
 }
 
 /// Checks that `value` is a finite number.

@@ -293,6 +293,7 @@ impl Fleet {
     pub fn new(world: &WorldSpec, spec: &FleetSpec) -> Result<Fleet, Error> {
         spec.validate()?;
         let world = World::new(world)?;
+        world.check_start(spec.robot.radius, spec.start_clearance)?;
         Ok(Fleet {
             arena: Arena {
                 scene: Scene::new(world.spec()),

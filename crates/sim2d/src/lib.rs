@@ -70,4 +70,4 @@ pub use sim::{Sim, SimSpec, Trace};
 pub use sonar::{input, Echo, Sonar, SonarSpec, DEFAULT_D0};
 pub use wall_follow::{Phase, WallFollower, WallFollowerSpec, MAX_GAIN};
 pub use world::{Hit, Surface, World};
-pub use world_spec::{BoxSpec, StartRegion, WorldSpec};
+pub use world_spec::{BoxSpec, StartRegion, WorldSpec, MAX_ROOM};

@@ -24,6 +24,11 @@ use streams::Stream;
 
 use crate::error::{check_finite, check_range, Error};
 
+/// The longest side of a room, in metres. The geometry is computed in `f32` (parry2d), whose
+/// steps are about 6e-5 m at 1000 m: in a larger room a robot's step of a few millimetres is
+/// lost to rounding and it stands still without a word.
+pub const MAX_ROOM: f64 = 1000.0;
+
 /// The shipped world of landmark 1: two crates pushed together.
 const LANDMARK1_TOML: &str = include_str!("../worlds/landmark1.toml");
 /// The shipped world of landmark 2: the same two crates one crate width apart.
@@ -54,7 +59,8 @@ const LANDMARK2_TOML: &str = include_str!("../worlds/landmark2.toml");
 #[serde(deny_unknown_fields)]
 pub struct WorldSpec {
     /// The room's `[width, height]` in metres; the room spans `[0, width] x [0, height]`, walled on
-    /// all four sides. Both must be finite and > 0. Default `[6, 5]`.
+    /// all four sides. Both must be > 0 and at most [`MAX_ROOM`]. Default `[6, 5]`.
+    #[serde(deserialize_with = "pair")]
     pub room: [f64; 2],
     /// The boxes standing in the room, each wholly inside it (boxes may touch or overlap each
     /// other). Default: landmark 1's one 1.2 m x 0.6 m box at the centre; empty when left out of a
@@ -70,10 +76,12 @@ pub struct WorldSpec {
 #[serde(deny_unknown_fields)]
 pub struct BoxSpec {
     /// The box's centre `[x, y]` in metres (no default in a file).
+    #[serde(deserialize_with = "pair")]
     pub center: [f64; 2],
     /// The box's side lengths `[sx, sy]` in metres before turning, both > 0 (no default in a file).
+    #[serde(deserialize_with = "pair")]
     pub size: [f64; 2],
-    /// The box's rotation in degrees, counter-clockwise (default 0).
+    /// The box's rotation in degrees, counter-clockwise, in [-360, 360] (default 0).
     #[serde(default)]
     pub angle_deg: f64,
 }
@@ -86,9 +94,11 @@ pub struct BoxSpec {
 #[serde(deny_unknown_fields)]
 pub struct StartRegion {
     /// The lower-left corner `[x, y]` in metres, inside the room (landmark default `[0.4, 0.4]`).
+    #[serde(deserialize_with = "pair")]
     pub min: [f64; 2],
     /// The upper-right corner `[x, y]` in metres, inside the room and `>= min` (landmark default
     /// `[5.6, 4.6]`).
+    #[serde(deserialize_with = "pair")]
     pub max: [f64; 2],
 }
 
@@ -97,6 +107,16 @@ impl Default for WorldSpec {
         // The shipped file is checked by the tests, so this parse cannot fail.
         parse(LANDMARK1_TOML).expect("landmark1.toml is a valid world")
     }
+}
+
+/// A `[x, y]` of exactly two numbers. (The TOML reader fills a `[f64; 2]` from the first two
+/// numbers of a longer array and drops the rest, so a world file's `room = [5, 4, 3]` would be
+/// read as `[5, 4]` without a word.)
+fn pair<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let numbers = Vec::<f64>::deserialize(d)?;
+    <[f64; 2]>::try_from(numbers.as_slice()).map_err(|_| {
+        serde::de::Error::invalid_length(numbers.len(), &"an array of 2 numbers, [x, y]")
+    })
 }
 
 /// Parses and validates a world file.
@@ -161,7 +181,7 @@ impl WorldSpec {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), Error> {
         for (k, &v) in self.room.iter().enumerate() {
-            check_range(&format!("room[{k}]"), v, 0.0, false, f64::INFINITY, false)?;
+            check_range(&format!("room[{k}]"), v, 0.0, false, MAX_ROOM, true)?;
         }
         let [w, h] = self.room;
         for (i, b) in self.boxes.iter().enumerate() {
@@ -176,7 +196,14 @@ impl WorldSpec {
                     false,
                 )?;
             }
-            check_finite(&format!("boxes[{i}].angle_deg"), b.angle_deg)?;
+            check_range(
+                &format!("boxes[{i}].angle_deg"),
+                b.angle_deg,
+                -360.0,
+                true,
+                360.0,
+                true,
+            )?;
             let [ex, ey] = b.aabb_half_extents();
             let tol = 1e-9 * (w + h);
             let inside = b.center[0] - ex >= -tol

@@ -101,6 +101,8 @@ pub struct Diverged {
     lane: usize,
     neuron: usize,
     value: f64,
+    /// `dt / tau` there.
+    step: f64,
 }
 
 impl Diverged {
@@ -113,6 +115,7 @@ impl Diverged {
                     lane,
                     neuron,
                     value: row[lane].to_f64(),
+                    step: lanes.step_size(neuron, lane),
                 });
             }
         }
@@ -121,13 +124,8 @@ impl Diverged {
 
     /// The error, naming the network that `network(lane)` says ran on the lane.
     pub(crate) fn error(self, network: impl FnOnce(usize) -> usize) -> Error {
-        Error::InvalidArgument(format!(
-            "integration diverged: state[{}] of network {} became {}; use a smaller dt \
-             (Euler needs dt / tau well below 2)",
-            self.neuron,
-            network(self.lane),
-            self.value
-        ))
+        let what = format!("network {}", network(self.lane));
+        ctrnn::integrate::diverged(&what, self.neuron, self.value, self.step)
     }
 }
 

@@ -130,6 +130,13 @@ impl RunConfig {
             Error::InvalidArgument(m) => Error::Config(format!("integrator.{m}")),
             other => other,
         })?;
+        // Every network the run makes has a time constant in ranges.tau.
+        self.integrator
+            .check_step(self.ranges.tau.0, "the lower end of ranges.tau")
+            .map_err(|e| match e {
+                Error::InvalidArgument(m) => Error::Config(format!("integrator.{m}")),
+                other => other,
+            })?;
         if self.champion_step_check {
             self.finer_integrator()?;
         }

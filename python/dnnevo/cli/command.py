@@ -159,13 +159,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("resume", help="continue a stopped run",
                        description="Continue a stopped run from its checkpoint, bit for bit. Every "
-                                   "file of the folder is checked first; an edited config.toml is "
-                                   "refused, naming the first setting that differs.",
+                                   "file of the folder is checked first: an edited config.toml is "
+                                   "refused, naming the first setting that differs, and a damaged "
+                                   "or deleted log.csv or best.json is written again from the "
+                                   "checkpoint, and said.",
                        epilog="examples:\n  dnnevo resume runs/demo\n"
                               "  dnnevo resume runs/demo --generations 500   extend a finished run",
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("dir", type=Path)
-    p.add_argument("--threads", type=_positive)
+    p.add_argument("dir", type=Path, help="the run folder")
+    p.add_argument("--threads", type=_positive, help="worker threads (default: all cores)")
     p.add_argument("--generations", type=_positive, metavar="N",
                    help="run until generation N: more than the run's count extends it, fewer "
                         "(not below the generations done) ends it sooner; config.toml and the "
@@ -308,6 +310,8 @@ def _cmd_presets(args: argparse.Namespace) -> int:
 def _cmd_plot(args: argparse.Namespace) -> int:
     written = figures.draw_run(args.dir, seed=args.seed, animate=args.animate)
     print(f"wrote {', '.join(str(args.dir / w) for w in written)}")
+    if args.animate and not any(w.endswith(".gif") for w in written):
+        print("note: --animate: only landmark runs have an animation; no GIF written", file=sys.stderr)
     return 0
 
 
@@ -353,8 +357,8 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except (DnnevoError, OSError) as e:
-        if args.debug:
-            raise
+        if args.debug:  # the traceback too, and the same exit status: 1 is assess's "fail"
+            traceback.print_exc()
         sys.stderr.write(f"dnnevo: error: {e}\n")
         return 2
     except KeyboardInterrupt as e:
@@ -363,7 +367,5 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except Exception:
         # A bug: show it, but exit 2 as for any error, never 1 (assess's "fail").
-        if args.debug:
-            raise
         sys.stderr.write("dnnevo: internal error, please report it:\n" + traceback.format_exc())
         return 2

@@ -40,8 +40,16 @@ def add_parser(sub: Any) -> None:
 
 def system(args: argparse.Namespace) -> int:
     """``dnnevo nav1d-system``."""
-    if args.environments < 1 or args.trials < 1 or args.seed < 0:
-        raise ConfigError("--environments and --trials must be >= 1 and --seed >= 0")
+    for flag, value, least in (("--environments", args.environments, 1), ("--trials", args.trials, 1),
+                               ("--seed", args.seed, 0)):
+        if value < least:
+            raise ConfigError(f"{flag} is {value}; it must be >= {least}")
+    if args.out is not None and args.out.exists() and not args.out.is_dir():
+        raise ConfigError(f"--out {args.out} is a file; it must be a folder for report.json and "
+                          "fig2-system.png")
+    if args.out is not None and (args.out / "config.toml").exists():
+        raise ConfigError(f"--out {args.out} is a run folder; choose a folder of its own for "
+                          "report.json and fig2-system.png")
     parts = [nav1d.load_part(p, role) for p, role in
              [(args.classifier, "--classifier"), (args.far, "--far"), (args.near, "--near")]]
     persist = not args.reset_each_trial

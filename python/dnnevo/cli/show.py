@@ -93,6 +93,9 @@ def next_line(path: Path, config: EvolutionConfig, success: Sequence[float], *,
     ruleless = bool(success) and all(math.isnan(s) for s in success)
     if config.task.startswith(PYTHON_TASK) and ruleless:
         judge, verb = f"dnnevo plot {path}", "draw"
+    if (pid := RunDir(path).writer()) is not None:
+        return (f"next: the run is going on (PID {pid}); show it again later, or {judge} to {verb} "
+                "the champion so far")
     if interrupted or len(success) < config.generations:
         return (f"next: dnnevo resume {path} to run the rest of its {config.generations} generations, "
                 f"or {judge} to {verb} the champion so far")

@@ -8,12 +8,15 @@ run more episodes than it has rows.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Environment", "RestartingEnvironment"]
+from dnnevo.errors import InvalidArgumentError
+
+__all__ = ["Environment", "RestartingEnvironment", "check_neurons"]
 
 
 class Environment(Protocol):
@@ -71,3 +74,22 @@ class RestartingEnvironment(Environment, Protocol):
         that step (``active`` is False for them), and the observations it returns for them are
         the new episodes' first.
         """
+
+
+def check_neurons(rates: npt.NDArray[np.float64], neurons: Iterable[int], reader: str) -> None:
+    """Raises :class:`~dnnevo.errors.InvalidArgumentError` when the networks whose ``rates``
+    (``B x N``) a step receives lack one of the ``neurons`` that ``reader`` (for example
+    ``"RobotWorld's wheels (left, right)"``) reads, instead of an ``IndexError`` from NumPy.
+
+    >>> check_neurons(np.zeros((4, 1)), [0, 1], "the wheels (left, right)")
+    Traceback (most recent call last):
+    ...
+    dnnevo.errors.InvalidArgumentError: the wheels (left, right) read neurons [0, 1]; the networks have 1 neuron: give them at least 2 (size = 2)
+    """
+    wanted = [int(n) for n in neurons]
+    size = rates.shape[1]
+    if wanted and max(wanted) >= size:
+        need = max(wanted) + 1
+        raise InvalidArgumentError(f"{reader} read neurons {wanted}; the networks have {size} "
+                                   f"neuron{'s' if size != 1 else ''}: give them at least {need} "
+                                   f"(size = {need})")

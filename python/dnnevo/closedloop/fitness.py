@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import inspect
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -41,6 +43,23 @@ SUCCESS_EPISODES = 40
 #: Episodes of the validation set on which a run chooses its champion (see
 #: :meth:`ClosedLoop.validate`).
 VALIDATION_EPISODES = 40
+
+
+_MISSING = object()
+
+
+def _plain(value: Any) -> bool:
+    """Whether ``value`` is what a config file holds as it is: a bool, int, finite float or
+    str, or a list or a table (str keys) of them."""
+    if type(value) in (bool, int, str):
+        return True
+    if type(value) is float:
+        return math.isfinite(value)
+    if type(value) is list:
+        return all(_plain(v) for v in value)
+    if type(value) is dict:
+        return all(type(k) is str and _plain(v) for k, v in value.items())
+    return False
 
 
 def success_rule(env: Any, task: str) -> tuple[Any, float]:
@@ -147,15 +166,47 @@ class ClosedLoop:
         check)."""
         return (self.digest(), *(hashlib.sha256(t.encode()).hexdigest() for t in self._legacy_sources))
 
+    def arguments(self) -> dict[str, Any]:
+        """The keyword arguments that make the environment again, where they can be told from
+        it: each parameter of its class's ``__init__`` that the environment keeps as an
+        attribute of the same name, with a value other than the default that a config file can
+        hold (numbers, strings, booleans, and lists and tables of them). Empty unless an
+        environment made with them has this one's digest, so that what is returned is the
+        whole truth or nothing."""
+        kind = type(self.env)
+        try:
+            parameters = inspect.signature(kind).parameters.values()
+        except (TypeError, ValueError):
+            return {}
+        found: dict[str, Any] = {}
+        for p in parameters:
+            if p.kind not in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) or p.name in ROLLOUT_KEYS:
+                continue
+            value = getattr(self.env, p.name, _MISSING)
+            if value is _MISSING or not _plain(value):
+                continue
+            if p.default is p.empty or not _plain(p.default) or value != p.default:
+                found[p.name] = value
+        if not found:
+            return {}
+        s = self.settings
+        try:
+            again = ClosedLoop(kind(**found), episodes=s["episodes"], max_steps=s["max_steps"], dt=s["dt"],
+                               substeps=s["substeps"], method=s["method"], precision=s["precision"],
+                               validation_episodes=self.validation_episodes, rows=self.rows,
+                               name=f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}")
+        except Exception:  # noqa: BLE001 - then the arguments are not known
+            return {}
+        return found if again.digest() == self.digest() else {}
+
     def configured(self, config: EvolutionConfig) -> EvolutionConfig:
         """``config`` saying what this fitness function runs: its name as ``task``, the rollout's
-        episodes and step limit as ``task_params`` and its integration as ``integrator`` and
-        ``precision``. The
-        environment's own parameters are not known, so ``task_params`` holds no others: a
-        command that builds the task from the config builds it with its defaults, and the digest
-        then tells whether that is the same task."""
+        episodes and step limit and the environment's :meth:`arguments` as ``task_params``, and
+        its integration as ``integrator`` and ``precision``. A command that builds the task from
+        the config builds it with those arguments (with the class's defaults when they could not
+        be told), and the digest then tells whether that is the same task."""
         s = self._recorded()
-        params = {k: s[k] for k in ROLLOUT_KEYS if k in s}
+        params = {**self.arguments(), **{k: s[k] for k in ROLLOUT_KEYS if k in s}}
         if config.precision not in ("f64", self.settings["precision"]):
             raise ConfigError(f"config.precision is {config.precision!r} but this ClosedLoop computes "
                               f"in {self.settings['precision']!r}; give ClosedLoop(..., "

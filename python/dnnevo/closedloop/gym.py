@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from dnnevo.closedloop.environment import check_neurons
 from dnnevo.errors import ConfigError
 
 try:
@@ -167,6 +168,7 @@ class GymEnvironment:
         return np.multiply(flat, self.scale, out=np.empty((len(obs), self.observation_size)))
 
     def _act(self, rates: npt.NDArray[np.float64]) -> npt.NDArray[Any]:
+        check_neurons(rates, self.outputs, f"{type(self).__name__}'s {self.actions!r} actions")
         if self.actions == "threshold":
             return (rates[:, self.outputs[0]] > 0.5).astype(np.int64)
         chosen = rates[:, self.outputs]

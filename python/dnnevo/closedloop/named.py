@@ -31,6 +31,7 @@ import importlib
 import numbers
 import os
 import sys
+from collections.abc import Mapping
 from typing import Any
 
 from dnnevo.closedloop.fitness import ROLLOUT_KEYS, ClosedLoop
@@ -102,11 +103,19 @@ def _import(module_name: str, task: str) -> Any:
                           f"{type(e).__name__}: {e}") from e
 
 
-def observation_size(task: str) -> int | None:
-    """The ``observation_size`` of the class that ``task`` names (importing its module), the
-    ``n_inputs`` its networks need; None when it is not a whole number >= 1 (an instance
-    attribute, or a mistake that :func:`closed_loop` then names)."""
-    return _whole_size(getattr(environment_class(task), "observation_size", None))
+def observation_size(task: str, task_params: Mapping[str, Any] | None = None) -> int | None:
+    """The ``observation_size`` of the environment that ``task`` names (importing its module),
+    the ``n_inputs`` its networks need: that of an instance made with ``task_params`` (less the
+    rollout's settings), as :func:`closed_loop` makes it, since an instance may set its own (a
+    :class:`~dnnevo.robots.RobotWorld` counts its sensors); else the class's. None when neither
+    is a whole number >= 1 (a mistake that :func:`closed_loop` then names)."""
+    cls = environment_class(task)
+    params = {k: v for k, v in (task_params or {}).items() if k not in ROLLOUT_KEYS}
+    try:
+        size = _whole_size(getattr(cls(**params), "observation_size", None))
+    except Exception:  # noqa: BLE001 - closed_loop names what is wrong with the arguments
+        size = None
+    return size if size is not None else _whole_size(getattr(cls, "observation_size", None))
 
 
 def _whole_size(size: Any) -> int | None:

@@ -56,7 +56,8 @@ class EvolutionResult:
     best: _core.Network
     """The champion: the best network of the run by validation (see
     ``EvolutionConfig.validation_candidates``), or by training fitness when the task has no
-    validation set (in its initial state)."""
+    validation set (in its initial state), with the ``meta`` and ``integrator`` that
+    ``best.json`` holds: ``best.run(inputs, **best.integrator)`` runs it as the run did."""
     best_fitness: float
     """The champion's training fitness."""
     best_generation: int
@@ -311,7 +312,10 @@ def resume(
             raise DnnevoError(
                 f"{run.path} was evolved with a Python fitness function ({ga.config.task}); resume it "
                 "from Python: dnnevo.resume(dir, task=fitness)")
-        # Every file rewritten from the state about to continue, so they agree from here on.
+        # Every file rewritten from the state about to continue, so they agree from here on;
+        # one that was damaged or gone is said, as it is repaired.
+        for note in _repairs(run, ga):
+            print(f"{run.path}: {note}; written again from checkpoint.json", file=sys.stderr)
         run.write_checkpoint(ga.state_dict(), history, table, ga.seed)
         run.write_config(ga.config, table)
         run.write_log(history)
@@ -364,6 +368,12 @@ def _restart(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], dic
     if not run.config.exists():
         raise RunFileError(f"{run.path} has no checkpoint.json and no config.toml; nothing to resume "
                            "(start the run again)")
+    done = run.logged_generations()
+    if done or run.best.exists():
+        raise RunFileError(f"{run.path} has no checkpoint.json, but {run.log.name} records {done} generation"
+                           f"{'s' if done != 1 else ''}{' and best.json a champion' if run.best.exists() else ''}: "
+                           "resuming would start again from generation 0 and lose them; restore "
+                           "checkpoint.json, or start the run again (dnnevo run --force)")
     config, table = run.read_config()
     if "seed" not in table:
         raise RunFileError(f"{run.config}: has no [run] table with the run's seed")
@@ -402,6 +412,29 @@ def _restored(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], di
         if cp.run is None:
             table = toml_table
     return ga, cp.history, table
+
+
+def _repairs(run: RunDir, ga: GeneticAlgorithm) -> list[str]:
+    """What is wrong with a resumed folder's files besides its checkpoint, which resume then
+    writes again from it: a file gone, or one its reader refuses. (A log.csv ahead of the
+    checkpoint, as a kill leaves it, is not damage.)"""
+    notes = []
+    if not run.config.exists():
+        notes.append("config.toml was gone")
+    for name, read in (("log.csv", lambda: run.read_log(ga.config)),
+                       ("best.json", lambda: run.read_best(ga.config))):
+        path = run.path / name
+        if name == "log.csv" and not ga.generation:  # nothing to log yet
+            continue
+        if not path.exists():
+            if name == "log.csv" or ga.best is not None:
+                notes.append(f"{name} was gone")
+            continue
+        try:
+            read()
+        except DnnevoError as e:
+            notes.append(f"{name} was damaged ({str(e).removeprefix(str(path) + ': ')})")
+    return notes
 
 
 def _takes_conditions(task: FitnessFn) -> bool:
@@ -517,11 +550,15 @@ def _loop(
     conditions = callable(task) and _takes_conditions(task)
     validate = _validation(task, ga)
 
+    checkpointed = len(history)  # the generations the folder's checkpoint holds
+
     def save_state() -> None:
+        nonlocal checkpointed
         if run is not None:
             run.write_log(history)
             run.write_checkpoint(ga.state_dict(), history, table or _run_table(ga.seed), ga.seed)
             _write_best(run, ga)
+            checkpointed = len(history)
 
     try:
         with _StopRequest().installed() as stop:
@@ -592,7 +629,11 @@ def _loop(
             save_state()
             saved = f"at generation {ga.generation}; checkpoint saved"
         else:
-            saved = "mid-generation; the previous checkpoint is kept"
+            lost = len(history) - checkpointed
+            saved = (f"mid-generation; the checkpoint of generation {checkpointed} is kept, and the "
+                     f"{lost} generation{'s' if lost != 1 else ''} since will be run again")
+            if run is not None:  # the log says what the checkpoint holds, as resume will
+                run.write_log(history[:checkpointed])
         if run is None:
             raise
     finally:
@@ -631,6 +672,12 @@ def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
     if net is None:
         run.best.unlink(missing_ok=True)
         return
+    net.save(run.best, **_champion_notes(ga))
+
+
+def _champion_notes(ga: GeneticAlgorithm) -> dict[str, dict[str, Any]]:
+    """The champion's ``meta`` (task, seed, generation, fitness, validation, precision) and its
+    ``integrator``, as ``best.json`` holds them and :attr:`EvolutionResult.best` carries them."""
     meta: dict[str, Any] = {
         "task": ga.config.task,
         "seed": ga.seed,
@@ -642,7 +689,7 @@ def _write_best(run: RunDir, ga: GeneticAlgorithm) -> None:
         meta["validation_rate"], meta["validation_score"] = ga.best_validation
     # How the run integrated it, so that the file alone says how to run the champion.
     meta["precision"] = ga.config.precision
-    net.save(run.best, meta=meta, integrator=dataclasses.asdict(ga.config.integrator))
+    return {"meta": meta, "integrator": dataclasses.asdict(ga.config.integrator)}
 
 
 def _result(
@@ -654,7 +701,7 @@ def _result(
     columns = history[0].keys() if history else ()
     arrays = {k: np.array([row[k] for row in history]) for k in columns}
     return EvolutionResult(
-        best=net,
+        best=_core.Network.from_dict({**net.to_dict(), **_champion_notes(ga)}),
         best_fitness=fitness,
         best_generation=generation,
         history=arrays,

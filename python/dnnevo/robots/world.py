@@ -32,6 +32,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
+from dnnevo.closedloop.environment import check_neurons
 from dnnevo.errors import InvalidArgumentError
 
 __all__ = ["D0", "WORLDS", "RobotWorld", "world_of"]
@@ -55,10 +56,18 @@ def world_of(world: str | PathLike[str] | Mapping[str, Any]) -> str | dict[str, 
         path = Path(world)
         try:
             return path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise FileNotFoundError(f"world file {path} does not exist") from None
         except OSError as e:
             raise InvalidArgumentError(f"world file {path} cannot be read: {e.strerror}") from None
+        except UnicodeDecodeError as e:
+            raise InvalidArgumentError(f"world file {path} is not UTF-8 text (byte {e.start}): a "
+                                       "world file is TOML") from None
+    hint = ""
+    if isinstance(world, str) and Path(world).suffix:
+        hint = f" (a world file's name ends in .toml, not {Path(world).suffix})"
     raise InvalidArgumentError(f"world is {world!r}; expected one of {', '.join(map(repr, WORLDS))}, "
-                               "a world file (a path ending in .toml) or a dict")
+                               f"a world file (a path ending in .toml) or a dict{hint}")
 
 
 def _neuron(name: str, value: Any) -> int:
@@ -130,6 +139,7 @@ class RobotWorld:
              ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
         """Drives every running robot with its network's rates for one step; returns
         ``(observe(), reward(active), done(active))``."""
+        check_neurons(rates, (self.left, self.right), f"{type(self).__name__}'s wheels (left, right)")
         self.wheels = self.max_speed * (2.0 * rates[:, (self.left, self.right)] - 1.0)
         self.fleet.step(self.wheels, active)
         self.t += 1

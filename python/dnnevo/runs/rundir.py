@@ -166,11 +166,33 @@ class RunDir:
         folder holds and what to do with it. A run that stopped before its first generation was
         scored does not count: a new run replaces it. :meth:`create` checks again under the
         lock."""
-        if force or not self.path.is_dir():
+        if not self.path.is_dir():
+            return
+        if (pid := self.writer()) is not None:
+            raise DnnevoError(f"{self.path} is in use by another dnnevo process (PID {pid}); "
+                              "wait for it to finish or stop it first")
+        if force:
             return
         contents = self._contents()
         if contents:
             raise DnnevoError(self._occupied(contents))
+
+    def writer(self) -> str | None:
+        """The PID of the process writing this folder now (the holder of its lock, as it wrote
+        it), or None when none is. Takes the lock, shared, for an instant to tell."""
+        try:
+            fd = os.open(self.lock_file, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
+        except OSError:
+            return None
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+            except BlockingIOError:
+                return os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "unknown"
+            fcntl.flock(fd, fcntl.LOCK_UN)
+            return None
+        finally:
+            os.close(fd)
 
     def _resume_command(self) -> str:
         """How to resume the run here: from Python when it was evolved with a fitness function
@@ -296,6 +318,11 @@ class RunDir:
                     f"{self.config} was edited after the run: {diff[0]} is {short(diff[1])} in "
                     f"config.toml and {short(diff[2])} in checkpoint.json, with which the run was "
                     f"made; put it back (to run longer: 'dnnevo resume {self.path} --generations N')")
+            if cp.run is not None and "seed" in cp.run and table.get("seed") != cp.run["seed"]:
+                raise RunFileError(
+                    f"{self.config} was edited after the run: run.seed is {short(table.get('seed'))} in "
+                    f"config.toml and {short(cp.run['seed'])} in checkpoint.json, with which the run was "
+                    "made; put it back")
         return config, table
 
     def read_checkpoint(self) -> Checkpoint:
@@ -369,14 +396,28 @@ class RunDir:
                 raise fail(path, f"has {len(rows)} generations; config.toml has {config.generations}")
             return rows
 
+    def logged_generations(self) -> int:
+        """How many generations ``log.csv`` has a row for (its non-empty lines after the header),
+        counted without judging them: a damaged log is a record of work all the same."""
+        try:
+            lines = self.log.read_text(encoding="utf-8", errors="replace").splitlines()
+        except FileNotFoundError:
+            return 0
+        except OSError as e:
+            raise RunFileError(f"{self.log}: cannot be read: {e.strerror}") from None
+        return sum(1 for line in lines[1:] if line.strip())
+
     def read_best(self, config: EvolutionConfig, run: Mapping[str, Any] | None = None) -> Network:
         """``best.json``, which must be a network of the run's size and inputs, and, when it
         says, of the run's task, seed, integrator and precision."""
         path = self.best
         if not path.exists() and not path.is_symlink():
-            if self.checkpoint.exists():
+            if self.checkpoint.exists() and self.logged_generations():
                 raise RunFileError(f"{self.path} has no best.json, though it has a checkpoint; "
                                    f"{self._resume_command()} writes it again")
+            if self.checkpoint.exists():  # a run that failed in its first generation
+                raise RunFileError(f"{self.path} has no best.json; no generation has finished: its run "
+                                   "stopped in generation 0, so start it again once what stopped it is changed")
             raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")
         with checked(path):
             try:

@@ -93,9 +93,13 @@ class UserTask:
         """``episodes.png``: the champion on the first :data:`DRAWN_EPISODES` of the fresh
         episodes that :meth:`judge` draws from ``seed``, one panel each: every observation
         (scaled onto its band, its range in the label) and every neuron's firing rate over the
-        episode, with the episode's return and length. Imports the task's module."""
+        episode, with the episode's return and length. For robots in a world (a
+        :class:`~dnnevo.robots.RobotWorld`), ``paths.png`` too: the room and each episode's
+        path, and the pursuers'. Imports the task's module."""
         champion = run.read_best(config, run.read_config()[1])
-        episodes = record(config, champion, DRAWN_EPISODES, seed=seed)
+        worlds: list[dict[str, Any]] = []
+        episodes = record(config, champion, DRAWN_EPISODES, seed=seed,
+                          probe=lambda env: _robot_state(env, worlds))
         fig, axes = plot.subplots(1, len(episodes), figsize=(4.5 * len(episodes), 1.5 + 0.6 * (
             config.n_inputs + config.size)), layout="constrained", squeeze=False)
         for e, (ax, ep) in enumerate(zip(axes[0], episodes, strict=True)):
@@ -110,7 +114,19 @@ class UserTask:
         fig.suptitle(f"{run.path.name}: the champion on fresh episodes (seed {seed})", fontsize=10)
         save_figure(fig, run.path / "episodes.png")
         plot.close(fig)
-        return ["episodes.png"]
+        if not worlds:
+            return ["episodes.png"]
+        fig, axes = plot.subplots(1, len(episodes), figsize=(4.5 * len(episodes), 4.2),
+                                  layout="constrained", squeeze=False)
+        for e, (ax, ep) in enumerate(zip(axes[0], episodes, strict=True)):
+            plot.plot_paths(worlds[0], ep.probes["pose"], ax, pursuers=ep.probes["pursuers"], title=(
+                f"episode {e}: return {np.cumsum(ep.rewards)[-1]:.4g}, {len(ep.rewards)} steps"))
+        axes[0, 0].legend(loc="upper left", fontsize=8, framealpha=0.9)
+        fig.suptitle(f"{run.path.name}: the champion's robot on fresh episodes (seed {seed}; "
+                     "circle: start, square: end)", fontsize=10)
+        save_figure(fig, run.path / "paths.png")
+        plot.close(fig)
+        return ["episodes.png", "paths.png"]
 
     def recorded_trials(self, config: EvolutionConfig, net: _core.Network, *,
                         seed: int) -> list[tuple[_Array, _Array]]:
@@ -119,6 +135,18 @@ class UserTask:
         if self.analysis is None:
             raise ConfigError(_refusal(config.task))
         return [(e.outputs, e.inputs) for e in record(config, net, self.analysis.episodes, seed=seed)]
+
+
+def _robot_state(env: Any, worlds: list[dict[str, Any]]) -> dict[str, npt.ArrayLike]:
+    """What ``paths.png`` draws of an environment with robots in a world (a ``fleet``, as
+    :class:`~dnnevo.robots.RobotWorld` has): every row's pose and its pursuers', its world kept
+    in ``worlds``; nothing of any other environment."""
+    fleet = getattr(env, "fleet", None)
+    if not isinstance(fleet, _core.Fleet):
+        return {}
+    if not worlds:
+        worlds.append(dict(env.fleet.world))
+    return {"pose": fleet.poses, "pursuers": fleet.pursuers}
 
 
 def _refusal(task: str) -> str:

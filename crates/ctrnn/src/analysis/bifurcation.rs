@@ -173,7 +173,7 @@ pub fn bifurcation(
             .last()
             .map(|prev| prev.iter().map(|e| e.state.clone()).collect())
             .unwrap_or_default();
-        let found = search(&at.field(p)?, &sweep.search, &extra)?;
+        let found = search(&at.field(p)?, &sweep.search, &extra, cancel)?;
         if found.retried {
             retried.push(p);
         }

@@ -17,6 +17,8 @@
 //! [`RETRY_STARTS`]). This is the one place that rule lives: `dnnevo analyze`, its conditions and
 //! its sweeps all search through here.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use serde::Serialize;
 
 use super::field::Field;
@@ -230,11 +232,54 @@ fn within(g: &[f64], tolerance: f64) -> bool {
     g.iter().all(|x| x.abs() <= tolerance)
 }
 
-/// Adds `v` to `found` unless an equilibrium within `distinct` (max norm) is already there.
-pub(crate) fn insert_distinct(found: &mut Vec<Vec<f64>>, v: Vec<f64>, distinct: f64) {
-    let close = |u: &Vec<f64>| u.iter().zip(&v).all(|(a, b)| (a - b).abs() < distinct);
-    if !found.iter().any(close) {
-        found.push(v);
+/// How far apart (max norm) two roots may be and still be one degenerate equilibrium, when the
+/// residual stays within tolerance between them ([`insert_distinct`]).
+const DEGENERATE_SPAN: f64 = 1e-2;
+
+/// Points between two roots at which [`insert_distinct`] checks the residual.
+const BETWEEN: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// Adds `v` to `found` unless an equilibrium within `distinct` (max norm) is already there, or
+/// one within [`DEGENERATE_SPAN`] with the residual within `tolerance` all along the way
+/// between them ([`BETWEEN`]): then both are points of one degenerate equilibrium (at a fold
+/// or a cusp `G` is flat, and Newton stops anywhere its residual is small, up to about `1e-3`
+/// from the root), and the one with the smaller residual is kept. Two distinct simple roots
+/// have a residual away from 0 between them.
+pub(crate) fn insert_distinct(
+    found: &mut Vec<Vec<f64>>,
+    v: Vec<f64>,
+    field: &Field<'_>,
+    distinct: f64,
+    tolerance: f64,
+) {
+    let gap = |u: &[f64]| {
+        u.iter()
+            .zip(&v)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    if found.iter().any(|u| gap(u) < distinct) {
+        return;
+    }
+    let mut g = vec![0.0; v.len()];
+    let mut residual = |x: &[f64]| {
+        field.residual(x, &mut g);
+        g.iter().map(|r| r.abs()).fold(0.0, f64::max)
+    };
+    let flat_to = |u: &[f64], residual: &mut dyn FnMut(&[f64]) -> f64| {
+        gap(u) < DEGENERATE_SPAN
+            && BETWEEN.iter().all(|&t| {
+                let x: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a + t * (b - a)).collect();
+                residual(&x) <= tolerance
+            })
+    };
+    match (0..found.len()).find(|&k| flat_to(&found[k], &mut residual)) {
+        Some(k) => {
+            if residual(&v) < residual(&found[k]) {
+                found[k] = v;
+            }
+        }
+        None => found.push(v),
     }
 }
 
@@ -254,9 +299,10 @@ pub(crate) fn search(
     field: &Field<'_>,
     settings: &EquilibriumSearch,
     extra: &[Vec<f64>],
+    cancel: Option<&AtomicBool>,
 ) -> Result<Found> {
     settings.validate()?;
-    let first = search_from(field, settings, settings.starts, extra)?;
+    let first = search_from(field, settings, settings.starts, extra, cancel)?;
     if first.len() % 2 == 1 || settings.retry_starts <= settings.starts {
         return Ok(Found {
             equilibria: first,
@@ -267,7 +313,7 @@ pub(crate) fn search(
     let mut again: Vec<Vec<f64>> = first.into_iter().map(|e| e.state).collect();
     again.extend_from_slice(extra);
     Ok(Found {
-        equilibria: search_from(field, settings, settings.retry_starts, &again)?,
+        equilibria: search_from(field, settings, settings.retry_starts, &again, cancel)?,
         retried: true,
     })
 }
@@ -277,12 +323,16 @@ fn search_from(
     settings: &EquilibriumSearch,
     starts: usize,
     extra: &[Vec<f64>],
+    cancel: Option<&AtomicBool>,
 ) -> Result<Vec<Equilibrium>> {
     let mut roots = Vec::new();
     let starts = starting_states(field, starts, settings.seed);
     for v in extra.iter().cloned().chain(starts) {
+        if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            return Err(Error::Interrupted);
+        }
         if let Some(r) = newton(field, v, settings.tolerance, settings.max_iterations) {
-            insert_distinct(&mut roots, r, settings.distinct);
+            insert_distinct(&mut roots, r, field, settings.distinct, settings.tolerance);
         }
     }
     roots.sort_by(|a, b| {
@@ -321,5 +371,16 @@ pub fn equilibria(
     input: &[f64],
     settings: &EquilibriumSearch,
 ) -> Result<Vec<Equilibrium>> {
-    Ok(search(&Field::new(net, input)?, settings, &[])?.equilibria)
+    equilibria_cancellable(net, input, settings, None)
+}
+
+/// [`equilibria`] that stops with [`Error::Interrupted`] soon after `cancel` is set (checked
+/// before each start's Newton search).
+pub fn equilibria_cancellable(
+    net: &Network,
+    input: &[f64],
+    settings: &EquilibriumSearch,
+    cancel: Option<&AtomicBool>,
+) -> Result<Vec<Equilibrium>> {
+    Ok(search(&Field::new(net, input)?, settings, &[], cancel)?.equilibria)
 }

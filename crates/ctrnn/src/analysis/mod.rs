@@ -36,7 +36,9 @@ pub(crate) mod stability;
 pub use bifurcation::{bifurcation, Bifurcation, Sweep};
 pub use branches::{CycleBranch, CycleEnd, CycleEndKind, CYCLE_BISECTIONS};
 pub use cycles::{limit_cycles, Cycle, CycleSearch, TRIVIAL_MULTIPLIER};
-pub use equilibria::{equilibria, Equilibrium, EquilibriumSearch, RETRY_STARTS};
+pub use equilibria::{
+    equilibria, equilibria_cancellable, Equilibrium, EquilibriumSearch, RETRY_STARTS,
+};
 pub use events::{Event, EventKind, CRITICAL};
 pub use field::{jacobian, vector_field};
 pub use stability::{Stability, MARGINAL};

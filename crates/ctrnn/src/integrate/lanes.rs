@@ -496,22 +496,44 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
     }
 
     /// Fails when a real lane's state is not finite, naming the first such neuron and lane (lane
-    /// `l` as `name(l)`: what the caller knows it as). An Euler step with `dt / tau > 2`
-    /// oscillates with growing amplitude; say so rather than return infinities.
+    /// `l` as `name(l)`: what the caller knows it as), and what made it so ([`diverged`]).
     pub fn check_finite(&self, name: impl Fn(usize) -> String) -> Result<()> {
         for (i, row) in self.state.iter().enumerate() {
             if let Some(l) = (0..self.len).find(|&l| !row[l].finite()) {
-                return Err(Error::InvalidArgument(format!(
-                    "integration diverged: state[{i}] of {} became {}; use a smaller dt \
-                     (dt / tau = {} here; Euler needs it well below 2)",
-                    name(l),
-                    row[l],
-                    self.scratch.h[i][l]
-                )));
+                return Err(diverged(&name(l), i, row[l].to_f64(), self.step_size(i, l)));
             }
         }
         Ok(())
     }
+
+    /// `dt / tau` of neuron `i` in lane `l` at the last step (NaN before the first).
+    pub fn step_size(&self, i: usize, l: usize) -> f64 {
+        self.scratch.h[i][l].to_f64()
+    }
+}
+
+/// The error of an integration in which neuron `neuron` of `what` (`network 3`, `row 7`) became
+/// `value`, not a finite number, with a step of `dt / tau` = `h` there. From `h` = 2 on the step
+/// is too long (Euler's limit; RK4's is 2.79, [`Method::unstable_from`](super::Method)); below
+/// it the neuron's own decay shrinks at every step, so only a weight, threshold or input too
+/// large for the precision can have overflowed it.
+pub fn diverged(what: &str, neuron: usize, value: f64, h: f64) -> Error {
+    let why = if h >= 2.0 {
+        format!(
+            "dt / tau is {} here, too long a step: use a smaller dt (a step grows without bound \
+             from dt / tau = 2 on with Euler, from 2.79 with RK4)",
+            super::settings::short(h)
+        )
+    } else {
+        format!(
+            "dt / tau is {} here, so the step is not the cause: a weight, threshold or input too \
+             large for the precision made it overflow",
+            super::settings::short(h)
+        )
+    };
+    Error::InvalidArgument(format!(
+        "integration diverged: state[{neuron}] of {what} became {value}; {why}"
+    ))
 }
 
 /// Compiles the stepping methods of `Lanes<W>` once, in this crate, for each width `W` given.

@@ -24,10 +24,13 @@ use crate::vector::Elem;
 pub(crate) mod kernel;
 mod lanes;
 mod settings;
+mod step_limit;
 
 pub(crate) use lanes::CANCEL_CHECK_STEPS;
-pub use lanes::{copy_lane, Lanes, LANES};
+pub use lanes::{copy_lane, diverged, Lanes, LANES};
 pub use settings::{Integrator, Method, Precision};
+pub use step_limit::check_step;
+pub(crate) use step_limit::Shortest;
 
 impl Network {
     /// Integrates the network through `steps` rows of `inputs` (row-major `steps x n_inputs`),
@@ -81,6 +84,7 @@ impl Network {
         cancel: Option<&AtomicBool>,
     ) -> Result<Vec<f64>> {
         integ.validate()?;
+        check_step(&[self.params()], integ)?;
         limits::check_work(1, steps, integ.substeps)?;
         check_inputs(
             inputs,

@@ -23,12 +23,36 @@ impl std::str::FromStr for Method {
 }
 
 impl Method {
+    /// The `dt / tau` from which a step of this method makes a neuron's own decay, `dv/dt =
+    /// -v / tau`, grow without bound instead of shrink: 2 for Euler (`|1 - h| < 1` ends there),
+    /// 2.7853 for classical RK4 (where its stability interval on the negative real axis ends).
+    /// At and beyond it a network's integration is no longer its dynamics.
+    pub fn unstable_from(self) -> f64 {
+        match self {
+            Method::Euler => 2.0,
+            Method::Rk4 => RK4_STABILITY_END,
+        }
+    }
+
     /// The lower-case name used in files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Method::Euler => "euler",
             Method::Rk4 => "rk4",
         }
+    }
+}
+
+/// Where classical RK4's stability interval on the negative real axis ends: the root of
+/// `1 - z + z^2/2 - z^3/6 + z^4/24 = 1` in `z`, `dt / tau`, other than 0.
+const RK4_STABILITY_END: f64 = 2.785_293_563_405_282;
+
+/// A number for a message: three significant digits, in exponent form when very large or small.
+pub(crate) fn short(x: f64) -> String {
+    if x != 0.0 && (x.abs() >= 1e5 || x.abs() < 1e-3) {
+        format!("{x:.3e}")
+    } else {
+        format!("{}", (x * 1000.0).round() / 1000.0)
     }
 }
 
@@ -105,6 +129,48 @@ impl Integrator {
             ));
         }
         Ok(())
+    }
+
+    /// Fails when a step of `dt` is too long for a time constant `tau` (of `what`, named in the
+    /// message): when `dt / tau` reaches [`Method::unstable_from`], where the neuron's own decay
+    /// would grow without bound and the integration would return numbers that are not the
+    /// network's dynamics (a period-2 flicker, then overflow).
+    ///
+    /// ```
+    /// use ctrnn::{Integrator, Method};
+    /// let euler = Integrator { dt: 0.1, ..Default::default() };
+    /// euler.check_step(0.06, "tau[0]")?;
+    /// let e = euler.check_step(0.04, "tau[0]").unwrap_err().to_string();
+    /// assert!(e.contains("dt / tau is 2.5 for tau[0] = 0.04 (dt 0.1)"), "{e}");
+    /// Integrator { method: Method::Rk4, ..euler }.check_step(0.04, "tau[0]")?;
+    /// # Ok::<(), ctrnn::Error>(())
+    /// ```
+    pub fn check_step(&self, tau: f64, what: &str) -> Result<()> {
+        let limit = self.method.unstable_from();
+        let h = self.dt / tau;
+        if h < limit {
+            return Ok(());
+        }
+        let other = match self.method {
+            Method::Euler => format!(
+                ", or method rk4 (to dt / tau < {})",
+                short(RK4_STABILITY_END)
+            ),
+            Method::Rk4 => String::new(),
+        };
+        Err(Error::InvalidArgument(format!(
+            "dt / tau is {} for {what} = {} (dt {}); from {} on, {} steps make a neuron's own decay \
+             grow without bound: use dt < {}{other}",
+            short(h),
+            tau,
+            self.dt,
+            short(limit),
+            match self.method {
+                Method::Euler => "Euler",
+                Method::Rk4 => "RK4",
+            },
+            short(limit * tau),
+        )))
     }
 
     /// The same method with a step `factor` times shorter and `factor` times as many steps per

@@ -779,3 +779,35 @@ fn a_network_whose_sums_overflow_has_no_nan_equilibria() {
         "{found:?}"
     );
 }
+
+/// At the cusp of one self-exciting neuron (w = 4, theta = w / 2) the residual is cubic about its
+/// one equilibrium, v = 2, and Newton stops anywhere its residual is within tolerance, up to
+/// 1.7e-3 from it: one equilibrium all the same, non-hyperbolic, and no fold in a sweep through
+/// it. Two neurons, each such a cusp and uncoupled, have one too.
+#[test]
+fn a_degenerate_equilibrium_is_found_once() {
+    let eq = equilibria(&one(4.0, 2.0), &[0.0], &EquilibriumSearch::default()).unwrap();
+    assert_eq!(eq.len(), 1, "{eq:?}");
+    assert!((eq[0].state[0] - 2.0).abs() < 2e-3, "{eq:?}");
+    assert_eq!(eq[0].stability, Stability::NonHyperbolic, "{eq:?}");
+    let two = Network::new(
+        vec![1.0, 1.0],
+        vec![2.0, 2.0],
+        vec![4.0, 0.0, 0.0, 4.0],
+        vec![1.0, 1.0],
+        None,
+    )
+    .unwrap();
+    let eq = equilibria(&two, &[0.0], &EquilibriumSearch::default()).unwrap();
+    assert_eq!(eq.len(), 1, "{eq:?}");
+    // Just past the cusp the three roots are u = 0 and u = +-sqrt(48 (w/4 - 1) / w) about theta:
+    // +-0.005 here, closer than the span but with residuals of ~3e-9 between them: three.
+    let w = 1.0 / (0.25 - 0.005f64.powi(2) / 48.0);
+    let found = equilibria(&one(w, w / 2.0), &[0.0], &EquilibriumSearch::default()).unwrap();
+    let states: Vec<f64> = found.iter().map(|e| e.state[0] - w / 2.0).collect();
+    assert_eq!(found.len(), 3, "{states:?}");
+    assert!(
+        (states[0] + 0.005).abs() < 1e-4 && states[1].abs() < 1e-4,
+        "{states:?}"
+    );
+}

@@ -189,7 +189,9 @@ fn a_long_step_stops_when_cancelled_and_a_diverging_one_says_so() {
         "{err}"
     );
     // A diverging row beside one left out: the error names it, and the other keeps its state.
-    let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    // Its first step overflows: 1e308 x 0.5 + 1e308 x 1 is past the largest f64. (A
+    // step too long for its time constant is refused before it is taken.)
+    let fast = Network::new(vec![1.0], vec![0.0], vec![1e308], vec![1e308], None).unwrap();
     let mut batch = Batch::new(&[fast], 2, integrator(false, 1000)).unwrap();
     batch.set_states(&[0.0, 0.5], None).unwrap();
     let mut rates = vec![0.0; 2];
@@ -413,7 +415,9 @@ fn small_steps_shared_with_the_helpers_give_the_bits_of_one_thread() {
 #[test]
 fn small_steps_shared_with_the_helpers_fail_as_one_thread() {
     let calm = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
-    let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    // Its first step overflows: 1e308 x 0.5 + 1e308 x 1 is past the largest f64. (A
+    // step too long for its time constant is refused before it is taken.)
+    let fast = Network::new(vec![1.0], vec![0.0], vec![1e308], vec![1e308], None).unwrap();
     // 256 rows in 16 blocks, 500 Euler steps each: rows 50 and 200 (blocks 3 and 12) diverge.
     let nets: Vec<Network> = (0..256)
         .map(|r| {

@@ -2,7 +2,7 @@ use std::sync::atomic::AtomicBool;
 
 use ctrnn::integrate::*;
 use ctrnn::testing::integrate::{random_networks, weight_order};
-use ctrnn::{Error, Network};
+use ctrnn::{Error, Method, Network};
 
 fn sig(x: f64) -> f64 {
     1.0 / (1.0 + (-x).exp())
@@ -115,9 +115,37 @@ fn divergence_is_reported_not_returned() {
         substeps: 1000,
         ..Integrator::default()
     };
+    // A step too long for a time constant is refused before it is taken.
     let e = net.run(&[0.0], 1, &huge).unwrap_err().to_string();
     assert!(
-        e.contains("diverged: state[0] of the network became"),
+        e.contains("dt / tau is 10 for tau[0] = 0.5 (dt 5); from 2 on, Euler steps make"),
+        "{e}"
+    );
+    let rk4 = Integrator {
+        method: Method::Rk4,
+        dt: 1.3,
+        ..Integrator::default()
+    };
+    assert!(net.run(&[0.0], 1, &rk4).is_ok()); // dt / tau = 2.6, within RK4's 2.785
+    let rk4 = Integrator { dt: 1.4, ..rk4 };
+    let e = net.run(&[0.0], 1, &rk4).unwrap_err().to_string();
+    assert!(e.contains("from 2.785 on, RK4 steps make"), "{e}");
+    // An overflow at a short step is not blamed on the step.
+    let mut loud = Network::new(
+        vec![1.0],
+        vec![0.0],
+        vec![0.0],
+        vec![1e308],
+        Some(vec![0.0]),
+    )
+    .unwrap();
+    let e = loud
+        .run(&[1e10], 1, &Integrator::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("diverged: state[0] of the network became")
+            && e.contains("dt / tau is 0.1 here, so the step is not the cause"),
         "{e}"
     );
 }

@@ -161,7 +161,9 @@ fn input_shape_is_checked() {
 #[test]
 fn a_diverging_population_names_its_first_diverging_network() {
     let calm = Network::new(vec![1.0], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
-    let fast = Network::new(vec![0.01], vec![0.0], vec![0.0], vec![1.0], None).unwrap();
+    // Its first step overflows: 1e308 x 0.5 + 1e308 x 1 is past the largest f64. (A
+    // step too long for its time constant is refused before it is taken.)
+    let fast = Network::new(vec![1.0], vec![0.0], vec![1e308], vec![1e308], None).unwrap();
     // 160 networks in 10 blocks: 70 (block 4) and 85 (block 5) diverge. With two threads, one
     // runs blocks 0-4 in order and the other starts at block 5.
     let nets: Vec<Network> = (0..160)

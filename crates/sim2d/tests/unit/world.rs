@@ -126,3 +126,45 @@ fn random_pose_is_clear_reproducible_and_fails_cleanly() {
     assert!(matches!(e, Error::NoStartPose { .. }));
     assert!(w.random_pose(-1.0, 0.0, &mut s).is_err());
 }
+
+#[test]
+fn the_free_share_of_the_start_region_matches_hand_computed_cases() {
+    let spec = |boxes: Vec<BoxSpec>, min: [f64; 2], max: [f64; 2]| {
+        World::new(&WorldSpec {
+            room: [4.0, 2.0],
+            boxes,
+            start: StartRegion { min, max },
+        })
+        .unwrap()
+    };
+    // An empty room whose start region keeps 0.315 m from every wall: free everywhere.
+    let open = spec(vec![], [0.4, 0.4], [3.6, 1.6]);
+    assert_eq!(open.start_free_share(0.265, 0.05), 1.0);
+    open.check_start(0.265, 0.05).unwrap();
+    // A 2 m x 2 m box fills the room's right half. A robot of radius 0.265 with clearance 0.05
+    // fits where 0.315 <= x <= 1.685 and 0.315 <= y <= 1.685: of the start region
+    // [0.3, 3.7] x [0.3, 1.7], a share (1.37 / 3.4) (1.37 / 1.4) = 0.394, to within a grid cell.
+    let half = spec(
+        vec![BoxSpec {
+            center: [3.0, 1.0],
+            size: [2.0, 2.0],
+            angle_deg: 0.0,
+        }],
+        [0.3, 0.3],
+        [3.7, 1.7],
+    );
+    let share = half.start_free_share(0.265, 0.05);
+    assert!((share - 0.394).abs() < 2.0 / 64.0, "{share}");
+    half.check_start(0.265, 0.05).unwrap();
+    // A robot of radius 0.99 fits only in a 0.02 m x 0.02 m square: too little.
+    let e = half.check_start(0.99, 0.0).unwrap_err();
+    assert!(matches!(e, Error::StartBlocked { .. }), "{e}");
+    assert!(
+        e.to_string().contains("enlarge start or move the boxes"),
+        "{e}"
+    );
+    // A robot that fits nowhere, and bad arguments.
+    assert_eq!(half.start_free_share(1.2, 0.0), 0.0);
+    assert!(half.check_start(-1.0, 0.0).is_err());
+    assert!(half.check_start(0.2, f64::NAN).is_err());
+}

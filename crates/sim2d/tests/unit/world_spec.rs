@@ -43,7 +43,7 @@ const START: &str = "start = { min = [0.4, 0.4], max = [1.0, 1.0] }\n";
 #[test]
 fn validation_errors_name_the_field() {
     let e = err(&format!("room = [6.0, -5.0]\n{START}"));
-    assert_eq!(e, "room[1] is -5; it must be a finite number > 0");
+    assert_eq!(e, "room[1] is -5; it must be in (0, 1000]");
     let e = err(&format!(
         "room = [6.0, 5.0]\n{START}[[boxes]]\ncenter = [3, 2]\nsize = [-0.6, 0.6]\n"
     ));
@@ -95,6 +95,42 @@ fn unknown_and_missing_fields_are_named() {
 }
 
 #[test]
+fn every_pair_has_exactly_two_numbers() {
+    // The TOML reader alone would read the first two numbers of a longer array and drop the rest.
+    let good = "room = [6.0, 5.0]\n[start]\nmin = [0.4, 0.4]\nmax = [1.0, 1.0]\n\
+                [[boxes]]\ncenter = [3, 2]\nsize = [1, 1]\n";
+    assert!(WorldSpec::from_toml_str(good).is_ok());
+    for (field, bad, line) in [
+        ("room", "room = [6.0, 5.0, 4.0]", 1),
+        ("room", "room = [6.0]", 1),
+        ("start.min", "min = [0.4, 0.4, 9]", 3),
+        ("start.max", "max = []", 4),
+        ("boxes[0].center", "center = [3, 2, 7]", 6),
+        ("boxes[0].size", "size = [1, 1, 1, 1]", 7),
+    ] {
+        let key = bad.split(" = ").next().unwrap();
+        let text: String = good
+            .lines()
+            .map(|l| {
+                if l.starts_with(&format!("{key} = ")) {
+                    bad
+                } else {
+                    l
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        let e = err(&text);
+        assert!(
+            e.contains(&format!("{field}: invalid length"))
+                && e.contains("an array of 2 numbers")
+                && e.contains(&format!("line {line}")),
+            "{bad}: {e}"
+        );
+    }
+}
+
+#[test]
 fn jitter_stays_valid_and_is_deterministic() {
     let base = WorldSpec::landmark(2).unwrap();
     for t in 0..50 {
@@ -114,4 +150,18 @@ fn jitter_stays_valid_and_is_deterministic() {
     assert!(e.starts_with("box_shift_m is -1"), "{e}");
     let e = base.jittered(&mut s, 0.1, 0.5).unwrap_err().to_string();
     assert_eq!(e, "room_scale_frac is 0.5; it must be in [0, 0.5)");
+}
+
+#[test]
+fn a_room_too_large_for_its_geometry_and_a_wild_angle_are_refused() {
+    let e = err(&format!("room = [1e300, 5.0]\n{START}"));
+    assert!(e.contains("room[0] is 1e300") && e.contains("1000"), "{e}");
+    let e = err(&format!(
+        "room = [6.0, 5.0]\n{START}[[boxes]]\ncenter = [3, 2]\nsize = [1, 1]\nangle_deg = 1e30\n"
+    ));
+    assert!(e.contains("boxes[0].angle_deg is 1e30"), "{e}");
+    let ok = format!(
+        "room = [1000.0, 5.0]\n{START}[[boxes]]\ncenter = [3, 2]\nsize = [1, 1]\nangle_deg = -360\n"
+    );
+    assert!(WorldSpec::from_toml_str(&ok).is_ok());
 }

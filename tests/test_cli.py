@@ -316,3 +316,15 @@ def test_nav1d_system_names_a_bad_count_and_a_bad_out_before_any_work(tmp_path: 
     (tmp_path / "run" / "config.toml").write_text("")
     r = dnnevo("nav1d-system", *parts, "--out", "run", cwd=tmp_path)
     assert r.returncode == 2 and "is a run folder" in r.stderr, r.stderr
+
+
+def test_a_sweep_folder_is_named_as_one_and_an_unknown_option_points_to_its_command(tmp_path: Path) -> None:
+    for seed in (0, 1):
+        (tmp_path / "sweep" / f"seed-{seed}").mkdir(parents=True)
+    for command in ("show", "resume", "assess"):
+        r = dnnevo(command, "sweep", cwd=tmp_path)
+        assert r.returncode == 2 and "it holds the runs seed-0, seed-1 (a sweep's folder)" in r.stderr, r.stderr
+    r = dnnevo("run", "sequence-1bit", "--bogus", cwd=tmp_path)
+    assert r.returncode == 2 and "unrecognized arguments: --bogus (see 'dnnevo run --help')" in r.stderr
+    listed = [line.split(maxsplit=1) for line in dnnevo("presets").stdout.splitlines()]
+    assert ["sequence-2bit-incremental16", "another name for sequence-2bit"] in listed

@@ -372,12 +372,22 @@ def test_a_run_whose_checkpoint_is_gone_is_not_quietly_started_again(pristine: P
     assert (run / "log.csv").read_text() .count("\n") == 7
 
 
-def test_a_run_that_failed_in_its_first_generation_is_not_sent_round_to_resume(pristine: Path,
-                                                                               tmp_path: Path) -> None:
-    run = copy(pristine, tmp_path / "run")
-    (run / "best.json").unlink()
-    header = (run / "log.csv").read_text().splitlines()[0]
-    (run / "log.csv").write_text(header + "\n")
+def test_a_run_that_failed_in_its_first_generation_is_not_sent_round_to_resume(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "boom0.py").write_text(
+        "import numpy as np\n"
+        "class Boom:\n"
+        "    observation_size = 1\n"
+        "    def reset(self, episodes, rng):\n"
+        "        return np.zeros((len(episodes), 1))\n"
+        "    def step(self, rates, active):\n"
+        "        raise RuntimeError('broken')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    run = tmp_path / "run"
+    r = run_cli("run", "python:boom0.Boom", "--set", "task_params.max_steps=5", "--set", "population=6",
+                "--set", "generations=2", "--out", run)
+    assert r.returncode == 2 and "broken" in r.stderr, r.stderr
+    assert (run / "checkpoint.json").exists() and not (run / "best.json").exists()
     assert_one_line_error(run_cli("assess", run), "no generation has finished: its run stopped in generation 0")
 
 
@@ -400,6 +410,8 @@ def test_a_folder_being_written_is_named_as_such_by_show_and_run(pristine: Path,
         assert shown.returncode == 0 and f"the run is going on (PID {os.getpid()})" in shown.stdout, shown.stdout
         assert_one_line_error(run_cli("run", "sequence-1bit", "--quick", "--out", run),
                               f"is in use by another dnnevo process (PID {os.getpid()})")
+        (run / "best.json").unlink()
+        assert_one_line_error(run_cli("assess", run), f"has no best.json yet: its run is going on (PID {os.getpid()})")
     assert RunDir(run).writer() is None
 
 

@@ -118,3 +118,29 @@ def test_a_run_of_a_task_class_missing_its_champion_says_to_resume_it(tmp_path: 
     (out / "best.json").unlink()
     r = run_cli("show", out)
     assert_one_line_error(r, f"has no best.json, though it has a checkpoint; 'dnnevo resume {out}' writes it again")
+
+
+class _Sized:
+    """An environment with an argument named as a run setting, and any step."""
+
+    observation_size = 1
+
+    def __init__(self, size: int = 5) -> None:
+        self.size = size
+
+    def reset(self, episodes, rng):
+        return np.zeros((len(episodes), 1))
+
+    def step(self, rates, active):
+        return np.zeros((len(rates), 1)), rates[:, 0], np.zeros(len(rates), dtype=bool)
+
+
+def test_a_long_step_and_an_argument_named_as_a_run_setting_are_not_refused(tmp_path) -> None:
+    from dnnevo.closedloop import ClosedLoop
+
+    # The step is judged against the networks' own time constants, not against a probe's.
+    ClosedLoop(_Sized(), max_steps=5, dt=2.5, substeps=1)
+    loop = ClosedLoop(_Sized(size=8), max_steps=5)
+    assert loop.arguments() == {}  # size is the run's; task_params may not hold it
+    config = dnnevo.EvolutionConfig(population=6, generations=1, size=2, n_inputs=1, selection="rank")
+    assert "size" not in dnnevo.evolve(loop, config, progress=False).config.task_params

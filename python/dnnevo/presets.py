@@ -154,7 +154,7 @@ PRESETS: dict[str, Preset] = {
         _QUICK,
     ),
     # The paper's route as it works here is `sequence-2bit`; the README's rows made before it had
-    # that name keep the name they were made under.
+    # that name keep the name they were made under (ALIASES).
     "sequence-2bit-incremental16": _INCREMENTAL16,
     "sequence-2bit": _INCREMENTAL16,
     # The paper solved these in generations 0, 2 and 5; 30 generations leave room for bad seeds.
@@ -291,6 +291,10 @@ PRESETS: dict[str, Preset] = {
         PYTHON_QUICK,
     ),
 }
+
+
+ALIASES = {"sequence-2bit-incremental16": "sequence-2bit"}
+"""Presets that are another name for one above, by the name they stand for."""
 
 
 def names() -> list[str]:

@@ -21,9 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::integrate::{
-    check_step, diverged, Integrator, Lanes, Precision, CANCEL_CHECK_STEPS, LANES,
-};
+use crate::integrate::{check_step, Integrator, Lanes, Precision, CANCEL_CHECK_STEPS, LANES};
 use crate::limits::{check_work, MAX_BATCH_ROWS};
 use crate::network::{Network, Params};
 use crate::spin;
@@ -693,12 +691,7 @@ fn check_finite<E: Elem>(
         }
         for l in 0..block.len() {
             if let Some(r) = row(l).filter(|_| !state[l].finite()) {
-                return Err(diverged(
-                    &format!("row {r}"),
-                    i,
-                    state[l].to_f64(),
-                    block.step_size(i, l),
-                ));
+                return Err(block.diverged(&format!("row {r}"), i, l));
             }
         }
     }

@@ -85,6 +85,14 @@ impl Ranges {
                     "ranges.{name} is ({lo}, {hi}); the lower bound must be below the upper bound"
                 )));
             }
+            if !(hi - lo).is_finite() {
+                // A draw lo + u (hi - lo), or a mutation's step, would be infinite.
+                return Err(Error::Config(format!(
+                    "ranges.{name} is ({lo:e}, {hi:e}); its width overflows: the bounds must be \
+                     less than {:e} apart",
+                    f64::MAX
+                )));
+            }
         }
         if self.tau.0 <= 0.0 {
             return Err(Error::Config(format!(

@@ -293,7 +293,12 @@ impl Fleet {
     pub fn new(world: &WorldSpec, spec: &FleetSpec) -> Result<Fleet, Error> {
         spec.validate()?;
         let world = World::new(world)?;
-        world.check_start(spec.robot.radius, spec.start_clearance)?;
+        // Pursuers start in the same region, each as a disc of its own radius.
+        let widest = match spec.pursuers.count {
+            0 => spec.robot.radius,
+            _ => spec.robot.radius.max(spec.pursuers.radius),
+        };
+        world.check_start(widest, spec.start_clearance)?;
         Ok(Fleet {
             arena: Arena {
                 scene: Scene::new(world.spec()),

@@ -101,8 +101,8 @@ pub struct Diverged {
     lane: usize,
     neuron: usize,
     value: f64,
-    /// `dt / tau` there.
-    step: f64,
+    /// `dt / tau` there, and the method.
+    step: (f64, Method),
 }
 
 impl Diverged {
@@ -115,7 +115,7 @@ impl Diverged {
                     lane,
                     neuron,
                     value: row[lane].to_f64(),
-                    step: lanes.step_size(neuron, lane),
+                    step: lanes.last_step(neuron, lane),
                 });
             }
         }
@@ -125,7 +125,8 @@ impl Diverged {
     /// The error, naming the network that `network(lane)` says ran on the lane.
     pub(crate) fn error(self, network: impl FnOnce(usize) -> usize) -> Error {
         let what = format!("network {}", network(self.lane));
-        ctrnn::integrate::diverged(&what, self.neuron, self.value, self.step)
+        let (h, method) = self.step;
+        ctrnn::integrate::diverged(&what, self.neuron, self.value, h, method)
     }
 }
 

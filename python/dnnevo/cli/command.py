@@ -302,6 +302,9 @@ def _cmd_presets(args: argparse.Namespace) -> int:
     width = max(map(len, presets.names()))
     for name in presets.names():
         preset = presets.PRESETS[name]
+        if name in presets.ALIASES:
+            print(f"{name:<{width}}  another name for {presets.ALIASES[name]}")
+            continue
         seeded_by = f"; {preset.seeded_by}" if preset.seeded_by else ""
         print(f"{name:<{width}}  {preset.summary}{seeded_by}")
     return 0
@@ -340,7 +343,11 @@ def main(argv: list[str] | None = None) -> int:
     try:
         _startup.allow_interrupts()  # one pressed during start-up is raised here
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args, extra = parser.parse_known_args(argv)
+        if extra:  # named by the command's own parser, whose --help lists its options
+            commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+            where = commands.choices.get(args.command, parser) if args.command else parser
+            where.error(f"unrecognized arguments: {' '.join(extra)}")
     except KeyboardInterrupt:
         sys.stderr.write("dnnevo: interrupted\n")
         return 130

@@ -36,6 +36,10 @@ __all__ = ["ROLLOUT_KEYS", "ClosedLoop"]
 #: environment's class), as :meth:`ClosedLoop.configured` records them.
 ROLLOUT_KEYS = ("episodes", "max_steps", "validation_episodes", "rows")
 
+#: Keys that ``task_params`` may not hold, because the run config sets them at its top level
+#: (``tasks::RunConfig``): an environment's argument of such a name is not recorded.
+SET_BY_RUN = ("size", "integrator", "precision")
+
 #: Fresh episodes on which a run checks, at each change of champion, whether it meets the task
 #: class's success rule (``dnnevo assess`` judges on as many as asked, 200 by default).
 SUCCESS_EPISODES = 40
@@ -109,7 +113,10 @@ class ClosedLoop:
                 raise ConfigError(f"{key} is {value!r}; expected a whole number, at least 1")
         # The integration's settings are checked where they are used, by the binding.
         integration: dict[str, Any] = dict(dt=dt, substeps=substeps, method=method)
-        _core.Batch([_core.Network(tau=[1.0], theta=[0.0], weights=[[0.0]], sensor_weights=[[]])],
+        # A probe network slow enough for any step (the step's limit is checked against the
+        # networks themselves, in each rollout).
+        slow = 10.0 * dt if isinstance(dt, float | int) and 0 < dt < 1e300 else 1.0
+        _core.Batch([_core.Network(tau=[max(1.0, slow)], theta=[0.0], weights=[[0.0]], sensor_weights=[[]])],
                     replicas=1, **integration)
         self.env = env
         if precision not in ("f64", "f32"):
@@ -170,9 +177,9 @@ class ClosedLoop:
         """The keyword arguments that make the environment again, where they can be told from
         it: each parameter of its class's ``__init__`` that the environment keeps as an
         attribute of the same name, with a value other than the default that a config file can
-        hold (numbers, strings, booleans, and lists and tables of them). Empty unless an
-        environment made with them has this one's digest, so that what is returned is the
-        whole truth or nothing."""
+        hold (numbers, strings, booleans, and lists and tables of them), not one the run config
+        sets (:data:`SET_BY_RUN`). Empty unless an environment made with them (and then closed,
+        when it has ``close``) has this one's digest: all of what the digest sees, or nothing."""
         kind = type(self.env)
         try:
             parameters = inspect.signature(kind).parameters.values()
@@ -180,9 +187,12 @@ class ClosedLoop:
             return {}
         found: dict[str, Any] = {}
         for p in parameters:
-            if p.kind not in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) or p.name in ROLLOUT_KEYS:
+            if p.kind not in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) or p.name in ROLLOUT_KEYS + SET_BY_RUN:
                 continue
-            value = getattr(self.env, p.name, _MISSING)
+            try:
+                value = getattr(self.env, p.name, _MISSING)
+            except Exception:  # noqa: BLE001 - a property that cannot be read yet
+                continue
             if value is _MISSING or not _plain(value):
                 continue
             if p.default is p.empty or not _plain(p.default) or value != p.default:
@@ -191,13 +201,25 @@ class ClosedLoop:
             return {}
         s = self.settings
         try:
-            again = ClosedLoop(kind(**found), episodes=s["episodes"], max_steps=s["max_steps"], dt=s["dt"],
+            env = kind(**found)
+        except Exception:  # noqa: BLE001 - then the arguments are not known
+            return {}
+        try:
+            again = ClosedLoop(env, episodes=s["episodes"], max_steps=s["max_steps"], dt=s["dt"],
                                substeps=s["substeps"], method=s["method"], precision=s["precision"],
                                validation_episodes=self.validation_episodes, rows=self.rows,
                                name=f"{PYTHON_TASK}{self.__module__}.{self.__qualname__}")
-        except Exception:  # noqa: BLE001 - then the arguments are not known
-            return {}
-        return found if again.digest() == self.digest() else {}
+            same = again.digest() == self.digest()
+        except Exception:  # noqa: BLE001
+            same = False
+        finally:
+            close = getattr(env, "close", None)
+            if callable(close):  # a simulator, a vector environment: release what it holds
+                try:
+                    close()
+                except Exception:  # noqa: BLE001 - the copy's own trouble is not the run's
+                    pass
+        return found if same else {}
 
     def configured(self, config: EvolutionConfig) -> EvolutionConfig:
         """``config`` saying what this fitness function runs: its name as ``task``, the rollout's

@@ -57,7 +57,8 @@ class EvolutionResult:
     """The champion: the best network of the run by validation (see
     ``EvolutionConfig.validation_candidates``), or by training fitness when the task has no
     validation set (in its initial state), with the ``meta`` and ``integrator`` that
-    ``best.json`` holds: ``best.run(inputs, **best.integrator)`` runs it as the run did."""
+    ``best.json`` holds: ``best.run(inputs, **best.integrator,
+    precision=best.meta["precision"])`` runs it as the run did."""
     best_fitness: float
     """The champion's training fitness."""
     best_generation: int
@@ -366,6 +367,8 @@ def _restart(run: RunDir) -> tuple[GeneticAlgorithm, list[dict[str, float]], dic
     """A folder with a config.toml and no checkpoint: its run stopped before its first
     checkpoint, so it starts again from generation 0 (identical to a run never stopped)."""
     if not run.config.exists():
+        if (hint := run.sweep_hint()) is not None:
+            raise RunFileError(f"{run.path} has no checkpoint.json and no config.toml; {hint}")
         raise RunFileError(f"{run.path} has no checkpoint.json and no config.toml; nothing to resume "
                            "(start the run again)")
     done = run.logged_generations()
@@ -421,7 +424,7 @@ def _repairs(run: RunDir, ga: GeneticAlgorithm) -> list[str]:
     notes = []
     if not run.config.exists():
         notes.append("config.toml was gone")
-    for name, read in (("log.csv", lambda: run.read_log(ga.config)),
+    for name, read in (("log.csv", run.read_log),  # its rows may outnumber the checkpoint's
                        ("best.json", lambda: run.read_best(ga.config))):
         path = run.path / name
         if name == "log.csv" and not ga.generation:  # nothing to log yet
@@ -629,7 +632,7 @@ def _loop(
             save_state()
             saved = f"at generation {ga.generation}; checkpoint saved"
         else:
-            lost = len(history) - checkpointed
+            lost = ga.generation - checkpointed  # its tell may have come before the history's row
             saved = (f"mid-generation; the checkpoint of generation {checkpointed} is kept, and the "
                      f"{lost} generation{'s' if lost != 1 else ''} since will be run again")
             if run is not None:  # the log says what the checkpoint holds, as resume will

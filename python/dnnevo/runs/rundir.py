@@ -34,6 +34,7 @@ import io
 import json
 import math
 import os
+import time
 import tomllib
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -73,6 +74,13 @@ FIGURES = (
 )
 
 
+LOCK_ATTEMPTS = 10
+"""Tries at a run folder's lock before it is reported in use, :data:`LOCK_WAIT` apart: a reader
+that asks whether a run is going on (:meth:`RunDir.writer`) holds it for an instant."""
+LOCK_WAIT = 0.01
+"""Seconds between two tries at the lock."""
+
+
 class RunDir:
     """The files of one run."""
 
@@ -110,13 +118,19 @@ class RunDir:
                 raise WriteError(f"{self.path} cannot be written: {write_failure(e)}") from None
             raise DnnevoError(f"cannot open the lock file {self.lock_file}: {e.strerror}") from None
         try:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "unknown"
-                raise DnnevoError(
-                    f"{self.path} is in use by another dnnevo process (PID {holder}); "
-                    "wait for it to finish or stop it first") from None
+            for attempt in range(LOCK_ATTEMPTS):
+                try:
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    break
+                except BlockingIOError:
+                    # A reader's probe (writer()) holds it for an instant; a writer, for good.
+                    if attempt + 1 < LOCK_ATTEMPTS:
+                        time.sleep(LOCK_WAIT)
+                        continue
+                    holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "unknown"
+                    raise DnnevoError(
+                        f"{self.path} is in use by another dnnevo process (PID {holder}); "
+                        "wait for it to finish or stop it first") from None
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
             self._lock_fd = fd
@@ -279,7 +293,7 @@ class RunDir:
                 raise RunFileError(f"{self.path} does not exist; give a run folder (one that holds config.toml)")
             if not self.path.is_dir():
                 raise RunFileError(f"{self.path} is a file, not a run folder (a folder that holds config.toml)")
-            raise RunFileError(f"{self.path} has no config.toml; is it a dnnevo run folder?")
+            raise RunFileError(f"{self.path} has no config.toml; {self.not_a_run()}")
         with checked(path):
             text = read_text(path)
             try:
@@ -330,7 +344,7 @@ class RunDir:
         and its config against the digest it carries."""
         path = self.checkpoint
         if not path.exists() and not path.is_symlink():
-            raise RunFileError(f"{self.path} has no checkpoint.json; is it a dnnevo run folder?")
+            raise RunFileError(f"{self.path} has no checkpoint.json; {self.not_a_run()}")
         with checked(path):
             doc = read_json(path)
             if not isinstance(doc, dict):
@@ -365,7 +379,7 @@ class RunDir:
         and no more generations than ``config`` has."""
         path = self.log
         if not path.exists() and not path.is_symlink():
-            raise RunFileError(f"{self.path} has no log.csv; is it a dnnevo run folder?")
+            raise RunFileError(f"{self.path} has no log.csv; {self.not_a_run()}")
         with checked(path):
             text = read_text(path)
             try:
@@ -396,6 +410,20 @@ class RunDir:
                 raise fail(path, f"has {len(rows)} generations; config.toml has {config.generations}")
             return rows
 
+    def not_a_run(self) -> str:
+        """What a folder without a run's files is, for a message: a sweep's (:meth:`sweep_hint`),
+        or a question."""
+        return self.sweep_hint() or "is it a dnnevo run folder?"
+
+    def sweep_hint(self) -> str | None:
+        """When the folder holds ``seed-N`` folders (a sweep's or a reproduction's), where its
+        runs are; else None."""
+        seeds = sorted(p.name for p in self.path.glob("seed-*") if p.is_dir()) if self.path.is_dir() else []
+        if not seeds:
+            return None
+        return (f"it holds the runs {', '.join(seeds[:3])}{', ...' if len(seeds) > 3 else ''} "
+                f"(a sweep's folder): name one of them, as {self.path / seeds[0]}")
+
     def logged_generations(self) -> int:
         """How many generations ``log.csv`` has a row for (its non-empty lines after the header),
         counted without judging them: a damaged log is a record of work all the same."""
@@ -412,13 +440,17 @@ class RunDir:
         says, of the run's task, seed, integrator and precision."""
         path = self.best
         if not path.exists() and not path.is_symlink():
-            if self.checkpoint.exists() and self.logged_generations():
+            if (pid := self.writer()) is not None:
+                raise RunFileError(f"{self.path} has no best.json yet: its run is going on (PID {pid}); "
+                                   "try again when a generation has finished")
+            if not self.checkpoint.exists():
+                raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")
+            if self.read_checkpoint().history:
                 raise RunFileError(f"{self.path} has no best.json, though it has a checkpoint; "
                                    f"{self._resume_command()} writes it again")
-            if self.checkpoint.exists():  # a run that failed in its first generation
-                raise RunFileError(f"{self.path} has no best.json; no generation has finished: its run "
-                                   "stopped in generation 0, so start it again once what stopped it is changed")
-            raise RunFileError(f"{self.path} has no best.json; no generation has finished yet")
+            # A run that failed in its first generation.
+            raise RunFileError(f"{self.path} has no best.json; no generation has finished: its run "
+                               "stopped in generation 0, so start it again once what stopped it is changed")
         with checked(path):
             try:
                 net = Network.load(path)

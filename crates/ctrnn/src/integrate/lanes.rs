@@ -14,7 +14,8 @@ use crate::vector::{avx2, avx512};
 use crate::vector::{Elem, Portable, Vector};
 
 use super::kernel::{rates, weight_order, Work};
-use super::Integrator;
+use super::settings::short;
+use super::{Integrator, Method};
 
 /// How many networks a population block steps together: two AVX-512 registers of f64, four
 /// AVX2 ones or eight NEON ones, so that every row of the kernel has independent dependency chains in flight.
@@ -95,6 +96,8 @@ pub struct Lanes<const L: usize, E: Elem = f64> {
 #[derive(Clone, Debug)]
 struct Scratch<const L: usize, E: Elem> {
     dt: f64,
+    /// The method of the last step, for a divergence's message.
+    method: Method,
     /// dt / tau, and its half and sixth for RK4.
     h: Rows<L, E>,
     h2: Rows<L, E>,
@@ -169,6 +172,7 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
             state: gather(|p| p.state, &neurons),
             scratch: Scratch {
                 dt: f64::NAN,
+                method: Method::Euler,
                 h: zeros(n),
                 h2: zeros(n),
                 h6: zeros(n),
@@ -306,11 +310,12 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
         copy_lane(&self.state, l, into);
     }
 
-    /// Makes the step sizes match `dt`.
+    /// Makes the step sizes match `integ`'s `dt`.
     #[inline(always)]
-    pub(super) fn prepare(&mut self, dt: f64) {
-        if self.scratch.dt.to_bits() != dt.to_bits() {
-            self.set_step_sizes(dt);
+    pub(super) fn prepare(&mut self, integ: &Integrator) {
+        self.scratch.method = integ.method;
+        if self.scratch.dt.to_bits() != integ.dt.to_bits() {
+            self.set_step_sizes(integ.dt);
         }
     }
 
@@ -366,7 +371,7 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
     /// [`advance`](Self::advance) on a given kernel, which the CPU must support.
     #[inline(always)]
     fn advance_on(&mut self, kernel: Kernel, inputs: Option<&[[E; L]]>, integ: &Integrator) {
-        self.prepare(integ.dt);
+        self.prepare(integ);
         with_backend!(kernel, self.advance_with(inputs, integ))
     }
 
@@ -424,7 +429,7 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
         row: impl FnMut(usize, &mut [[E; L]]),
         record: impl FnMut(usize, &[[E; L]]),
     ) -> Result<()> {
-        self.prepare(integ.dt);
+        self.prepare(integ);
         with_backend!(
             simd::kernel(),
             self.run_rows_with(steps, integ, cancel, row, record)
@@ -500,35 +505,46 @@ impl<const L: usize, E: Elem> Lanes<L, E> {
     pub fn check_finite(&self, name: impl Fn(usize) -> String) -> Result<()> {
         for (i, row) in self.state.iter().enumerate() {
             if let Some(l) = (0..self.len).find(|&l| !row[l].finite()) {
-                return Err(diverged(&name(l), i, row[l].to_f64(), self.step_size(i, l)));
+                return Err(self.diverged(&name(l), i, l));
             }
         }
         Ok(())
     }
 
-    /// `dt / tau` of neuron `i` in lane `l` at the last step (NaN before the first).
-    pub fn step_size(&self, i: usize, l: usize) -> f64 {
-        self.scratch.h[i][l].to_f64()
+    /// The error of neuron `i` in lane `l` (of `what`) when its state is not finite
+    /// ([`diverged`]), with the step and method of the last step.
+    pub fn diverged(&self, what: &str, i: usize, l: usize) -> Error {
+        let (h, method) = self.last_step(i, l);
+        diverged(what, i, self.state[i][l].to_f64(), h, method)
+    }
+
+    /// `dt / tau` of neuron `i` in lane `l` at the last step (NaN before the first), and the
+    /// step's method.
+    pub fn last_step(&self, i: usize, l: usize) -> (f64, Method) {
+        (self.scratch.h[i][l].to_f64(), self.scratch.method)
     }
 }
 
 /// The error of an integration in which neuron `neuron` of `what` (`network 3`, `row 7`) became
-/// `value`, not a finite number, with a step of `dt / tau` = `h` there. From `h` = 2 on the step
-/// is too long (Euler's limit; RK4's is 2.79, [`Method::unstable_from`](super::Method)); below
-/// it the neuron's own decay shrinks at every step, so only a weight, threshold or input too
-/// large for the precision can have overflowed it.
-pub fn diverged(what: &str, neuron: usize, value: f64, h: f64) -> Error {
-    let why = if h >= 2.0 {
+/// `value`, not a finite number, with a step of `dt / tau` = `h` of `method` there. From
+/// [`Method::unstable_from`] on the step is too long; below it the neuron's own decay shrinks at
+/// every step, so only a weight, threshold or input too large for the precision can have
+/// overflowed it.
+pub fn diverged(what: &str, neuron: usize, value: f64, h: f64, method: Method) -> Error {
+    let limit = method.unstable_from();
+    let why = if h >= limit {
         format!(
-            "dt / tau is {} here, too long a step: use a smaller dt (a step grows without bound \
-             from dt / tau = 2 on with Euler, from 2.79 with RK4)",
-            super::settings::short(h)
+            "dt / tau is {} here, too long a step: use a smaller dt ({} steps grow without \
+             bound from dt / tau = {} on)",
+            short(h),
+            method.name(),
+            short(limit)
         )
     } else {
         format!(
             "dt / tau is {} here, so the step is not the cause: a weight, threshold or input too \
              large for the precision made it overflow",
-            super::settings::short(h)
+            short(h)
         )
     };
     Error::InvalidArgument(format!(

@@ -47,13 +47,26 @@ impl Method {
 /// `1 - z + z^2/2 - z^3/6 + z^4/24 = 1` in `z`, `dt / tau`, other than 0.
 const RK4_STABILITY_END: f64 = 2.785_293_563_405_282;
 
-/// A number for a message: three significant digits, in exponent form when very large or small.
+/// A number for a message: four significant digits (rounded to nearest), in exponent form when
+/// very large or small.
 pub(crate) fn short(x: f64) -> String {
-    if x != 0.0 && (x.abs() >= 1e5 || x.abs() < 1e-3) {
+    if x != 0.0 && (x.abs() >= 1e5 || x.abs() < 1e-3) || !x.is_finite() {
         format!("{x:.3e}")
     } else {
-        format!("{}", (x * 1000.0).round() / 1000.0)
+        let digits = 3 - x.abs().log10().floor().max(-4.0) as i32;
+        let scale = 10f64.powi(digits.max(0));
+        format!("{}", (x * scale).round() / scale)
     }
+}
+
+/// [`short`] rounded down, for a bound that `x` must stay below: the bound it prints is one.
+fn short_below(x: f64) -> String {
+    if x != 0.0 && (x.abs() >= 1e5 || x.abs() < 1e-3) || !x.is_finite() {
+        return short(x);
+    }
+    let digits = 3 - x.abs().log10().floor().max(-4.0) as i32;
+    let scale = 10f64.powi(digits.max(0));
+    format!("{}", (x * scale).floor() / scale)
 }
 
 /// The floating-point type an integration computes in.
@@ -169,7 +182,7 @@ impl Integrator {
                 Method::Euler => "Euler",
                 Method::Rk4 => "RK4",
             },
-            short(limit * tau),
+            short_below(limit * tau),
         )))
     }
 

@@ -102,6 +102,13 @@ fn ranges_validate_names_the_field() {
             },
             "ranges.theta",
         ),
+        (
+            Ranges {
+                weights: (-1e308, 1e308),
+                ..Ranges::default()
+            },
+            "ranges.weights is (-1e308, 1e308); its width overflows",
+        ),
     ];
     for (r, field) in cases {
         let e = r.validate().unwrap_err();

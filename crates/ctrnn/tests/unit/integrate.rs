@@ -148,6 +148,17 @@ fn divergence_is_reported_not_returned() {
             && e.contains("dt / tau is 0.1 here, so the step is not the cause"),
         "{e}"
     );
+    // Within RK4's limit, though past Euler's, the step is not blamed either.
+    let rk4 = Integrator {
+        method: Method::Rk4,
+        dt: 2.5,
+        ..Integrator::default()
+    };
+    let e = loud.run(&[1e10], 1, &rk4).unwrap_err().to_string();
+    assert!(
+        e.contains("dt / tau is 2.5 here, so the step is not the cause"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -282,3 +282,10 @@ def test_example_evolved_comparison_runs_with_tiny_settings(tmp_path: Path) -> N
                                            "evolved, seed 0"]
     assert all("/2 (" in cell for r in doc["rows"] for cell in r[1:4])
     assert doc["summary"][-1].endswith("The paper evolved no network for this task.")
+
+
+def test_a_missing_navigation_world_file_is_file_not_found(tmp_path: Path) -> None:
+    from dnnevo.robots import Navigate
+
+    with pytest.raises(FileNotFoundError, match="world file .*gone.toml does not exist"):
+        Navigate(tmp_path / "gone.toml")

@@ -134,8 +134,9 @@ def build_parser() -> argparse.ArgumentParser:
     def run_options(p: argparse.ArgumentParser) -> None:
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a setting, e.g. population=200, integrator.dt=0.05 or "
-                            "task_params.sim.sonars.0.lobe_deg=10 (a number picks a list's entry; "
-                            "the rest of a task's table keeps its defaults)")
+                            "task_params.sim.sonars.0.lobe_deg=10 (in task_params, a number picks "
+                            "a list's entry and the rest of the task's table keeps its defaults; a "
+                            "top-level pair is set whole: ranges.tau=[1, 10])")
         p.add_argument("--quick", action="store_true",
                        help="small population, few generations: a demo, not a result")
         p.add_argument("--threads", type=_positive, help="worker threads (default: all cores)")

@@ -51,7 +51,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
 from os import PathLike
-from pathlib import Path
 from typing import Any, TypedDict
 
 import numpy as np
@@ -60,7 +59,7 @@ import numpy.typing as npt
 from dnnevo import _core
 from dnnevo.closedloop import rollout
 from dnnevo.errors import InvalidArgumentError
-from dnnevo.robots.world import D0, RobotWorld
+from dnnevo.robots.world import D0, RobotWorld, world_text
 
 __all__ = ["INTEGRATOR", "WORLDS", "Integration", "Detectors", "Navigate", "bearing", "design", "destination",
            "hand_designed", "looping", "navigation_world", "navigator", "stuck"]
@@ -98,10 +97,7 @@ def navigation_world(world: str | PathLike[str] | Mapping[str, Any]
             text = _data(f"{world}.toml").read_text(encoding="utf-8")
             where = world
         elif isinstance(world, PathLike) or (isinstance(world, str) and world.endswith(".toml")):
-            try:
-                text = Path(world).read_text(encoding="utf-8")
-            except OSError as e:
-                raise InvalidArgumentError(f"world file {world} cannot be read: {e.strerror}") from None
+            text = world_text(world)
             where = str(world)
         else:
             raise InvalidArgumentError(f"world is {world!r}; expected one of "

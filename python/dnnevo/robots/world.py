@@ -35,7 +35,7 @@ from dnnevo import _core
 from dnnevo.closedloop.environment import check_neurons
 from dnnevo.errors import InvalidArgumentError
 
-__all__ = ["D0", "WORLDS", "RobotWorld", "world_of"]
+__all__ = ["D0", "WORLDS", "RobotWorld", "world_of", "world_text"]
 
 WORLDS = {"landmark1": 1, "landmark2": 2}
 """The built-in worlds by name: the two rooms of the landmark experiment (docs/worlds.md)."""
@@ -53,21 +53,27 @@ def world_of(world: str | PathLike[str] | Mapping[str, Any]) -> str | dict[str, 
     if isinstance(world, str) and world in WORLDS:
         return _core.sim2d_landmark_world(WORLDS[world])
     if isinstance(world, PathLike) or (isinstance(world, str) and world.endswith(".toml")):
-        path = Path(world)
-        try:
-            return path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise FileNotFoundError(f"world file {path} does not exist") from None
-        except OSError as e:
-            raise InvalidArgumentError(f"world file {path} cannot be read: {e.strerror}") from None
-        except UnicodeDecodeError as e:
-            raise InvalidArgumentError(f"world file {path} is not UTF-8 text (byte {e.start}): a "
-                                       "world file is TOML") from None
+        return world_text(world)
     hint = ""
     if isinstance(world, str) and Path(world).suffix:
         hint = f" (a world file's name ends in .toml, not {Path(world).suffix})"
     raise InvalidArgumentError(f"world is {world!r}; expected one of {', '.join(map(repr, WORLDS))}, "
                                f"a world file (a path ending in .toml) or a dict{hint}")
+
+
+def world_text(path: str | PathLike[str]) -> str:
+    """The text of the world file at ``path``: ``FileNotFoundError`` when there is none, an
+    :class:`~dnnevo.errors.InvalidArgumentError` naming it when it cannot be read or is not
+    UTF-8 text."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileNotFoundError(f"world file {path} does not exist") from None
+    except OSError as e:
+        raise InvalidArgumentError(f"world file {path} cannot be read: {e.strerror}") from None
+    except UnicodeDecodeError as e:
+        raise InvalidArgumentError(f"world file {path} is not UTF-8 text (byte {e.start}): a "
+                                   "world file is TOML") from None
 
 
 def _neuron(name: str, value: Any) -> int:

@@ -50,23 +50,23 @@ const RK4_STABILITY_END: f64 = 2.785_293_563_405_282;
 /// A number for a message: four significant digits (rounded to nearest), in exponent form when
 /// very large or small.
 pub(crate) fn short(x: f64) -> String {
-    if x != 0.0 && (x.abs() >= 1e5 || x.abs() < 1e-3) || !x.is_finite() {
-        format!("{x:.3e}")
-    } else {
-        let digits = 3 - x.abs().log10().floor().max(-4.0) as i32;
-        let scale = 10f64.powi(digits.max(0));
-        format!("{}", (x * scale).round() / scale)
-    }
+    rounded(x, f64::round)
 }
 
 /// [`short`] rounded down, for a bound that `x` must stay below: the bound it prints is one.
 fn short_below(x: f64) -> String {
+    rounded(x, f64::floor)
+}
+
+/// `x` to four significant digits by `round` (in exponent form, rounded to nearest, when very
+/// large or small).
+fn rounded(x: f64, round: fn(f64) -> f64) -> String {
     if x != 0.0 && (x.abs() >= 1e5 || x.abs() < 1e-3) || !x.is_finite() {
-        return short(x);
+        return format!("{x:.3e}");
     }
     let digits = 3 - x.abs().log10().floor().max(-4.0) as i32;
     let scale = 10f64.powi(digits.max(0));
-    format!("{}", (x * scale).floor() / scale)
+    format!("{}", round(x * scale) / scale)
 }
 
 /// The floating-point type an integration computes in.

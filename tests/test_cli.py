@@ -33,6 +33,10 @@ def test_run_show_assess_resume_sweep(tmp_path: Path) -> None:
     # Exit status 0 pass, 1 fail, 3 undecided: the overall verdict.
     verdict = {0: "pass", 1: "fail", 3: "undecided"}[r.returncode]
     assert f"overall: {verdict}" in r.stdout and "switch test" in r.stdout, r.stdout
+    # A reader that stops reading (`| head`) leaves the verdict as the exit status, quietly.
+    gone = subprocess.run(["bash", "-c", f"set -o pipefail; {sys.executable} -m dnnevo assess {out} "
+                           "--trials 5 --seed 1 | (exec <&-)"], capture_output=True, text=True, timeout=600)
+    assert (gone.returncode, gone.stderr) == (r.returncode, ""), gone
     # The command's old name still works, says it is deprecated, and judges the same.
     old = dnnevo("evaluate", str(out), "--trials", "5", "--seed", "1")
     assert (old.returncode, old.stdout) == (r.returncode, r.stdout)

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from dnnevo import tasks
+from dnnevo.cli.outputs import reader_gone
 from dnnevo.closedloop import named
 from dnnevo.evaluation.assessment import Assessment, Rate
 from dnnevo.evaluation.stats import Verdict
@@ -74,13 +75,15 @@ def assess(args: argparse.Namespace) -> int:
         check = step_check(lambda c: tasks.assess(c, champion, a.trials, seed=seed, robot_like=args.robot_like),
                            config, base=a)
         extra = {**extra, "step_check": check.to_dict()}
-    if args.json:
-        print(json.dumps({"run": str(args.dir), **a.to_dict(), **extra}, indent=1))
-    else:
-        print("\n".join(text(args.dir, a, extra) + (step_lines(check) if check else [])))
-    if check is not None and check.artefact:
-        return EXIT_STATUS["fail"]
-    return EXIT_STATUS[a.verdict]
+    status = EXIT_STATUS["fail" if check is not None and check.artefact else a.verdict]
+    try:  # the verdict stands when the reader stops early (`| head`)
+        if args.json:
+            print(json.dumps({"run": str(args.dir), **a.to_dict(), **extra}, indent=1), flush=True)
+        else:
+            print("\n".join(text(args.dir, a, extra) + (step_lines(check) if check else [])), flush=True)
+    except BrokenPipeError:
+        reader_gone()
+    return status
 
 
 def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:

@@ -13,7 +13,6 @@ if sys.excepthook is sys.__excepthook__:
     sys.excepthook = _startup.interrupted_import
 
 import argparse
-import os
 import traceback
 from pathlib import Path
 from typing import Any
@@ -22,6 +21,7 @@ from dnnevo import figures
 from dnnevo.cli import analyze as _cli_analyze
 from dnnevo.cli import assess as _cli_assess
 from dnnevo.cli import nav1d_system as _cli_nav1d_system
+from dnnevo.cli import outputs as _outputs
 from dnnevo.cli import reproduce as _cli_reproduce
 from dnnevo.cli import show as _cli_show
 from dnnevo.cli import sweep as _cli_sweep
@@ -361,8 +361,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return COMMANDS[args.command](args)
     except BrokenPipeError:
-        # The reader (e.g. `| head`) stopped reading; that is not an error of ours.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        _outputs.reader_gone()
         return 0
     except (DnnevoError, OSError) as e:
         if args.debug:  # the traceback too, and the same exit status: 1 is assess's "fail"

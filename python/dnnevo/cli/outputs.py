@@ -1,14 +1,16 @@
-"""Files a reading command writes beside a run (a figure, an analysis): when the folder cannot
-take them (read-only, full), the command still gives its answer and says what it did not write."""
+"""What a command writes besides its answer: files beside a run (a figure, an analysis), which a
+folder that cannot take them (read-only, full) does not stop the answer for, and the answer itself
+when its reader (``| head``) stops reading."""
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable
 
 from dnnevo.errors import WriteError
 
-__all__ = ["try_write"]
+__all__ = ["reader_gone", "try_write"]
 
 
 def try_write(write: Callable[[], None]) -> bool:
@@ -20,3 +22,9 @@ def try_write(write: Callable[[], None]) -> bool:
         sys.stderr.write(f"dnnevo: note: {e}\n")
         return False
     return True
+
+
+def reader_gone() -> None:
+    """Sends the rest of stdout nowhere, after a :class:`BrokenPipeError`: the reader (``| head``)
+    stopped reading, which is not an error of ours, and Python must not complain at exit."""
+    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

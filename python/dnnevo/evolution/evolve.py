@@ -424,19 +424,19 @@ def _repairs(run: RunDir, ga: GeneticAlgorithm) -> list[str]:
     notes = []
     if not run.config.exists():
         notes.append("config.toml was gone")
-    for name, read in (("log.csv", run.read_log),  # its rows may outnumber the checkpoint's
-                       ("best.json", lambda: run.read_best(ga.config))):
-        path = run.path / name
-        if name == "log.csv" and not ga.generation:  # nothing to log yet
-            continue
+    # log.csv's rows may outnumber the checkpoint's generations; that is no damage
+    for path, read, expected in ((run.log, run.read_log, ga.generation > 0),
+                                 (run.best, lambda: run.read_best(ga.config), ga.best is not None)):
         if not path.exists():
-            if name == "log.csv" or ga.best is not None:
-                notes.append(f"{name} was gone")
+            if expected:
+                notes.append(f"{path.name} was gone")
+            continue
+        if path == run.log and not expected:  # nothing logged yet
             continue
         try:
             read()
         except DnnevoError as e:
-            notes.append(f"{name} was damaged ({str(e).removeprefix(str(path) + ': ')})")
+            notes.append(f"{path.name} was damaged ({str(e).removeprefix(str(path) + ': ')})")
     return notes
 
 

@@ -5,6 +5,7 @@ every misuse a one-line error that names it."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -558,6 +559,12 @@ def test_a_class_edited_after_its_run_is_refused_by_every_command_that_runs_the_
         r = dnnevo_command(tmp_path, command, "runs/seeker_edit.Seeker-seed0")
         assert r.returncode == 2 and "evolved with another version of python:seeker_edit.Seeker" in r.stderr, \
             (command, r.stderr)
+        # The new default changed the class's source and the environment's attributes, not the rollout.
+        assert "source" in r.stderr and "attributes differ" in r.stderr and "settings" not in r.stderr
+    # Each part that differs is named, and only those.
+    (tmp_path / "seeker_edit.py").write_text(SEEKER.replace("success_rate = 0.9", "success_rate = 0.95"))
+    r = dnnevo_command(tmp_path, "assess", "runs/seeker_edit.Seeker-seed0")
+    assert "a success rule added or changed counts" in r.stderr and "attributes" not in r.stderr, r.stderr
 
 
 def test_a_fitness_that_tells_no_networks_apart_is_warned_about(tmp_path) -> None:
@@ -630,7 +637,7 @@ def test_naming_the_task_or_passing_it_evolves_the_same(tmp_path, monkeypatch) -
     assert np.array_equal(by_name.history["best"], by_object.history["best"])
 
 
-def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path, monkeypatch) -> None:
+def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path, monkeypatch, capsys) -> None:
     """config.toml records an environment object's arguments only when they can be told from
     it (ClosedLoop.arguments): else a command that builds the task from it builds Seeker() with
     its defaults, and the digest says that is another task."""
@@ -650,6 +657,9 @@ def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path,
     for speed, tagged, folder in [(0.1, False, "same"), (0.2, False, "told"), (0.2, True, "other")]:
         loop = ClosedLoop(seeker(speed, tagged), episodes=2, max_steps=50)
         dnnevo.evolve(loop, config, out=tmp_path / folder, progress=False)
+        # The run says at its start when the command line will not build its task again.
+        note = "the command line will not judge, draw or resume" in capsys.readouterr().err
+        assert note == tagged, folder
     for folder in ("same", "told"):
         judged = dnnevo_command(tmp_path, "assess", folder, "--trials", "20")
         assert judged.returncode in (0, 1, 3) and "20 fresh episodes" in judged.stdout, judged.stderr
@@ -665,6 +675,18 @@ def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path,
     for folder in ("same", "told"):
         by_name = dnnevo.resume(tmp_path / folder, "python:seeker_arg.Seeker", generations=3, progress=False)
         assert len(by_name.history["best"]) == 3
+    # Continued with new arguments (a curriculum): config.toml says what the task is from then
+    # on, so the command line still builds, judges and resumes it.
+    harder = ClosedLoop(seeker(0.3, False), episodes=3, max_steps=40)
+    dnnevo.resume(tmp_path / "same", harder, generations=4, new_fitness=True, progress=False)
+    import tomllib
+    table = tomllib.loads((tmp_path / "same" / "config.toml").read_text())
+    assert table["task_params"] == {"speed": 0.3, "episodes": 3, "max_steps": 40}
+    assert table["run"]["fitness_changes"] == [{"generation": 3, "task": "python:seeker_arg.Seeker",
+                                                "task_params": table["task_params"]}]
+    for command in (["assess", "same", "--trials", "20"], ["resume", "same", "--generations", "5"]):
+        r = dnnevo_command(tmp_path, *command)
+        assert r.returncode in (0, 1, 3), r.stderr
 
 
 def test_a_fitness_function_run_is_neither_resumed_nor_judged_by_the_command_line(tmp_path) -> None:
@@ -817,3 +839,41 @@ def test_a_run_begun_from_python_records_the_arguments_it_can_tell_and_the_comma
     judged = dnnevo_command(tmp_path, "assess", "run", "--trials", "20")
     assert judged.returncode in (0, 1, 3), judged.stderr
     assert "fresh episodes" in judged.stdout
+
+
+class _Halfway:
+    observation_size = 1
+
+    def reset(self, episodes, rng):
+        return np.zeros((len(episodes), 1))
+
+    def step(self, rates, active):
+        return np.zeros((len(rates), 1)), np.zeros(len(rates)), np.ones(len(rates), bool)
+
+
+class _RuleWithoutRate(_Halfway):
+    def success(self, returns, lengths):
+        return returns > 0
+
+
+class _RateWithoutRule(_Halfway):
+    success_rate = 0.9
+
+
+class _RateOutOfRange(_RuleWithoutRate):
+    success_rate = 1.5
+
+
+class _RuleTurnedOff(_RuleWithoutRate):
+    success_rate = None
+
+
+@pytest.mark.parametrize("env, message", [
+    (_RuleWithoutRate(), "_RuleWithoutRate has a success method but no success_rate"),
+    (_RateWithoutRule(), "_RateWithoutRule has a success_rate but no method success(returns, lengths)"),
+    (_RateOutOfRange(), "_RateOutOfRange.success_rate is 1.5; expected a number in (0, 1]"),
+])
+def test_half_a_success_rule_is_refused_when_the_task_is_made(env, message: str) -> None:
+    with pytest.raises(dnnevo.ConfigError, match=re.escape(message)):
+        ClosedLoop(env, max_steps=5)
+    ClosedLoop(_RuleTurnedOff(), max_steps=5)  # success_rate = None: no rule, said so

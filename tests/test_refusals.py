@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import dnnevo
@@ -105,3 +107,19 @@ def test_negative_timings_and_threads_are_named() -> None:
     evolution = dnnevo.GeneticAlgorithm(dnnevo.presets.get("sequence-1bit", quick=True), seed=0)
     with pytest.raises(InvalidArgumentError, match="threads is -1"):
         evolution.step(threads=-1)
+
+
+def test_numpy_numbers_stand_for_python_ones_and_what_toml_cannot_hold_is_named() -> None:
+    config = dnnevo.EvolutionConfig(population=np.int64(50), mutation_rate=np.float32(0.5),
+                                    task_params={"max_steps": np.int64(10), "pair": (1, np.float64(2.5)),
+                                                 "flags": {"on": np.bool_(True)}})
+    assert (config.population, type(config.population)) == (50, int)
+    assert config.task_params == {"max_steps": 10, "pair": [1, 2.5], "flags": {"on": True}}
+    assert type(config.task_params["max_steps"]) is int
+    assert "max_steps = 10" in config.to_toml()
+    for params, message in [({"x": None}, "task_params.x is None"),
+                            ({"x": np.zeros(2)}, "task_params.x is an array; a config holds lists"),
+                            ({"x": [1, {"y": object()}]}, "task_params.x[1].y is of type object"),
+                            ({1: 2}, "task_params has the key 1")]:
+        with pytest.raises(dnnevo.ConfigError, match=re.escape(message)):
+            dnnevo.EvolutionConfig(task_params=params)

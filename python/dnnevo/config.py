@@ -17,6 +17,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+import numpy as np
 import tomli_w
 
 from dnnevo import _core
@@ -173,7 +174,7 @@ class EvolutionConfig:
             raise ConfigError(f"ranges is {self.ranges!r}; expected a table")
         if not isinstance(self.task_params, Mapping):
             raise ConfigError(f"task_params is {self.task_params!r}; expected a table")
-        object.__setattr__(self, "task_params", dict(self.task_params))
+        object.__setattr__(self, "task_params", _plain(self.task_params, "task_params"))
         d = self.to_dict()
         _check_finite(d, "")
         _check_counts(d)
@@ -241,6 +242,9 @@ def _check_type(obj: Any, name: str, kind: type, prefix: str = "") -> None:
     """``obj.name`` has the type ``kind``: a str; a bool; an int (not a bool; a negative one is
     refused by :func:`_check_counts`); or a float, which an int may stand for."""
     value = getattr(obj, name)
+    if isinstance(value, np.generic):  # a NumPy number stands for the Python one it holds
+        value = value.item()
+        object.__setattr__(obj, name, value)
     if kind is bool:
         ok = isinstance(value, bool)
         expected = "true or false"
@@ -282,6 +286,28 @@ def _check_counts(d: dict[str, Any]) -> None:
             if said.startswith(f"{key} is 0; "):
                 rule = said[len(f"{key} is 0; "):]
         raise ConfigError(f"{key} is {value}; {rule}")
+
+
+def _plain(value: Any, where: str) -> Any:
+    """``value`` as a config file holds it: NumPy numbers as the Python numbers they hold, tuples
+    as lists, tables as dicts; anything a TOML file cannot hold (None, an array, an object) is a
+    :class:`ConfigError` naming where it is."""
+    if isinstance(value, np.generic) and not isinstance(value, np.str_ | np.bytes_ | np.void):
+        value = value.item()
+    if isinstance(value, bool | int | float | str):
+        return value
+    if isinstance(value, Mapping):
+        for k in value:
+            if not isinstance(k, str):
+                raise ConfigError(f"{where} has the key {k!r}; keys of a table are strings")
+        return {k: _plain(v, f"{where}.{k}") for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, np.ndarray):
+        raise ConfigError(f"{where} is an array; a config holds lists (give array.tolist())")
+    what = "None" if value is None else f"of type {type(value).__name__}"
+    raise ConfigError(f"{where} is {what}; a config holds numbers, strings, booleans, and lists "
+                      "and tables of them")
 
 
 def _check_finite(value: Any, where: str) -> None:

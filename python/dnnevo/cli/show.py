@@ -56,8 +56,8 @@ def success_line(task: str, success: Sequence[float], *, closed_loop: bool = Fal
     judged = [s for s in success if not math.isnan(s)]
     if not judged and closed_loop and success:
         # A run checks a task class's champion every generation; NaN means it has no rule.
-        return ("success rule: none (the task class has no success_rate and success method: "
-                "docs/closed-loop.md#a-success-rule)")
+        return ("success rule: none (the task class has no success_rate and success method; one "
+                "added makes another task, so run again with it: docs/closed-loop.md#a-success-rule)")
     if not judged:
         return "success rule: not checked in this run (champion_success is nan in log.csv)"
     # A task class's champion is checked on a few episodes only: say so, as assess will differ.
@@ -101,7 +101,7 @@ def next_line(path: Path, config: EvolutionConfig, success: Sequence[float], *,
                 f"or {judge} to {verb} the champion so far")
     if verb == "draw":
         return (f"next: {judge}   (draws the champion on fresh episodes; dnnevo assess needs a "
-                "success rule: docs/closed-loop.md#a-success-rule)")
+                "success rule, written before the run: docs/closed-loop.md#a-success-rule)")
     return f"next: {judge}   (judges the champion on fresh trials, with 95% intervals and a verdict)"
 
 

@@ -71,10 +71,15 @@ def success_rule(env: Any, task: str) -> tuple[Any, float]:
     :class:`~dnnevo.ConfigError` says what is missing."""
     kind = type(env).__name__
     rule, threshold = getattr(env, "success", None), getattr(env, "success_rate", None)
-    if rule is None or threshold is None:
+    if threshold is None and (rule is None or hasattr(env, "success_rate")):  # None: turned off
         raise ConfigError(f"{task} has no success rule: give {kind} a success_rate (the fraction "
                           "of episodes that must succeed) and a method success(returns, lengths) "
                           "(docs/closed-loop.md#a-success-rule)")
+    if rule is None or threshold is None:
+        has, lacks = ("success_rate", "method success(returns, lengths)") if rule is None else \
+            ("success method", "success_rate (the fraction of episodes that must succeed)")
+        raise ConfigError(f"{kind} has a {has} but no {lacks}; a success rule needs both, and "
+                          "success_rate = None says the class has none (docs/closed-loop.md#a-success-rule)")
     if isinstance(threshold, bool) or not (isinstance(threshold, float | int) and 0 < threshold <= 1):
         raise ConfigError(f"{kind}.success_rate is {threshold!r}; expected a number in (0, 1]")
     return rule, float(threshold)
@@ -119,10 +124,17 @@ class ClosedLoop:
         _core.Batch([_core.Network(tau=[max(1.0, slow)], theta=[0.0], weights=[[0.0]], sensor_weights=[[]])],
                     replicas=1, **integration)
         self.env = env
+        # Half a rule, or a rate out of range, is refused; success_rate = None says there is none.
+        rule, rate = getattr(env, "success", None), getattr(env, "success_rate", None)
+        if rate is not None or (rule is not None and not hasattr(env, "success_rate")):
+            success_rule(env, type(env).__name__)
         if precision not in ("f64", "f32"):
             raise ConfigError(f"precision is {precision!r}; expected 'f64' or 'f32'")
-        self.settings: dict[str, Any] = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps,
-                             method=method, precision=precision)
+        given = dict(episodes=episodes, max_steps=max_steps, dt=dt, substeps=substeps, method=method,
+                     precision=precision)
+        # A NumPy number stands for the Python one it holds, which a config file can record.
+        self.settings: dict[str, Any] = {k: v.item() if isinstance(v, np.generic) else v
+                                         for k, v in given.items()}
         self.validation_episodes = int(validation_episodes)
         if rows is not None and (isinstance(rows, bool) or not isinstance(rows, int | np.integer)
                                  or rows < episodes):
@@ -142,8 +154,9 @@ class ClosedLoop:
         except TypeError:  # a class with __slots__
             attributes = {k: getattr(env, k) for k in getattr(kind, "__slots__", ()) if hasattr(env, k)}
         recorded = self._recorded()
-        self.fitness_source = "\n".join([task_source(kind) or kind.__qualname__, fingerprint(attributes),
-                                         fingerprint(recorded)])
+        self._parts = {"source": task_source(kind) or kind.__qualname__,
+                       "attributes": fingerprint(attributes), "settings": fingerprint(recorded)}
+        self.fitness_source = "\n".join(self._parts.values())
         # As made before digests took in what the class reads from its module (source.py): the
         # class's source as it was then, and without an analysis attribute added since.
         legacy = [legacy_fingerprint(attributes), legacy_fingerprint(recorded)]
@@ -166,6 +179,13 @@ class ClosedLoop:
     def digest(self) -> str:
         """SHA-256 of :attr:`fitness_source`, as ``config.toml``'s ``fitness_sha256`` records it."""
         return hashlib.sha256(self.fitness_source.encode()).hexdigest()
+
+    def part_digests(self) -> dict[str, str]:
+        """SHA-256 of each part of :attr:`fitness_source`, as ``config.toml``'s ``fitness_parts``
+        records them, to say which part differs when a digest does: the class's ``source`` (with
+        what it reads from its module), the environment's ``attributes`` and the rollout's
+        ``settings``."""
+        return {k: hashlib.sha256(v.encode()).hexdigest() for k, v in self._parts.items()}
 
     def digests(self) -> tuple[str, ...]:
         """Every digest a run of this task may record: :meth:`digest`, and the one runs recorded

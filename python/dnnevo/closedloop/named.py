@@ -125,9 +125,11 @@ def _whole_size(size: Any) -> int | None:
     return int(size)
 
 
-def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> ClosedLoop:
+def closed_loop(config: EvolutionConfig, *, digest: str | None = None,
+                parts: Mapping[str, str] | None = None) -> ClosedLoop:
     """The fitness function of the task that ``config`` names (see the module docs). With
-    ``digest`` (a run's ``fitness_sha256``), it must be the run's own task."""
+    ``digest`` (a run's ``fitness_sha256``), it must be the run's own task; ``parts`` (its
+    ``fitness_parts``, when it has them) let the refusal say what differs."""
     cls = environment_class(config.task)
     params = dict(config.task_params)
     settings = {k: params.pop(k) for k in ROLLOUT_KEYS if k in params}
@@ -151,10 +153,31 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None) -> Closed
     loop = ClosedLoop(env, **settings, dt=i.dt, substeps=i.substeps, method=i.method,
                       precision=config.precision, name=config.task)
     if digest is not None and digest not in loop.digests():
-        raise ConfigError(f"the run was evolved with another version of {config.task} (its source, "
-                          "the environment's attributes or the rollout's settings differ, or the run "
-                          "began from Python with an environment made with other arguments)")
+        raise ConfigError(f"the run was evolved with another version of {config.task} "
+                          f"({_what_differs(loop, parts)})")
     return loop
+
+
+DIFFERENCES = {
+    "source": "the class's source, or what it reads from its module, was edited since the run; "
+              "a success rule added or changed counts: it is part of the task",
+    "attributes": "the environment's attributes differ: task_params, or the run began from Python "
+                  "with an environment made with arguments config.toml could not record",
+    "settings": "the rollout's settings differ: episodes, max_steps, validation_episodes or the "
+                "integrator",
+}
+"""What each part of a task's digest (:meth:`ClosedLoop.part_digests`) differing means."""
+
+
+def _what_differs(loop: ClosedLoop, parts: Mapping[str, str] | None) -> str:
+    """Which parts of the task differ from the run's (its ``fitness_parts``), said; all three
+    possibilities for a run that recorded no parts."""
+    if parts:
+        differ = [k for k, v in loop.part_digests().items() if parts.get(k) != v]
+        if differ:
+            return "; ".join(DIFFERENCES[k] for k in differ)
+    return ("its source, the environment's attributes or the rollout's settings differ, or the run "
+            "began from Python with an environment made with other arguments")
 
 
 def check_own_task(config: EvolutionConfig, table: dict[str, Any]) -> None:
@@ -164,4 +187,4 @@ def check_own_task(config: EvolutionConfig, table: dict[str, Any]) -> None:
     champion (``assess``, ``plot``, ``analyze``) calls it first: an edited class would judge the
     champion in another task."""
     if is_closed_loop(config):
-        closed_loop(config, digest=table.get("fitness_sha256"))
+        closed_loop(config, digest=table.get("fitness_sha256"), parts=table.get("fitness_parts"))

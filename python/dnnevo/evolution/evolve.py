@@ -197,6 +197,7 @@ def evolve(
     ``config.toml``, e.g. where the founders came from.
     """
     _check_task(task)
+    named_task = isinstance(task, str)  # a task built from its name is built so again
     if isinstance(task, str) and task in presets.names() and named.is_python_task(presets.get(task).task):
         config = _task_config(task, config)  # a preset of a task written in Python
         task = config.task
@@ -225,6 +226,11 @@ def evolve(
     table = {**_run_table(seed), **(run_info or {})}
     if callable(task) and (digest := _fitness_digest(task)) is not None:
         table["fitness_sha256"] = digest
+    if isinstance(task, ClosedLoop):
+        table["fitness_parts"] = task.part_digests()
+        if not named_task and (why := _not_rebuilt(task, config)) is not None:
+            print(f"dnnevo: note: the command line will not judge, draw or resume {out} ({why}); "
+                  "do so from Python with this environment (docs/closed-loop.md)", file=sys.stderr)
     with run.writing(create=True):
         run.create(force=force)
         # The checkpoint first: from here on the folder can be resumed.
@@ -299,13 +305,20 @@ def resume(
                         f"{run.path} was evolved with {ga.config.task}, not "
                         f"{'an edited ' + name if edited and name == ga.config.task else name}; "
                         "pass new_fitness=True to continue it with another fitness function")
-                changes = [*table.get("fitness_changes", []),
-                           {"generation": ga.generation, "task": name}]
-                table = {**table, "fitness_changes": changes}
+                change: dict[str, Any] = {"generation": ga.generation, "task": name}
+                evolved_with = ga.config.task
+                if isinstance(task, ClosedLoop):
+                    # config.toml says what the task is from here on, so that a command can build
+                    # it again (its digest is the new one)
+                    ga.config = task.configured(ga.config)
+                    change["task_params"] = dict(ga.config.task_params)
+                table = {**table, "fitness_changes": [*table.get("fitness_changes", []), change]}
                 if digest is not None:
                     table["fitness_sha256"] = digest
+                if isinstance(task, ClosedLoop):
+                    table["fitness_parts"] = task.part_digests()
                 print(f"{run.path}: continuing at generation {ga.generation} with {name} "
-                      f"(the run was evolved with {ga.config.task}); recorded in config.toml",
+                      f"(the run was evolved with {evolved_with}); recorded in config.toml",
                       file=sys.stderr)
         elif named.is_closed_loop(ga.config):
             fitness = _named_fitness(run, ga.config, table)
@@ -325,11 +338,30 @@ def resume(
                      threads=threads, table=table)
 
 
+def _not_rebuilt(task: ClosedLoop, config: EvolutionConfig) -> str | None:
+    """Why a command that builds ``task`` from ``config`` (as ``dnnevo assess`` does) would not get
+    this very task, or None when it would (or when the class is a script's, which says so itself)."""
+    if task.__module__ == "__main__":
+        return None
+    try:
+        again = named.closed_loop(config)
+    except DnnevoError as e:
+        return str(e)
+    close = getattr(again.env, "close", None)
+    if callable(close):  # the copy holds what a simulator holds
+        close()
+    if again.digest() == task.digest():
+        return None
+    return (f"config.toml cannot record the arguments this {type(task.env).__name__} was made with: "
+            "keep each argument of __init__ as an attribute of the same name, holding a Python "
+            "number, string or boolean, or a list or dict of them")
+
+
 def _named_fitness(run: RunDir, config: EvolutionConfig, table: Mapping[str, Any]) -> FitnessFn:
     """The task class a run's config names, built from the config (importing its module), when
     its digest is the run's own."""
     try:
-        return named.closed_loop(config, digest=table.get("fitness_sha256"))
+        return named.closed_loop(config, digest=table.get("fitness_sha256"), parts=table.get("fitness_parts"))
     except ConfigError as e:
         raise ConfigError(f"{run.path}: {e}; resume it from Python with the environment it began "
                           "with, or with new_fitness=True") from None

@@ -11,8 +11,9 @@ pub enum Error {
     /// An integrator setting (dt, substeps, method) or an input array is unusable.
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
-    /// A network file is not a valid `dnnevo-network` document.
-    #[error("invalid network file: {0}")]
+    /// A network file is not a valid `dnnevo-network` document, or a checkpoint not a valid
+    /// state of an evolution (the message says which).
+    #[error("invalid file: {0}")]
     Format(String),
     /// An evolution setting is out of range.
     #[error("invalid config: {0}")]

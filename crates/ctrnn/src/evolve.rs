@@ -76,6 +76,21 @@ pub trait Task: Send + Sync {
     }
 }
 
+/// `validations` when each is one a checkpoint can hold (a rate in [0, 1], a finite score), else
+/// an error naming the first that is not: a task's validation is checked before the run keeps it.
+fn checked(validations: Vec<Validation>) -> Result<Vec<Validation>> {
+    match validations
+        .iter()
+        .find(|v| !(0.0..=1.0).contains(&v.rate) || !v.score.is_finite())
+    {
+        Some(bad) => Err(Error::Fitness(format!(
+            "a validation gave rate {} and score {}; a rate lies in [0, 1] and a score is finite",
+            bad.rate, bad.score
+        ))),
+        None => Ok(validations),
+    }
+}
+
 /// Summary statistics of one generation's fitness.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
@@ -94,8 +109,15 @@ pub struct Stats {
 }
 
 impl Stats {
-    /// Statistics of `fitness` (non-empty, finite).
+    /// Statistics of `fitness` (finite values).
+    ///
+    /// # Panics
+    /// If `fitness` is empty: a generation has at least one individual.
     pub fn of(generation: u64, fitness: &[f64]) -> Stats {
+        assert!(
+            !fitness.is_empty(),
+            "Stats::of needs at least one fitness value"
+        );
         let n = fitness.len() as f64;
         let mean = fitness.iter().sum::<f64>() / n;
         let var = fitness.iter().map(|f| (f - mean) * (f - mean)).sum::<f64>() / n;
@@ -285,20 +307,7 @@ impl Evolution {
     ) -> Result<Stats> {
         self.check(fitness)?;
         let nets = self.networks()?;
-        let validated = self.validate_with(&nets, fitness, |batch| {
-            let scores = validate(batch)?;
-            if let Some(bad) = scores
-                .iter()
-                .find(|v| !(0.0..=1.0).contains(&v.rate) || !v.score.is_finite())
-            {
-                return Err(Error::Fitness(format!(
-                    "a validation gave rate {} and score {}; a rate lies in [0, 1] and a score \
-                     is finite",
-                    bad.rate, bad.score
-                )));
-            }
-            Ok(Some(scores))
-        })?;
+        let validated = self.validate_with(&nets, fitness, |batch| validate(batch).map(Some))?;
         self.tell_validated(fitness, validated.as_deref())
     }
 
@@ -439,7 +448,7 @@ impl Evolution {
             Vec::new()
         } else {
             match scores(&batch)? {
-                Some(v) if v.len() == batch.len() => v,
+                Some(v) if v.len() == batch.len() => checked(v)?,
                 Some(v) => {
                     return Err(Error::Fitness(format!(
                         "the task validated {} networks; it was given {}",
@@ -522,7 +531,7 @@ impl Evolution {
         cancel: Option<&AtomicBool>,
     ) -> Result<Validation> {
         match task.validate_finer(std::slice::from_ref(net), self.seed, cancel)? {
-            Some(v) if v.len() == 1 => Ok(v[0]),
+            Some(v) if v.len() == 1 => Ok(checked(v)?[0]),
             Some(v) => Err(Error::Fitness(format!(
                 "the task validated {} networks at the finer step; it was given 1",
                 v.len()

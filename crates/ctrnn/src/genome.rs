@@ -181,7 +181,15 @@ impl Layout {
     }
 
     /// A readable name for gene `g`, such as `"gene 9 (neuron 1, weights[1][2])"`.
+    ///
+    /// # Panics
+    /// If `g` is not a gene of the layout (`g >= self.len()`).
     pub fn gene_name(&self, g: usize) -> String {
+        assert!(
+            g < self.len(),
+            "gene {g} of a layout of {} genes",
+            self.len()
+        );
         let per = self.genes_per_neuron();
         let (i, o) = (g / per, g % per);
         let what = match Gene::of(*self, o) {

@@ -313,11 +313,17 @@ pub(crate) fn strip(e: Error) -> String {
 
 /// Writes `file` to `path` atomically.
 pub fn save(path: &Path, file: &NetworkFile) -> Result<()> {
-    // A file that `load` would refuse is not written: meta's conventional keys are checked here.
+    // A file that `load` would refuse is not written: meta's conventional keys are named here,
+    // and anything else (a NaN dt, which JSON writes as null) by reading the text back.
     if let Some(problem) = meta_problem(&file.meta) {
         return Err(Error::InvalidArgument(problem));
     }
     let mut text = to_json(file);
+    if let Err(Error::Format(problem)) = from_json(&text) {
+        return Err(Error::InvalidArgument(format!(
+            "not written, since it would not load: {problem}"
+        )));
+    }
     text.push('\n');
     write_atomic(path, text.as_bytes())
 }
@@ -329,7 +335,7 @@ pub fn save(path: &Path, file: &NetworkFile) -> Result<()> {
 /// # Example
 /// ```
 /// let e = ctrnn::io::from_bytes(b"{\"format\": \"dnnevo-net\xffwork\"}").unwrap_err();
-/// assert_eq!(e.to_string(), "invalid network file: not UTF-8 text (byte 22)");
+/// assert_eq!(e.to_string(), "invalid file: not UTF-8 text (byte 22)");
 /// ```
 pub fn from_bytes(bytes: &[u8]) -> Result<NetworkFile> {
     let text = std::str::from_utf8(bytes)

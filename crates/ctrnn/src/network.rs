@@ -10,6 +10,11 @@
 //!
 //! Matrices are stored row-major: `weights[i * size + j]` is the weight from neuron j to neuron i,
 //! and `sensor_weights[i * n_inputs + k]` the weight from sensor k to neuron i.
+//!
+//! There is no gain: Beer's `tau_i dy_i/dt = -y_i + sum_j w_ji sigma(g_j (y_j + bias_j)) + I_i`
+//! is this model in `v_i = g_i y_i`, with `theta_i = -g_i bias_i`, `weights[i][j] = g_i w_ji`,
+//! sensor weights multiplied by `g_i` and the state `v = g y` (a gain of 0 has no such form);
+//! the firing rates are the same (`docs/network-format.md`).
 
 use crate::error::{check_finite, Error, Result};
 use crate::math::firing_rates;

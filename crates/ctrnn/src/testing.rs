@@ -5,7 +5,7 @@
 //! that `cargo test` builds anyway, instead of compiling the whole crate a second time as a
 //! unit-test harness.
 
-/// The lane vectors ([`crate::vector`]) and their register backends.
+/// The lane vectors (the crate's private `vector` module) and their register backends.
 pub mod vector {
     pub use crate::vector::{pow2, pow2_f32, Arith, Elem, Portable, Vector};
 

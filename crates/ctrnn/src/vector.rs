@@ -105,7 +105,7 @@ pub trait Elem:
 pub trait Vector: Arith {
     /// How a row is stored: its lanes' values in order (`f64`, `[f64; 8]`, or arrays of those).
     type Row: Copy;
-    /// Whether a [`Group`] of a few of these still fits in registers, so that running long
+    /// Whether a `Group` of a few of these still fits in registers, so that running long
     /// dependency chains side by side pays. True for AVX-512 (32 registers); not for AVX2 (16
     /// registers, and a block is already four of them); plain lanes are left to the compiler
     /// (grouping 16-lane portable rows four at a time made an AVX2 build 4x slower, and made

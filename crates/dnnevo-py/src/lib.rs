@@ -1,7 +1,7 @@
 //! The Python binding of dnnevo, built by maturin as `dnnevo._core`.
 //!
 //! This is the only crate that knows Python. It converts arguments, maps errors to the exception
-//! tree of `dnnevo.errors`, and runs long calls with the GIL released (see [`detach`]).
+//! tree of `dnnevo.errors`, and runs long calls with the GIL released (see `detach.rs`).
 
 mod analysis;
 mod arrays;

@@ -68,6 +68,9 @@ pub use scene::{Disc, Scene, SceneHit};
 pub use sectors::SectorSpec;
 pub use sim::{Sim, SimSpec, Trace};
 pub use sonar::{input, Echo, Sonar, SonarSpec, DEFAULT_D0};
+/// The random streams the simulator draws from ([`Stream`](streams::Stream)), so that a user of
+/// this crate needs no other dependency to make one.
+pub use streams;
 pub use wall_follow::{Phase, WallFollower, WallFollowerSpec, MAX_GAIN};
 pub use world::{Hit, Surface, World};
 pub use world_spec::{BoxSpec, StartRegion, WorldSpec, MAX_ROOM};

@@ -128,6 +128,14 @@ impl<'w> Sim<'w> {
             f64::INFINITY,
             false,
         )?;
+        let [w, h] = world.room();
+        if !(start.x > 0.0 && start.x < w && start.y > 0.0 && start.y < h) {
+            return Err(Error::invalid(
+                "start",
+                format!("({}, {})", start.x, start.y),
+                &format!("a position inside the room, (0, {w}) x (0, {h})"),
+            ));
+        }
         let c = world.clearance(start.position(), spec.robot.radius);
         if c < 0.0 {
             return Err(Error::invalid(

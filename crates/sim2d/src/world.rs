@@ -157,11 +157,13 @@ impl World {
     /// The nearest hit of the ray from `origin` along `dir` within `max_distance`, over all walls
     /// and boxes; `None` if nothing is that close.
     ///
-    /// `dir` need not be a unit vector; a zero or non-finite `dir` hits nothing. An origin inside
-    /// a wall or box hits it at distance 0. Allocates nothing.
+    /// `dir` need not be a unit vector; a zero or non-finite `dir`, or an origin that is not
+    /// finite in f32 (the geometry's precision), hits nothing. An origin inside a wall or box hits
+    /// it at distance 0. Allocates nothing.
     pub fn cast_ray(&self, origin: [f64; 2], dir: [f64; 2], max_distance: f64) -> Option<Hit> {
         let norm = dir[0].hypot(dir[1]);
-        if !(norm > 0.0 && norm.is_finite() && max_distance >= 0.0) {
+        let finite = origin.iter().all(|&v| (v as Real).is_finite());
+        if !(finite && norm > 0.0 && norm.is_finite() && max_distance >= 0.0) {
             return None;
         }
         let ray = Ray::new(

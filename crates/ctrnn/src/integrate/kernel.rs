@@ -195,8 +195,8 @@ const RATE_GROUP: usize = 4;
 const WEIGHT_GROUP: usize = 4;
 const PREFETCH_COLUMNS: usize = 4;
 
-/// The order in which [`drive`] reads the row-major `N x N` weights, as one stream: each group
-/// of [`WEIGHT_GROUP`] rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the
+/// The order in which `drive` reads the row-major `N x N` weights, as one stream: each group
+/// of `WEIGHT_GROUP` (4) rows column by column (`w[i][0], w[i+1][0], ..., w[i][1], ...`), then the
 /// rows left over, row by row. Row `i`'s weights start at `i * N` either way.
 pub fn weight_order(n: usize) -> impl Iterator<Item = usize> {
     let full = n - n % WEIGHT_GROUP;

@@ -3,10 +3,11 @@
 //! The kernel works on [`Lanes`]: `L` networks of the same shape, stored parameter by parameter
 //! with the networks side by side (`theta[i][lane]`), so that one step is straight-line
 //! arithmetic over rows of `L` values, one per network. A single network is `Lanes<1>` and a
-//! population block is `Lanes<LANES>`. The kernel is written once over the crate's lane vectors:
-//! where the build's target CPU has AVX-512F a block keeps each row in 512-bit registers (8 lanes
-//! each), elsewhere it runs lane by lane. Every path performs the same operations in the same
-//! order, which is why single networks and populations agree bit for bit.
+//! population block is `Lanes<LANES>`. The kernel is written once over the crate's lane vectors,
+//! and `simd.rs` chooses at run time, from the CPU the process runs on, whether a block keeps
+//! each row in AVX-512 registers, in AVX2 registers, or runs lane by lane. Every path performs
+//! the same operations in the same order, which is why single networks and populations agree bit
+//! for bit.
 //!
 //! One Euler step of size `dt`, with `h = dt / tau`:
 //! `v += h * (-v + W f(v - theta) + S I)`. Each row of inputs is held for `substeps` steps.

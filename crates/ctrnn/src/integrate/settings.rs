@@ -53,6 +53,15 @@ pub(crate) fn short(x: f64) -> String {
     rounded(x, f64::round)
 }
 
+/// A number for a message, exact (the shortest text that reads back as `x`), in exponent form
+/// when very large or small: `1e-300`, not three hundred digits.
+pub(crate) fn exact(x: f64) -> String {
+    if x != 0.0 && (x.abs() >= 1e16 || x.abs() < 1e-5) {
+        return format!("{x:e}");
+    }
+    format!("{x}")
+}
+
 /// [`short`] rounded down, for a bound that `x` must stay below: the bound it prints is one.
 fn short_below(x: f64) -> String {
     rounded(x, f64::floor)
@@ -175,8 +184,8 @@ impl Integrator {
             "dt / tau is {} for {what} = {} (dt {}); from {} on, {} steps make a neuron's own decay \
              grow without bound: use dt < {}{other}",
             short(h),
-            tau,
-            self.dt,
+            exact(tau),
+            exact(self.dt),
             short(limit),
             match self.method {
                 Method::Euler => "Euler",

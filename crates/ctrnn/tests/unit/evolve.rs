@@ -255,6 +255,52 @@ fn copies_among_the_candidates_are_validated_once() {
     assert_eq!(champion.validation.unwrap().rate, rate(&one));
 }
 
+/// Excite, validated with one fixed (rate, score), whatever it is.
+struct Validated(f64, f64);
+impl Task for Validated {
+    fn layout(&self) -> Layout {
+        Excite.layout()
+    }
+    fn evaluate(
+        &self,
+        networks: &[Network],
+        generation: u64,
+        seed: u64,
+        cancel: Option<&AtomicBool>,
+    ) -> Result<Vec<f64>> {
+        Excite.evaluate(networks, generation, seed, cancel)
+    }
+    fn validate(
+        &self,
+        networks: &[Network],
+        _seed: u64,
+        _cancel: Option<&AtomicBool>,
+    ) -> Result<Option<Vec<Validation>>> {
+        let v = Validation {
+            rate: self.0,
+            score: self.1,
+        };
+        Ok(Some(vec![v; networks.len()]))
+    }
+}
+
+#[test]
+fn a_task_s_own_validation_is_checked_before_the_run_keeps_it() {
+    // Kept, it would make a checkpoint that from_json refuses (NaN is written as null).
+    for (rate, score) in [(1.5, 0.0), (f64::NAN, 0.0), (0.5, f64::INFINITY)] {
+        let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
+        let e = evo
+            .step(&Validated(rate, score), None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a validation gave rate"), "{e}");
+        assert!(Evolution::from_json(&evo.to_json()).is_ok());
+    }
+    let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
+    evo.step(&Validated(0.5, -3.0), None).unwrap();
+    assert!(Evolution::from_json(&evo.to_json()).is_ok());
+}
+
 #[test]
 fn a_validation_told_from_outside_is_checked() {
     let mut evo = Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();

@@ -190,4 +190,21 @@ fn nan_and_infinity_are_named_and_meta_s_conventional_keys_are_checked() {
         other => panic!("{other:?}"),
     }
     assert!(!path.exists());
+    // The whole class: any integrator block load refuses (NaN dt is written as null).
+    for (dt, substeps) in [(f64::NAN, 1), (0.0, 1), (0.1, 0)] {
+        let mut file = from_json(minimal).unwrap();
+        file.integrator = Some(Integrator {
+            method: Method::Euler,
+            dt,
+            substeps,
+        });
+        match save(&path, &file) {
+            Err(Error::InvalidArgument(m)) => assert!(
+                m.starts_with("not written, since it would not load: integrator"),
+                "{m}"
+            ),
+            other => panic!("{dt} {substeps}: {other:?}"),
+        }
+        assert!(!path.exists());
+    }
 }

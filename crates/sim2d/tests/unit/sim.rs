@@ -118,6 +118,15 @@ fn bad_use_is_an_error() {
             .starts_with("start is (3, 2.5) with clearance"),
         "{e}"
     );
+    let [w, h] = world.room();
+    for (x, y) in [(w + 1.0, 1.0), (1.0, -2.0), (-1.0, h + 1.0)] {
+        let e = Sim::new(&world, &spec, Pose::new(x, y, 0.0)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("; it must be a position inside the room"),
+            "{e}"
+        );
+    }
     let mut sim = Sim::new(&world, &spec, Pose::new(1.0, 1.0, 0.0)).unwrap();
     let mut s = Stream::new(0, 0, Purpose::Trial, 0, 0);
     let e = sim.step(&mut s, &mut []).unwrap_err();

@@ -97,6 +97,15 @@ fn walls_bound_the_room_and_rays_from_inside_a_box_stop_at_once() {
 }
 
 #[test]
+fn a_ray_from_a_non_finite_origin_hits_nothing_and_panics_not() {
+    let w = world(vec![square([5.0, 4.0], 1.0, 30.0)]);
+    for origin in [[f64::NAN, 1.0], [1.0, f64::INFINITY], [1e300, 1.0]] {
+        assert!(w.cast_ray(origin, [1.0, 0.0], 10.0).is_none(), "{origin:?}");
+    }
+    assert!(w.cast_ray([1.0, 4.0], [1.0, 0.0], 10.0).is_some());
+}
+
+#[test]
 fn clearance_is_signed() {
     let w = world(vec![square([5.0, 4.0], 1.0, 0.0)]);
     assert!(close(w.clearance([1.0, 4.0], 0.25), 0.75)); // left wall

@@ -42,7 +42,7 @@ use sim2d::{BoxSpec, WorldSpec};
 /// How the training trials vary (all ranges default to 0: no variation, the paper's training).
 ///
 /// Each trial draws its own values, each uniform over its range. The test trials
-/// ([`LandmarkTask::assess`]) never vary.
+/// ([`LandmarkTask::assess`](crate::landmark::LandmarkTask::assess)) never vary.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Training {

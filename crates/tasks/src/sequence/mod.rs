@@ -48,7 +48,7 @@
 //!
 //! # Success rule
 //! A network has learnt a target when, over fresh random timings (drawn with
-//! [`Purpose::Evaluate`], see [`SequenceTask::assessment_timings`]), in at least 90 %
+//! [`Purpose::Evaluate`](ctrnn::Purpose::Evaluate), see [`SequenceTask::assessment_timings`]), in at least 90 %
 //! ([`SUCCESS_FRACTION`]) of its trials every trigger from index `warmup = 2 * len(target)` on is
 //! correct. A trigger is correct when the mean output over its window is on the target bit's side
 //! of 0.5 (above 0.5 for a 1, below for a 0). It has learnt B when it has learnt every target

@@ -877,3 +877,43 @@ def test_half_a_success_rule_is_refused_when_the_task_is_made(env, message: str)
     with pytest.raises(dnnevo.ConfigError, match=re.escape(message)):
         ClosedLoop(env, max_steps=5)
     ClosedLoop(_RuleTurnedOff(), max_steps=5)  # success_rate = None: no rule, said so
+
+
+THREADS_SCRIPT = '''
+import sys
+import numpy as np
+import dnnevo
+from dnnevo import _core
+from dnnevo.closedloop import ClosedLoop
+
+class Still:
+    observation_size = 1
+    def reset(self, episodes, rng):
+        return np.zeros((len(episodes), 1))
+    def step(self, rates, active):
+        return np.zeros((len(rates), 1)), rates[:, 0].copy(), np.zeros(len(rates), bool)
+
+config = dnnevo.EvolutionConfig(population=20, generations=2, size=2, n_inputs=1, selection="rank")
+for threads in (-1, 0):
+    try:
+        dnnevo.evolve(ClosedLoop(Still(), max_steps=5), config, progress=False, threads=threads)
+    except dnnevo.InvalidArgumentError as e:
+        print("refused:", e)
+dnnevo.evolve(ClosedLoop(Still(), max_steps=5), config, progress=False, threads=1)
+print("pool:", _core.process_threads())
+dnnevo.evolve(ClosedLoop(Still(), max_steps=5), config, progress=False, threads=2)
+'''
+
+
+def test_threads_reach_a_python_task_through_the_process_pool() -> None:
+    """A Python task steps its networks on the process's shared pool: evolve(threads=n) sizes it
+    when it has not started, says so when it cannot, and refuses a count below 1 as a built-in
+    task does."""
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-c", THREADS_SCRIPT], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.count("refused: threads is") == 2 and "pool: 1\n" in r.stdout, r.stdout
+    assert "threads=2 does not reach this Python task: the process's thread pool started earlier, with 1" \
+        in r.stderr, r.stderr

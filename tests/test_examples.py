@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -314,3 +316,17 @@ def test_predator_avoidance_ablation_judges_saved_champions(tmp_path: Path, caps
     with pytest.raises(SystemExit):
         predator_avoidance.main(["--ablation", str(nets), "--seeds", "1", "--figure", str(tmp_path / "x.png")])
     assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.skipif(shutil.which("cargo") is None or not (ROOT / "crates").is_dir(),
+                    reason="the Rust example needs cargo and the source tree")
+def test_the_rust_example_evolves_saves_loads_and_analyses_its_own_task() -> None:
+    """crates/ctrnn/examples/own_task.rs, which docs/rust.md shows, runs: its own Task evolves
+    (a fixed seed, so the figures are fixed), the champion goes through a file and back, and
+    its equilibria are found."""
+    r = subprocess.run(["cargo", "run", "-q", "-p", "ctrnn", "--example", "own_task"], cwd=ROOT,
+                       capture_output=True, text=True, timeout=1800)
+    assert r.returncode == 0, r.stderr
+    best = [float(b) for b in re.findall(r"best ([0-9.]+)", r.stdout)]
+    assert len(best) == 4 and best[-1] > 5 * best[0], r.stdout
+    assert "champion swing from rest" in r.stdout and "equilibrium at rates" in r.stdout, r.stdout

@@ -45,6 +45,7 @@ __all__ = [
     "analysis_cycles",
     "analysis_equilibria",
     "condition_seed",
+    "process_threads",
     "compose",
     "decode",
     "encode",
@@ -261,6 +262,11 @@ class Batch:
 def condition_seed(seed: int, generation: int, purpose: Literal["trial", "validate", "evaluate"] = "trial") -> int:
     """The first word of dnnevo's random stream (seed, generation, purpose): the seed of a
     Python task's conditions."""
+
+def process_threads(threads: int | None = None) -> int:
+    """The number of threads of the process's shared pool (Batch, robot fleets, calls without
+    ``threads``); with ``threads``, sized to that many first, which takes only before its first
+    use."""
 
 # -- a run's settings and the GA ------------------------------------------------------------
 

@@ -274,22 +274,29 @@ impl Batch {
     /// [`Batch::pack`] in element type `E`.
     fn pack_as<E: Elem>(&self, order: &[usize], states: Option<&[f64]>) -> Result<Blocks<E>> {
         let (n, m) = (self.size, self.n_inputs);
-        let blocks = order
-            .par_chunks(LANES)
-            .map(|rows| {
-                let refs: Vec<&Network> = rows
-                    .iter()
-                    .map(|&r| &self.networks[self.network_of[r]])
-                    .collect();
-                let mut block = Lanes::new(&refs)?;
-                if let Some(states) = states {
-                    for (l, &r) in rows.iter().enumerate() {
-                        set_lane_state(&mut block, l, &states[r * n..(r + 1) * n]);
-                    }
+        let pack = |rows: &[usize]| {
+            let refs: Vec<&Network> = rows
+                .iter()
+                .map(|&r| &self.networks[self.network_of[r]])
+                .collect();
+            let mut block = Lanes::new(&refs)?;
+            if let Some(states) = states {
+                for (l, &r) in rows.iter().enumerate() {
+                    set_lane_state(&mut block, l, &states[r * n..(r + 1) * n]);
                 }
-                Ok(block)
-            })
-            .collect::<Result<Vec<_>>>()?;
+            }
+            Ok(block)
+        };
+        // One block is packed here: a batch that never steps in parallel (a probe, one network)
+        // leaves rayon's pool unstarted, so that a caller can still choose its size.
+        let blocks = if order.len() <= LANES {
+            order.chunks(LANES).map(pack).collect::<Result<Vec<_>>>()?
+        } else {
+            order
+                .par_chunks(LANES)
+                .map(pack)
+                .collect::<Result<Vec<_>>>()?
+        };
         let slot = Slot {
             inputs: vec![[E::default(); LANES]; m],
             kept: vec![E::default(); LANES * n],

@@ -1,5 +1,6 @@
 //! The generation loop's state: a population, its generation counter and its champion, with
-//! ask/tell, a [`Task`] trait for built-in fitness functions, and checkpoints.
+//! ask/tell, a [`Task`] trait for fitness functions written in Rust (the built-in tasks, or your
+//! own: `crates/ctrnn/examples/own_task.rs`), and checkpoints.
 //!
 //! One generation is: decode the genomes, score them all with a task (or with fitness told from
 //! outside), re-score the best candidates on the task's validation set
@@ -25,8 +26,9 @@ use crate::validation::{candidates, Validation, STEP_CHECK_FINER};
 /// population integrator.
 ///
 /// `evaluate` must be a pure function of `(self, networks, generation, seed)`: that is what makes
-/// runs reproducible, resumable, and shardable across machines. By default every individual of a
-/// generation meets the same trial conditions (common random numbers), drawn from
+/// runs reproducible, resumable, and shardable across machines. The task draws its own trial
+/// conditions; the convention of the built-in tasks is that every individual of a generation
+/// meets the same ones (common random numbers), drawn from
 /// `Stream::new(seed, generation, Purpose::Trial, 0, trial)`.
 pub trait Task: Send + Sync {
     /// The network shape the task drives.

@@ -113,6 +113,25 @@ fn pool(threads: Option<usize>) -> PyResult<Option<Arc<rayon::ThreadPool>>> {
     Ok(Some(p))
 }
 
+/// The number of threads of the process's shared rayon pool, which `Batch`, robot fleets and
+/// every call without `threads` use. With `threads`, the pool is first sized to that many, which
+/// takes only before its first use: after, it keeps its size, and the result says so.
+#[pyfunction]
+#[pyo3(signature = (threads=None), text_signature = "(threads=None)")]
+pub fn process_threads(threads: Option<&Bound<'_, PyAny>>) -> PyResult<usize> {
+    if let Some(t) = threads.filter(|t| !t.is_none()) {
+        let n: usize = uint(t, "threads", "[1, 2**64)")?;
+        if n == 0 {
+            return Err(arg_err("threads is 0; it must be >= 1".into()));
+        }
+        // An error here only means the pool is running already; the count below tells.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
+    }
+    Ok(rayon::current_num_threads())
+}
+
 /// Runs `f` on the pool for `threads`, or directly.
 fn on_pool<T: Send>(threads: Option<&Arc<rayon::ThreadPool>>, f: impl FnOnce() -> T + Send) -> T {
     match threads {

@@ -45,6 +45,8 @@ mod _core {
         PyBifurcation, PyCycle, PyCycleBranch, PyCycleEnd, PyEquilibrium, PyEvent,
     };
     #[pymodule_export]
+    use super::evolution::process_threads;
+    #[pymodule_export]
     use super::evolution::{decode, encode, evaluate, task_names, PyEvolution};
     #[pymodule_export]
     use super::landmark::{

@@ -218,6 +218,7 @@ def evolve(
         config = _task_config(task, config)
         _check_layout(config)
         task = config.task  # a preset name stands for its config's task
+    _share_threads(task, threads)
     ga = GeneticAlgorithm(config, seed=seed, founders=founders_argument(founders, seeds))
     if out is None:
         return _loop(ga, task, [], None, progress=progress, callback=callback, threads=threads)
@@ -328,6 +329,7 @@ def resume(
                 "from Python: dnnevo.resume(dir, task=fitness)")
         # Every file rewritten from the state about to continue, so they agree from here on;
         # one that was damaged or gone is said, as it is repaired.
+        _share_threads(fitness, threads)
         for note in _repairs(run, ga):
             print(f"{run.path}: {note}; written again from checkpoint.json", file=sys.stderr)
         run.write_checkpoint(ga.state_dict(), history, table, ga.seed)
@@ -336,6 +338,20 @@ def resume(
         _write_best(run, ga)
         return _loop(ga, fitness, history, run, progress=progress, callback=callback,
                      threads=threads, table=table)
+
+
+def _share_threads(task: str | FitnessFn, threads: int | None) -> None:
+    """``threads`` for a task written in Python, which steps its networks (``Batch``, robot
+    fleets) on the process's shared thread pool: the pool is sized to it, which takes only before
+    its first use; said on stderr when it is running with another size already. (A built-in task
+    runs on a pool of its own of that size.)"""
+    if threads is None or not callable(task):
+        return
+    running = _core.process_threads(threads)
+    if running != threads:
+        print(f"dnnevo: note: threads={threads} does not reach this Python task: the process's "
+              f"thread pool started earlier, with {running} (set RAYON_NUM_THREADS={threads} "
+              "before the process starts)", file=sys.stderr)
 
 
 def _not_rebuilt(task: ClosedLoop, config: EvolutionConfig) -> str | None:

@@ -79,6 +79,12 @@ macro_rules! with_backend {
 /// `L` networks of the same shape, laid out for stepping together, computing in `E`: `f64`
 /// (the default and the reference), or `f32`, single precision, where the parameters are rounded
 /// to `f32` once, when packed, and every state, rate and step is `f32`.
+///
+/// This is the kernel's own type, and its stepping methods trust their caller for speed: the
+/// inputs must have one row per sensor, the integrator must be valid ([`Integrator::validate`])
+/// and a lane index below `L`; a wrong call may panic or give wrong states, and the states are
+/// checked only by [`Lanes::check_finite`]. [`Network::run`](crate::Network::run),
+/// [`Population`](crate::Population) and [`Batch`](crate::Batch) check everything first.
 #[derive(Clone, Debug)]
 pub struct Lanes<const L: usize, E: Elem = f64> {
     size: usize,

@@ -316,3 +316,42 @@ def test_evaluate_scores_a_python_task_preset_as_its_run_does(tmp_path: Path) ->
         dnnevo.evaluate("legged-walker", genomes[0], generation=0, seed=11)
     with pytest.raises(dnnevo.errors.InvalidArgumentError, match="genomes must be"):
         dnnevo.evaluate("legged-walker", [networks[0], genomes[1]], generation=0, seed=11)
+
+
+def test_a_failing_task_keeps_what_it_finished_and_a_kill_s_rerun_is_said(tmp_path: Path, monkeypatch,
+                                                                          capsys) -> None:
+    import shutil
+
+    from dnnevo.evolution import evolve as engine
+
+    # Checkpoints only at the start and the end, the log at every generation: a kill in between
+    # leaves log.csv ahead of checkpoint.json.
+    monkeypatch.setattr(engine, "CHECKPOINT_SECONDS", 1e9)
+    monkeypatch.setattr(engine, "LOG_SECONDS", 0.0)
+    calls = []
+
+    def fails_at_4(networks):
+        calls.append(1)
+        if len(calls) == 3:  # generations 0-1 logged, the checkpoint still at 0: a kill here
+            shutil.copytree(tmp_path / "run", tmp_path / "killed")
+        if len(calls) == 5:
+            raise RuntimeError("the simulator crashed")
+        return follow_square(networks)
+
+    with pytest.raises(RuntimeError, match="the simulator crashed"):
+        dnnevo.evolve(fails_at_4, SMALL, seed=7, out=tmp_path / "run", progress=False)
+    # The four finished generations are kept: checkpoint, log and best agree, and resume
+    # continues from the fifth.
+    evolution = json.loads(json.loads((tmp_path / "run" / "checkpoint.json").read_text())["state"]["evolution"])
+    assert evolution["generation"] == 4
+    from dnnevo.runs import RunDir
+    assert RunDir(tmp_path / "run").logged_generations() == 4
+    full = dnnevo.evolve(follow_square, SMALL, seed=7, out=tmp_path / "full", progress=False)
+    resumed = dnnevo.resume(tmp_path / "run", follow_square, progress=False, new_fitness=True)
+    np.testing.assert_array_equal(full.history["best"], resumed.history["best"])
+    capsys.readouterr()
+    # The killed copy: its log is two generations ahead of its checkpoint, and resume says so.
+    resumed = dnnevo.resume(tmp_path / "killed", follow_square, progress=False, new_fitness=True)
+    assert "continuing from its checkpoint at generation 0; the 2 generations log.csv has after " \
+           "it run again, to the same results" in capsys.readouterr().err
+    np.testing.assert_array_equal(full.history["best"], resumed.history["best"])

@@ -337,6 +337,16 @@ DEPRECATED = {"evaluate": "assess"}
 """Old command names that still work, each with a line on stderr naming the new one."""
 
 
+def one_line(message: str) -> str:
+    r"""``message`` with every character that is not printable (a line break or a control
+    character quoted from a damaged file) escaped, so that an error stays on one line.
+
+    >>> one_line("has columns \x0b; expected generation")
+    'has columns \\x0b; expected generation'
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Runs the command line; returns the exit status."""
     if sys.excepthook is _startup.interrupted_import:
@@ -366,7 +376,7 @@ def main(argv: list[str] | None = None) -> int:
     except (DnnevoError, OSError) as e:
         if args.debug:  # the traceback too, and the same exit status: 1 is assess's "fail"
             traceback.print_exc()
-        sys.stderr.write(f"dnnevo: error: {e}\n")
+        sys.stderr.write(f"dnnevo: error: {one_line(str(e))}\n")
         return 2
     except KeyboardInterrupt as e:
         # evolve's message says where a stopped run's checkpoint is, when it has one.

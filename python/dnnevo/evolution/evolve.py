@@ -330,6 +330,11 @@ def resume(
         # Every file rewritten from the state about to continue, so they agree from here on;
         # one that was damaged or gone is said, as it is repaired.
         _share_threads(fitness, threads)
+        ahead = run.logged_generations() - len(history)
+        if ahead > 0:  # a kill between two checkpoints: said, since the bar starts further back
+            print(f"{run.path}: continuing from its checkpoint at generation {len(history)}; the "
+                  f"{ahead} generation{'s' * (ahead != 1)} log.csv has after it run again, to the same "
+                  "results", file=sys.stderr)
         for note in _repairs(run, ga):
             print(f"{run.path}: {note}; written again from checkpoint.json", file=sys.stderr)
         run.write_checkpoint(ga.state_dict(), history, table, ga.seed)
@@ -687,6 +692,13 @@ def _loop(
                 run.write_log(history[:checkpointed])
         if run is None:
             raise
+    except Exception as e:
+        # The task (or a callback) failed: the folder keeps every generation finished before,
+        # when the history still matches the population, so that show and resume start there.
+        # (Not after a failed write, which would fail again.)
+        if run is not None and len(history) == ga.generation and not isinstance(e, OSError):
+            save_state()
+        raise
     finally:
         if bar is not None:
             bar.close()

@@ -868,6 +868,15 @@ class _RuleTurnedOff(_RuleWithoutRate):
     success_rate = None
 
 
+class _RateStatistic(_Halfway):
+    success_rate = 0.0  # a statistic the environment keeps, not a rule's rate
+
+
+class _FlagsArray(_Halfway):
+    def __init__(self):
+        self.success = np.zeros(3, bool)  # flags, not a rule's method
+
+
 @pytest.mark.parametrize("env, message", [
     (_RuleWithoutRate(), "_RuleWithoutRate has a success method but no success_rate"),
     (_RateWithoutRule(), "_RateWithoutRule has a success_rate but no method success(returns, lengths)"),
@@ -876,7 +885,8 @@ class _RuleTurnedOff(_RuleWithoutRate):
 def test_half_a_success_rule_is_refused_when_the_task_is_made(env, message: str) -> None:
     with pytest.raises(dnnevo.ConfigError, match=re.escape(message)):
         ClosedLoop(env, max_steps=5)
-    ClosedLoop(_RuleTurnedOff(), max_steps=5)  # success_rate = None: no rule, said so
+    for env in (_RuleTurnedOff(), _RateStatistic(), _FlagsArray()):  # no rule, as they always were
+        ClosedLoop(env, max_steps=5)
 
 
 THREADS_SCRIPT = '''
@@ -899,7 +909,7 @@ for threads in (-1, 0):
         dnnevo.evolve(ClosedLoop(Still(), max_steps=5), config, progress=False, threads=threads)
     except dnnevo.InvalidArgumentError as e:
         print("refused:", e)
-dnnevo.evolve(ClosedLoop(Still(), max_steps=5), config, progress=False, threads=1)
+dnnevo.evolve(ClosedLoop(Still(), max_steps=5), config, progress=False, threads=5)
 print("pool:", _core.process_threads())
 dnnevo.evolve(ClosedLoop(Still(), max_steps=5), config, progress=False, threads=2)
 '''
@@ -914,6 +924,7 @@ def test_threads_reach_a_python_task_through_the_process_pool() -> None:
 
     r = subprocess.run([sys.executable, "-c", THREADS_SCRIPT], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
-    assert r.stdout.count("refused: threads is") == 2 and "pool: 1\n" in r.stdout, r.stdout
-    assert "threads=2 does not reach this Python task: the process's thread pool started earlier, with 1" \
+    # 5, not a usual core count, so that the pool's default would not pass
+    assert r.stdout.count("refused: threads is") == 2 and "pool: 5\n" in r.stdout, r.stdout
+    assert "threads=2 does not reach this Python task: the process's thread pool started earlier, with 5" \
         in r.stderr, r.stderr

@@ -353,5 +353,5 @@ def test_a_failing_task_keeps_what_it_finished_and_a_kill_s_rerun_is_said(tmp_pa
     # The killed copy: its log is two generations ahead of its checkpoint, and resume says so.
     resumed = dnnevo.resume(tmp_path / "killed", follow_square, progress=False, new_fitness=True)
     assert "continuing from its checkpoint at generation 0; the 2 generations log.csv has after " \
-           "it run again, to the same results" in capsys.readouterr().err
+           "it run again" in capsys.readouterr().err
     np.testing.assert_array_equal(full.history["best"], resumed.history["best"])

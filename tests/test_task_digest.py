@@ -391,3 +391,19 @@ def test_an_environment_that_holds_itself_is_wrapped() -> None:
     env.graph = {"leaf": 1}
     env.graph["parent"] = env.graph
     assert len(ClosedLoop(env, max_steps=10).digests()) == 3
+
+
+def test_runs_begun_with_numpy_settings_keep_the_digest_they_recorded() -> None:
+    """A NumPy dt is now recorded as the Python number it holds; a run begun with one before
+    recorded it by its NumPy form, and is still accepted."""
+    from dnnevo.closedloop.far_seeker import FarSeeker
+    from dnnevo.closedloop.source import fingerprint
+
+    loop = ClosedLoop(FarSeeker(), max_steps=10, dt=np.float64(0.05))
+    assert loop.settings["dt"] == 0.05 and type(loop.settings["dt"]) is float
+    head, _, settings = loop.fitness_source.rpartition("\n")
+    before = head + "\n" + settings.replace(fingerprint(0.05), fingerprint(np.float64(0.05)))
+    assert before != loop.fitness_source
+    assert hashlib.sha256(before.encode()).hexdigest() in loop.digests()
+    plain = ClosedLoop(FarSeeker(), max_steps=10, dt=0.05)
+    assert plain.digest() == loop.digest() and len(plain.digests()) < len(loop.digests())

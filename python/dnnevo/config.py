@@ -292,7 +292,7 @@ def _plain(value: Any, where: str) -> Any:
     """``value`` as a config file holds it: NumPy numbers as the Python numbers they hold, tuples
     as lists, tables as dicts; anything a TOML file cannot hold (None, an array, an object) is a
     :class:`ConfigError` naming where it is."""
-    if isinstance(value, np.generic) and not isinstance(value, np.str_ | np.bytes_ | np.void):
+    if isinstance(value, np.generic) and not isinstance(value, np.bytes_ | np.void):
         value = value.item()
     if isinstance(value, bool | int | float | str):
         return value

@@ -124,9 +124,13 @@ class ClosedLoop:
         _core.Batch([_core.Network(tau=[max(1.0, slow)], theta=[0.0], weights=[[0.0]], sensor_weights=[[]])],
                     replicas=1, **integration)
         self.env = env
-        # Half a rule, or a rate out of range, is refused; success_rate = None says there is none.
+        # Half a rule is refused: a success method without any success_rate, or a rate that can
+        # only be a rule's (in (0, 1]) without a method; a rule's rate out of range too. Other
+        # attributes of those names (a statistic, an array) are no rule, as they always were.
         rule, rate = getattr(env, "success", None), getattr(env, "success_rate", None)
-        if rate is not None or (rule is not None and not hasattr(env, "success_rate")):
+        a_rate = isinstance(rate, float | int) and not isinstance(rate, bool) and 0 < rate <= 1
+        if callable(rule) and (rate is not None or not hasattr(env, "success_rate")) \
+                or rule is None and a_rate:
             success_rule(env, type(env).__name__)
         if precision not in ("f64", "f32"):
             raise ConfigError(f"precision is {precision!r}; expected 'f64' or 'f32'")
@@ -162,6 +166,11 @@ class ClosedLoop:
         legacy = [legacy_fingerprint(attributes), legacy_fingerprint(recorded)]
         self._legacy_sources = ["\n".join([text or kind.__qualname__, *legacy])
                                 for text in (plain_source(kind), plain_source(kind, ignored=True))]
+        if any(isinstance(v, np.generic) for v in given.values()):
+            # NumPy settings, as runs recorded them before they were made Python numbers
+            as_given = {**recorded, **{k: given[k] for k in recorded if k in given}}
+            self._legacy_sources.append("\n".join([self._parts["source"], self._parts["attributes"],
+                                                   fingerprint(as_given)]))
 
     def _recorded(self) -> dict[str, Any]:
         """The settings a run records: the rollout's (its precision only when ``"f32"``), the

@@ -142,6 +142,21 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None,
         raise ConfigError(f"{cls.__name__}(**task_params) failed: {e}") from None
     except Exception as e:
         raise TaskError(f"{cls.__name__}(**task_params) raised {type(e).__name__}: {e}") from e
+    try:
+        return _checked_loop(config, cls, env, settings, digest, parts)
+    except BaseException:
+        close = getattr(env, "close", None)
+        if callable(close):  # a simulator the refused task had started
+            try:
+                close()
+            except Exception:  # noqa: BLE001 - the refusal is the news, not the copy's trouble
+                pass
+        raise
+
+
+def _checked_loop(config: EvolutionConfig, cls: type, env: Any, settings: dict[str, Any],
+                  digest: str | None, parts: Mapping[str, str] | None) -> ClosedLoop:
+    """:func:`closed_loop`'s checks of the environment it made, and the task around it."""
     size = env.observation_size
     if _whole_size(size) is None:
         raise ConfigError(f"{cls.__name__}.observation_size is {size!r}; expected the number of "
@@ -163,8 +178,8 @@ DIFFERENCES = {
               "a success rule added or changed counts: it is part of the task",
     "attributes": "the environment's attributes differ: task_params, or the run began from Python "
                   "with an environment made with arguments config.toml could not record",
-    "settings": "the rollout's settings differ: episodes, max_steps, validation_episodes or the "
-                "integrator",
+    "settings": "the rollout's settings differ: episodes, max_steps, validation_episodes, rows, "
+                "precision or the integrator",
 }
 """What each part of a task's digest (:meth:`ClosedLoop.part_digests`) differing means."""
 
@@ -172,7 +187,7 @@ DIFFERENCES = {
 def _what_differs(loop: ClosedLoop, parts: Mapping[str, str] | None) -> str:
     """Which parts of the task differ from the run's (its ``fitness_parts``), said; all three
     possibilities for a run that recorded no parts."""
-    if parts:
+    if isinstance(parts, Mapping):  # a damaged [run] table says nothing more
         differ = [k for k, v in loop.part_digests().items() if parts.get(k) != v]
         if differ:
             return "; ".join(DIFFERENCES[k] for k in differ)

@@ -282,6 +282,8 @@ def resume(
         elif ga.generation > ga.config.generations:
             raise RunFileError(f"{run.checkpoint}: generation {ga.generation} is beyond the run's "
                                f"{ga.config.generations} generations")
+        # What is damaged, judged by the run's own settings, before a new task may change them.
+        repairs = _repairs(run, ga)
         fitness: str | FitnessFn = ga.config.task
         if isinstance(task, str) and named.is_python_task(task):
             if task != ga.config.task:
@@ -318,6 +320,8 @@ def resume(
                     table["fitness_sha256"] = digest
                 if isinstance(task, ClosedLoop):
                     table["fitness_parts"] = task.part_digests()
+                else:
+                    table.pop("fitness_parts", None)
                 print(f"{run.path}: continuing at generation {ga.generation} with {name} "
                       f"(the run was evolved with {evolved_with}); recorded in config.toml",
                       file=sys.stderr)
@@ -333,9 +337,9 @@ def resume(
         ahead = run.logged_generations() - len(history)
         if ahead > 0:  # a kill between two checkpoints: said, since the bar starts further back
             print(f"{run.path}: continuing from its checkpoint at generation {len(history)}; the "
-                  f"{ahead} generation{'s' * (ahead != 1)} log.csv has after it run again, to the same "
-                  "results", file=sys.stderr)
-        for note in _repairs(run, ga):
+                  f"{ahead} generation{'s' * (ahead != 1)} log.csv has after it run again",
+                  file=sys.stderr)
+        for note in repairs:
             print(f"{run.path}: {note}; written again from checkpoint.json", file=sys.stderr)
         run.write_checkpoint(ga.state_dict(), history, table, ga.seed)
         run.write_config(ga.config, table)

@@ -5,7 +5,7 @@
 //! arithmetic over rows of `L` values, one per network. A single network is `Lanes<1>` and a
 //! population block is `Lanes<LANES>`. The kernel is written once over the crate's lane vectors,
 //! and `simd.rs` chooses at run time, from the CPU the process runs on, whether a block keeps
-//! each row in AVX-512 registers, in AVX2 registers, or runs lane by lane. Every path performs
+//! each row in AVX-512 or AVX2 registers (NEON on 64-bit ARM), or runs lane by lane. Every path performs
 //! the same operations in the same order, which is why single networks and populations agree bit
 //! for bit.
 //!

@@ -293,7 +293,7 @@ class ClosedLoop:
                          **self._run(self.validation_episodes))
         shape = result.returns.shape
         rule = getattr(self.env, "success", None)
-        if rule is None or getattr(self.env, "success_rate", None) is None:
+        if not self.has_success_rule:
             rates = np.zeros(shape[0])
         else:
             ok = self._rule(rule, result.returns.ravel(), result.lengths.ravel())
@@ -322,9 +322,10 @@ class ClosedLoop:
 
     @property
     def has_success_rule(self) -> bool:
-        """Whether the environment has a success rule (``success`` and ``success_rate``); without
-        one every network's validation rate is 0, and the validation score chooses."""
-        return getattr(self.env, "success", None) is not None and getattr(self.env, "success_rate", None) is not None
+        """Whether the environment has a success rule (a ``success`` method and a
+        ``success_rate``); without one every network's validation rate is 0, and the validation
+        score chooses."""
+        return callable(getattr(self.env, "success", None)) and getattr(self.env, "success_rate", None) is not None
 
     def succeeds(self, network: _core.Network, seed: int) -> float:
         """1.0 when ``network`` meets the environment's success rule on

@@ -66,6 +66,18 @@ def _plain(value: Any) -> bool:
     return False
 
 
+def close_copy(env: Any) -> None:
+    """Closes an environment made only to be compared or checked, when it has ``close`` (a
+    simulator, a vector environment: it releases what it holds); its own trouble in closing is
+    not the caller's."""
+    close = getattr(env, "close", None)
+    if callable(close):
+        try:
+            close()
+        except Exception:  # noqa: BLE001
+            pass
+
+
 def success_rule(env: Any, task: str) -> tuple[Any, float]:
     """The environment's ``success`` method and ``success_rate``, checked; a
     :class:`~dnnevo.ConfigError` says what is missing."""
@@ -242,12 +254,7 @@ class ClosedLoop:
         except Exception:  # noqa: BLE001
             same = False
         finally:
-            close = getattr(env, "close", None)
-            if callable(close):  # a simulator, a vector environment: release what it holds
-                try:
-                    close()
-                except Exception:  # noqa: BLE001 - the copy's own trouble is not the run's
-                    pass
+            close_copy(env)
         return found if same else {}
 
     def configured(self, config: EvolutionConfig) -> EvolutionConfig:

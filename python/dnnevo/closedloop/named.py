@@ -34,7 +34,7 @@ import sys
 from collections.abc import Mapping
 from typing import Any
 
-from dnnevo.closedloop.fitness import ROLLOUT_KEYS, ClosedLoop
+from dnnevo.closedloop.fitness import ROLLOUT_KEYS, ClosedLoop, close_copy
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, TaskError, did_you_mean, with_article
 
@@ -145,12 +145,7 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None,
     try:
         return _checked_loop(config, cls, env, settings, digest, parts)
     except BaseException:
-        close = getattr(env, "close", None)
-        if callable(close):  # a simulator the refused task had started
-            try:
-                close()
-            except Exception:  # noqa: BLE001 - the refusal is the news, not the copy's trouble
-                pass
+        close_copy(env)  # the refused task's environment
         raise
 
 

@@ -27,7 +27,7 @@ import numpy.typing as npt
 from dnnevo import _core, presets
 from dnnevo._checks import nonnegative
 from dnnevo.closedloop import named
-from dnnevo.closedloop.fitness import ClosedLoop
+from dnnevo.closedloop.fitness import ClosedLoop, close_copy
 from dnnevo.closedloop.source import plain_source, task_source
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError, InvalidArgumentError, did_you_mean
@@ -310,18 +310,16 @@ def resume(
                         "pass new_fitness=True to continue it with another fitness function")
                 change: dict[str, Any] = {"generation": ga.generation, "task": name}
                 evolved_with = ga.config.task
+                table = {k: v for k, v in table.items() if k != "fitness_parts"}
                 if isinstance(task, ClosedLoop):
                     # config.toml says what the task is from here on, so that a command can build
                     # it again (its digest is the new one)
                     ga.config = task.configured(ga.config)
                     change["task_params"] = dict(ga.config.task_params)
-                table = {**table, "fitness_changes": [*table.get("fitness_changes", []), change]}
+                    table["fitness_parts"] = task.part_digests()
+                table["fitness_changes"] = [*table.get("fitness_changes", []), change]
                 if digest is not None:
                     table["fitness_sha256"] = digest
-                if isinstance(task, ClosedLoop):
-                    table["fitness_parts"] = task.part_digests()
-                else:
-                    table.pop("fitness_parts", None)
                 print(f"{run.path}: continuing at generation {ga.generation} with {name} "
                       f"(the run was evolved with {evolved_with}); recorded in config.toml",
                       file=sys.stderr)
@@ -334,7 +332,10 @@ def resume(
         # Every file rewritten from the state about to continue, so they agree from here on;
         # one that was damaged or gone is said, as it is repaired.
         _share_threads(fitness, threads)
-        ahead = run.logged_generations() - len(history)
+        try:
+            ahead = run.logged_generations() - len(history)
+        except DnnevoError:  # an unreadable log is repaired below
+            ahead = 0
         if ahead > 0:  # a kill between two checkpoints: said, since the bar starts further back
             print(f"{run.path}: continuing from its checkpoint at generation {len(history)}; the "
                   f"{ahead} generation{'s' * (ahead != 1)} log.csv has after it run again",
@@ -372,9 +373,7 @@ def _not_rebuilt(task: ClosedLoop, config: EvolutionConfig) -> str | None:
         again = named.closed_loop(config)
     except DnnevoError as e:
         return str(e)
-    close = getattr(again.env, "close", None)
-    if callable(close):  # the copy holds what a simulator holds
-        close()
+    close_copy(again.env)
     if again.digest() == task.digest():
         return None
     return (f"config.toml cannot record the arguments this {type(task.env).__name__} was made with: "

@@ -85,6 +85,11 @@ pub struct Training {
     /// The network's sonar's axis turns by up to this many degrees, in [0, 90]. Drawn from the
     /// third stream. Default 0.
     pub sonar_axis_deg: f64,
+    /// Every range above is drawn at one of its two ends, each end with probability 1/2, instead
+    /// of uniformly over it: each varied trial is a corner of the envelope, where a network that
+    /// relies on its middle fails. The draws are the same as without it, each mapped to the end
+    /// on its side, so the ideal trials and the input noise are unchanged. Default false.
+    pub at_ends: bool,
 }
 
 /// One trial's draw of [`Training`]'s variations.
@@ -123,9 +128,15 @@ impl Variation {
     };
 }
 
-/// `range(-r, r)`: uniform over `[-r, r)`, and exactly 0 when `r` is 0.
-fn symmetric(stream: &mut Stream, r: f64) -> f64 {
-    stream.range(-r, r)
+/// `range(-r, r)`: uniform over `[-r, r)`, and exactly 0 when `r` is 0; with `at_ends`, the end of
+/// `[-r, r]` on the draw's side (`-r` below 0, else `r`).
+fn symmetric(stream: &mut Stream, r: f64, at_ends: bool) -> f64 {
+    let x = stream.range(-r, r);
+    match at_ends {
+        false => x,
+        true if x < 0.0 => -r,
+        true => r,
+    }
 }
 
 impl Training {
@@ -133,6 +144,7 @@ impl Training {
     pub fn is_off(&self) -> bool {
         self == &Training {
             ideal_trials_per_landmark: self.ideal_trials_per_landmark,
+            at_ends: self.at_ends,
             ..Training::default()
         }
     }
@@ -198,22 +210,22 @@ impl Training {
     /// order).
     pub(crate) fn draw(&self, stream: &mut Stream, third: &mut Stream) -> Variation {
         let shift = [
-            symmetric(stream, self.landmark_shift),
-            symmetric(stream, self.landmark_shift),
+            symmetric(stream, self.landmark_shift, self.at_ends),
+            symmetric(stream, self.landmark_shift, self.at_ends),
         ];
-        let turn_deg = symmetric(stream, self.landmark_turn_deg);
-        let scale = 1.0 + symmetric(stream, self.landmark_scale);
-        let speed_factor = 1.0 + symmetric(stream, self.follower_speed);
-        let distance_offset = symmetric(stream, self.follower_distance);
-        let cone_offset = symmetric(stream, self.cone_deg);
-        let seconds_offset = symmetric(stream, self.trial_seconds);
-        let gain = 1.0 + symmetric(stream, self.input_gain);
-        let offset = symmetric(stream, self.input_offset);
+        let turn_deg = symmetric(stream, self.landmark_turn_deg, self.at_ends);
+        let scale = 1.0 + symmetric(stream, self.landmark_scale, self.at_ends);
+        let speed_factor = 1.0 + symmetric(stream, self.follower_speed, self.at_ends);
+        let distance_offset = symmetric(stream, self.follower_distance, self.at_ends);
+        let cone_offset = symmetric(stream, self.cone_deg, self.at_ends);
+        let seconds_offset = symmetric(stream, self.trial_seconds, self.at_ends);
+        let gain = 1.0 + symmetric(stream, self.input_gain, self.at_ends);
+        let offset = symmetric(stream, self.input_offset, self.at_ends);
         let room_scale = [
-            1.0 + symmetric(third, self.room_scale),
-            1.0 + symmetric(third, self.room_scale),
+            1.0 + symmetric(third, self.room_scale, self.at_ends),
+            1.0 + symmetric(third, self.room_scale, self.at_ends),
         ];
-        let axis_offset = symmetric(third, self.sonar_axis_deg);
+        let axis_offset = symmetric(third, self.sonar_axis_deg, self.at_ends);
         Variation {
             shift,
             turn_deg,

@@ -25,6 +25,7 @@ fn varied() -> LandmarkConfig {
             input_noise_sd: 0.02,
             room_scale: 0.0,
             sonar_axis_deg: 0.0,
+            at_ends: false,
         },
         ..LandmarkConfig::default()
     }
@@ -212,6 +213,43 @@ fn varied_trials_vary_within_their_ranges_and_keep_the_landmark_rigid() {
         }
     }
     assert!(lengths.iter().any(|&n| n != lengths[0]));
+}
+
+#[test]
+fn at_ends_puts_every_range_at_the_end_on_its_draws_side() {
+    let c = varied();
+    let uniform = task(c.clone()).trials(8, 4).unwrap();
+    let ends = task(LandmarkConfig {
+        training: Training {
+            at_ends: true,
+            ..c.training.clone()
+        },
+        ..c
+    })
+    .trials(8, 4)
+    .unwrap();
+    let plain = LandmarkConfig::default();
+    for (k, (e, u)) in ends.iter().zip(&uniform).enumerate() {
+        if k % 3 == 0 {
+            assert_eq!(e, u, "the ideal trials do not vary");
+            continue;
+        }
+        // 15 s +- 3 s of 0.1 s steps, and the landmark's scale 1 +- 0.2 and turn +-20 degrees,
+        // the last two at the end on the side of the uniform draw of the same stream.
+        assert!([120, 180].contains(&e.input.len()), "trial {k}");
+        let side = |x: f64| if x < 0.0 { -1.0 } else { 1.0 };
+        let ideal = &plain.world(e.landmark).boxes[0];
+        let scale = |s: &tasks::landmark::Sensing| s.world.boxes[0].size[0] / ideal.size[0] - 1.0;
+        assert!((scale(e) - 0.2 * side(scale(u))).abs() < 1e-12, "trial {k}");
+        let turn = |s: &tasks::landmark::Sensing| s.world.boxes[0].angle_deg - ideal.angle_deg;
+        assert!((turn(e) - 20.0 * side(turn(u))).abs() < 1e-12, "trial {k}");
+    }
+    // Ranges of 0 stay off, whatever at_ends says.
+    assert!(Training {
+        at_ends: true,
+        ..Training::default()
+    }
+    .is_off());
 }
 
 /// The robot-like test and training share nothing: the test never draws from the training

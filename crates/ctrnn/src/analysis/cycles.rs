@@ -4,7 +4,9 @@
 //! transient has passed. If some neuron still moves, the section is the level halfway between
 //! that neuron's extremes (the neuron that moves most), crossed upwards. A cycle is closed when
 //! the state at a crossing returns, within [`CycleSearch::tolerance`], to the state one, two, three
-//! or four crossings earlier. One period from that crossing, integrated together with the
+//! or four crossings earlier; a closure after several crossings that is a cycle of fewer still
+//! converging (its crossings alternating about the cycle's, as a negative multiplier makes them)
+//! is that cycle of fewer crossings. One period from that crossing, integrated together with the
 //! variational equation `dPhi/dt = J(v(t)) Phi`, gives the orbit, the amplitude of each neuron and
 //! the monodromy matrix, whose eigenvalues are the Floquet multipliers. One multiplier is 1 (along
 //! the orbit); the cycle is stable when every other one lies inside the unit circle. An orbit
@@ -341,20 +343,55 @@ fn from_start(
         if prev[k] < level && v[k] >= level {
             let (h, x) = rk.cross(field, &prev, dt, k, level, v[k]);
             let t = s as f64 * dt + h;
-            for p in 1..=4.min(sections.len()) {
-                let (t0, x0) = &sections[sections.len() - p];
-                let gap: Vec<f64> = x.iter().zip(x0).map(|(a, b)| a - b).collect();
-                // Every coordinate, so that a NaN (which max_abs passes over) never closes a cycle.
-                if gap.iter().all(|g| g.abs() < settings.tolerance) {
-                    return describe(field, &x, t - t0, p, k, dt, settings);
-                }
-            }
             sections.push((t, x));
+            // A closure after p > 1 crossings waits until p more crossings tell whether it is a
+            // cycle of fewer crossings converging ([`converging`]).
+            let decided = |p: usize| p == 1 || sections.len() > 2 * p;
+            if let Some(p) = closing(&sections, settings.tolerance).filter(|&p| decided(p)) {
+                let q = (1..p)
+                    .find(|&q| p % q == 0 && converging(&sections, q, p))
+                    .unwrap_or(p);
+                let (t0, _) = &sections[sections.len() - 1 - q];
+                let (t, x) = &sections[sections.len() - 1];
+                return describe(field, x, t - t0, q, k, dt, settings);
+            }
         }
         prev.copy_from_slice(&v);
     }
     Ok(None)
 }
+
+/// The state at crossing `a` minus the one at crossing `b`, in the max norm; NaN when either has
+/// a NaN coordinate (which `max_abs` would pass over), so that a NaN never closes a cycle.
+fn gap(a: &[f64], b: &[f64]) -> f64 {
+    if a.iter().chain(b).any(|x| x.is_nan()) {
+        return f64::NAN;
+    }
+    max_abs(&a.iter().zip(b).map(|(x, y)| x - y).collect::<Vec<_>>())
+}
+
+/// The fewest crossings (1 to 4) after which the last crossing's state returns within
+/// `tolerance` to an earlier one, if any.
+fn closing(sections: &[(f64, Vec<f64>)], tolerance: f64) -> Option<usize> {
+    let last = sections.len() - 1;
+    (1..=4.min(last)).find(|&p| gap(&sections[last].1, &sections[last - p].1) < tolerance)
+}
+
+/// Whether the orbit that closed after `p` crossings is one of `q` crossings (`q` divides `p`)
+/// still converging: the gap between crossings `q` apart shrank by more than
+/// [`CONVERGING`] over the last `p` crossings. Near a cycle whose dominant Floquet multiplier is
+/// negative, the crossings alternate about the cycle's, so those two apart close the tolerance
+/// first; on a cycle of `p` crossings the gap `q` apart stays the distance between two of them.
+fn converging(sections: &[(f64, Vec<f64>)], q: usize, p: usize) -> bool {
+    let last = sections.len() - 1;
+    let lag = |at: usize| gap(&sections[at].1, &sections[at - q].1);
+    lag(last) < CONVERGING * lag(last - p)
+}
+
+/// See [`converging`]: a gap that keeps more than this share of itself over `p` crossings is a
+/// cycle's, not a convergence's (the crossings of a converged cycle of `p` crossings keep their
+/// gaps to about the tolerance, which is far smaller than a gap between two of them).
+const CONVERGING: f64 = 0.99;
 
 /// The distinct attracting limit cycles reached from `extra` starts and the search's own.
 pub(crate) fn search(

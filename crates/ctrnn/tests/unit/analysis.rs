@@ -133,20 +133,26 @@ fn centre_crossing_network_has_its_equilibrium_at_the_centre() {
         .all(|(v, t)| (v - t).abs() < 1e-9)));
 }
 
-/// The period of neuron 0's oscillation by plain RK4 integration (the network's own integrator),
-/// from upward crossings of its threshold.
-fn measured_period(net: &Network) -> f64 {
+/// The period of neuron 0's oscillation by plain RK4 integration (the network's own integrator)
+/// with every sensor at `input`, from upward crossings of the middle of its range over the last
+/// half of the run.
+fn measured_period(net: &Network, input: f64) -> f64 {
     let mut net = net.clone();
     let integ = Integrator {
         method: Method::Rk4,
         dt: 0.005,
         substeps: 1,
     };
-    let steps = 40_000;
-    let states = net.run(&vec![0.0; steps], steps, &integ).unwrap();
-    let level = net.theta()[0];
+    let (steps, n) = (40_000, net.size());
+    let inputs = vec![input; steps * net.n_inputs()];
+    let states = net.run(&inputs, steps, &integ).unwrap();
+    let v0 = |t: usize| states[n * t];
+    let (lo, hi) = (steps / 2..steps).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {
+        (lo.min(v0(t)), hi.max(v0(t)))
+    });
+    let level = (lo + hi) / 2.0;
     let ups: Vec<f64> = (steps / 2..steps)
-        .filter(|&t| states[2 * (t - 1)] < level && states[2 * t] >= level)
+        .filter(|&t| v0(t - 1) < level && v0(t) >= level)
         .map(|t| t as f64 * integ.dt)
         .collect();
     (ups[ups.len() - 1] - ups[0]) / (ups.len() - 1) as f64
@@ -168,7 +174,7 @@ fn two_neuron_oscillator_has_one_stable_cycle() {
         .map(|[re, im]| (re - 1.0).hypot(*im))
         .fold(1.0, f64::min);
     assert!(trivial < 1e-4, "{:?}", c.multipliers);
-    let period = measured_period(&net);
+    let period = measured_period(&net, 0.0);
     assert!(
         (c.period - period).abs() < 1e-3 * period,
         "{} vs {period}",
@@ -176,6 +182,79 @@ fn two_neuron_oscillator_has_one_stable_cycle() {
     );
     assert!(c.amplitude.iter().all(|a| *a > 1.0));
     assert_eq!(c.orbit.len(), CycleSearch::default().orbit_points);
+}
+
+/// A cycle whose dominant Floquet multiplier is negative (about -0.83): the crossings of its
+/// section alternate about the cycle's as they converge, so those two apart come within the
+/// tolerance before neighbouring ones do. It is one cycle of one crossing, not one of two at
+/// twice the period (an evolved pattern generator of a user's, four neurons and one input).
+#[test]
+fn a_cycle_approached_by_alternation_is_found_once_at_its_own_period() {
+    let net = Network::new(
+        vec![
+            5.053301106194501,
+            1.4393757871444395,
+            1.0143141206290467,
+            2.568263903439527,
+        ],
+        vec![
+            12.518850220356345,
+            -11.842000602583997,
+            2.6806438744363525,
+            0.9356610529658447,
+        ],
+        vec![
+            11.741630340645155,
+            5.382859711571111,
+            3.032630390521174,
+            -14.41209596921287,
+            -9.798332349553736,
+            6.702562382870685,
+            -10.021183083297139,
+            6.185326662163483,
+            3.6741567634066357,
+            7.4762635119870176,
+            2.117347933649203,
+            -7.599471376356121,
+            10.430071176660995,
+            -12.792976808706708,
+            -13.177636555100907,
+            -3.0115407533647662,
+        ],
+        vec![
+            4.070481782096625,
+            -4.889835058311331,
+            -3.1907003225685635,
+            8.524927475028985,
+        ],
+        None,
+    )
+    .unwrap();
+    let period = measured_period(&net, 1.0);
+    for starts in [4, 8] {
+        let settings = CycleSearch {
+            starts,
+            ..CycleSearch::default()
+        };
+        let cycles = limit_cycles(&net, &[1.0], &settings, None).unwrap();
+        assert_eq!(cycles.len(), 1, "{starts} starts: {cycles:?}");
+        let c = &cycles[0];
+        assert_eq!(
+            c.crossings,
+            1,
+            "{starts} starts: {:?}",
+            (c.period, &c.multipliers)
+        );
+        assert!(
+            (c.period - period).abs() < 1e-3 * period,
+            "{} vs {period}",
+            c.period
+        );
+        // The dominant non-trivial multiplier is real and negative.
+        let [re, im] = c.multipliers[1];
+        assert!(re < -0.8 && im.abs() < 1e-9, "{:?}", c.multipliers);
+        assert!((c.max_multiplier - re.abs()).abs() < 1e-12);
+    }
 }
 
 #[test]

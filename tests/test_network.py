@@ -239,6 +239,11 @@ def test_population_matches_single_bit_for_bit() -> None:
         np.testing.assert_array_equal(states[p], own)
     final = dnnevo.run_population(nets, inputs[0], record=False)
     assert final.shape == (13, 4)
+    # No steps, as Network.run: nothing recorded, the states as they were.
+    assert dnnevo.run_population(nets, inputs[:, :0]).shape == (13, 0, 4)
+    assert net.copy().run(inputs[0, :0]).states.shape == (0, 4)
+    np.testing.assert_array_equal(dnnevo.run_population(nets, inputs[0, :0], record=False),
+                                  [n.state for n in nets])
 
 
 def test_population_from_stacked_arrays() -> None:

@@ -341,7 +341,8 @@ fn run_blocks<E: Elem>(
         0
     };
     let mut out = limits::zeros(len, "recorded states")?;
-    let mut chunks: Vec<Option<&mut [f64]>> = if record {
+    // No steps record nothing (and `chunks_mut` takes no chunks of length 0).
+    let mut chunks: Vec<Option<&mut [f64]>> = if record && steps > 0 {
         out.chunks_mut(LANES * steps * n).map(Some).collect()
     } else {
         blocks.iter().map(|_| None).collect()

@@ -15,7 +15,7 @@ fn arb_network(n: usize, m: usize) -> impl Strategy<Value = Network> {
 }
 
 fn arb_population() -> impl Strategy<Value = (Vec<Network>, Vec<f64>, usize, bool)> {
-    (1usize..7, 0usize..3, 1usize..20, 1usize..12, any::<bool>()).prop_flat_map(
+    (1usize..7, 0usize..3, 1usize..20, 0usize..12, any::<bool>()).prop_flat_map(
         |(n, m, p, t, rk4)| {
             (
                 prop::collection::vec(arb_network(n, m), p),

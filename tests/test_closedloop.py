@@ -334,6 +334,39 @@ def test_observation_size_must_match_the_networks() -> None:
         rollout(networks(2, m=2), Drift(), max_steps=3)
 
 
+class _Sized(Drift):
+    def __init__(self, size: object) -> None:
+        self.observation_size = size
+
+
+class _Unsized(Drift):
+    observation_size = property(lambda self: self.missing)  # an attribute it does not have
+
+
+@pytest.mark.parametrize("env, message", [
+    (_Sized("1"), "_Sized.observation_size is '1'; expected the number of observations the task gives "
+                  "at each step, a whole number >= 0"),
+    (_Sized(1.0), "_Sized.observation_size is 1.0; expected"),
+    (_Sized(True), "_Sized.observation_size is True; expected"),
+    (_Sized(-1), "_Sized.observation_size is -1; expected"),
+    (_Unsized(), "_Unsized has no observation_size; give it the number of observations"),
+])
+def test_an_observation_size_that_is_no_count_is_refused_alike_everywhere(env, message: str) -> None:
+    """rollout and ClosedLoop check it as the command line does: they took a string, a float or
+    none at all before."""
+    with pytest.raises(TaskError) as rolled:
+        rollout(networks(2, m=1), env, max_steps=3)
+    with pytest.raises(TaskError) as made:
+        ClosedLoop(env, max_steps=3)
+    assert message in str(rolled.value) and message in str(made.value)
+
+
+def test_closed_loop_takes_an_environment_not_its_class() -> None:
+    with pytest.raises(dnnevo.ConfigError, match=r"env is the class Drift; ClosedLoop takes an "
+                                                 r"environment made from it, Drift\(...\)"):
+        ClosedLoop(Drift, max_steps=3)
+
+
 def test_condition_seed_checks_its_arguments() -> None:
     seed = dnnevo._core.condition_seed
     assert seed(0, 0) != seed(0, 1) != seed(1, 0)
@@ -432,6 +465,8 @@ import json
 
 import numpy as np
 
+from dnnevo.tasks.protocol import Analysis
+
 
 class Seeker:
     """A 1-D agent seeks a light."""
@@ -462,6 +497,22 @@ class Ruleless(Seeker):
 
 class Sizeless(Seeker):
     observation_size = None
+
+
+class Blind(Seeker):
+    """No sensor: the light is always at 1, and a network must find it from its own dynamics."""
+
+    observation_size = 0
+    analysis = Analysis(input_names=[], conditions={"free": []}, main_input=0, output_neuron=0,
+                        episodes=1)
+
+    def reset(self, episodes, rng):
+        self.light, self.x = np.ones(len(episodes)), np.zeros(len(episodes))
+        return np.zeros((len(episodes), 0))
+
+    def step(self, rates, active):
+        _, reward, done = super().step(rates, active)
+        return np.zeros((len(rates), 0)), reward, done
 
 
 def not_a_class():
@@ -593,6 +644,24 @@ def test_n_inputs_defaults_to_the_class_s_observation_size_on_the_command_line(t
     wrong = dnnevo_command(tmp_path, "run", "python:seeker_size.Seeker", *without, "--set", "n_inputs=2",
                            "--out", "runs/wrong")
     assert wrong.returncode == 2 and "n_inputs is 2; Seeker.observation_size is 1" in wrong.stderr
+
+
+def test_a_task_without_sensors_runs_and_is_judged_from_the_command_line(tmp_path) -> None:
+    """A pattern generator's task gives its networks no input (observation_size = 0), as
+    Python's evolve always allowed; the command line refused it."""
+    (tmp_path / "seeker_blind.py").write_text(SEEKER)
+    without = [a for a in SETTINGS if a != "n_inputs=1"]
+    without.remove("--set")
+    run = dnnevo_command(tmp_path, "run", "python:seeker_blind.Blind", *without)
+    assert run.returncode == 0, run.stderr
+    assert "n_inputs = 0" in (tmp_path / "runs" / "seeker_blind.Blind-seed0" / "config.toml").read_text()
+    judged = dnnevo_command(tmp_path, "assess", "runs/seeker_blind.Blind-seed0", "--seed", "1", "--trials", "8")
+    assert judged.returncode in (0, 1, 3) and "episodes" in judged.stdout, judged.stderr
+    analysed = dnnevo_command(tmp_path, "analyze", "runs/seeker_blind.Blind-seed0", "--no-lesions")
+    assert analysed.returncode == 0 and "no sweep: the network has no input to vary" in analysed.stdout, \
+        analysed.stderr
+    doc = json.loads((tmp_path / "runs" / "seeker_blind.Blind-seed0" / "analysis.json").read_text())
+    assert doc["bifurcation"] is None and doc["conditions"][0]["input"] == []
 
 
 def test_a_task_without_a_success_rule_cannot_be_judged(tmp_path) -> None:

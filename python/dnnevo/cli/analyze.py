@@ -140,13 +140,18 @@ def analyze(args: argparse.Namespace) -> int:
         order = np.argsort(-outputs.var(axis=0), kind="stable")
         neurons = (int(order[0]), int(order[1])) if net.size > 1 else (0, 0)
 
-    index, name = task.MAIN_INPUT, task.INPUT_NAMES[task.MAIN_INPUT]
+    start, stop = _range(args.sweep)
+    bif, name = None, "no input"  # a network without sensors has no input to sweep
+    if m > 0:
+        index, name = task.MAIN_INPUT, task.INPUT_NAMES[task.MAIN_INPUT]
     if args.sweep_input is not None:
         if not 0 <= args.sweep_input < m:
-            raise InvalidArgumentError(f"--sweep-input is {args.sweep_input}; this network's inputs are 0..{m - 1}")
+            inputs = f"inputs are 0..{m - 1}" if m else "network has no inputs"
+            raise InvalidArgumentError(f"--sweep-input is {args.sweep_input}; this {inputs}")
         index, name = args.sweep_input, f"input {args.sweep_input}"
-    start, stop = _range(args.sweep)
-    bif = analysis.bifurcation(net, index, start, stop, steps=args.steps, cycle_starts=4 if args.sweep_cycles else 0)
+    if m > 0:
+        bif = analysis.bifurcation(net, index, start, stop, steps=args.steps,
+                                   cycle_starts=4 if args.sweep_cycles else 0)
 
     table = analysis.lesions(config, net, args.trials, seed=args.seed, cuts=args.cuts) if args.lesions else None
     seen = [view(config, net, args.seed, run.path.name) for view in views(task)]
@@ -157,7 +162,8 @@ def analyze(args: argparse.Namespace) -> int:
         "format": "dnnevo-analysis", "version": 1, "run": str(args.dir), "task": config.task,
         "size": net.size, "seed": args.seed, "neurons": list(neurons),
         "conditions": [a.to_dict() for a in found],
-        "bifurcation": {"input_name": name, "shown_neuron": _moving_neuron(bif), **bif.to_dict()},
+        "bifurcation": None if bif is None else {"input_name": name, "shown_neuron": _moving_neuron(bif),
+                                                 **bif.to_dict()},
         "lesions": table.to_dict() if table else None,
         "trial_basins": {"input": found[0].input.tolist(), "attractors": [e.outputs.tolist() for e in stable],
                          "every": basins[0], "basins": basins[1].tolist()},
@@ -187,19 +193,19 @@ def analyze(args: argparse.Namespace) -> int:
     return 0
 
 
-def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifurcation,
+def _figures(run: RunDir, net: _core.Network, found: list[Attractors], bif: Bifurcation | None,
              table: LesionTable | None, outputs: np.ndarray, neurons: tuple[int, int], label: str) -> list[str]:
     written = []
     n_lesions = len(table.lesions) if table is not None else 0
     for name, size in (("analysis-phase.png", (7.0, 5.5)), ("analysis-bifurcation.png", (7.0, 4.0)),
                        ("analysis-lesions.png", (7.0, 1.5 + 0.22 * n_lesions))):
-        if name == "analysis-lesions.png" and table is None:
+        if name == "analysis-lesions.png" and table is None or name == "analysis-bifurcation.png" and bif is None:
             continue
         fig, ax = plot.subplots(figsize=size, layout="constrained")
         if name == "analysis-phase.png":
             analysis.plot_phase_portrait(found, ax, net=net, neurons=neurons, trajectory=outputs,
                                 title=f"{run.path.name}: attractors under each input, and a real trial")
-        elif name == "analysis-bifurcation.png":
+        elif name == "analysis-bifurcation.png" and bif is not None:
             analysis.plot_bifurcation(bif, ax, neuron=_moving_neuron(bif), xlabel=label,
                              title=f"{run.path.name}: equilibria as {label} varies")
         elif table is not None:
@@ -231,7 +237,7 @@ def _basins(config: EvolutionConfig, net: _core.Network, trials: list[tuple[np.n
 
 
 def _basin_figure(run: RunDir, task: Task, trials: list[tuple[np.ndarray, np.ndarray]],
-                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation, name: str,
+                  basins: tuple[int, np.ndarray], off: Attractors, bif: Bifurcation | None, name: str,
                   neuron: int) -> list[str]:
     every, which = basins
     outputs = np.vstack([o for o, _ in trials])[::every]
@@ -242,7 +248,7 @@ def _basin_figure(run: RunDir, task: Task, trials: list[tuple[np.ndarray, np.nda
     labels = [f"{chr(65 + k)} (neuron {neuron} at {e.outputs[neuron]:.2f})" for k, e in enumerate(stable)]
     fig, ax = plot.subplots(figsize=(9.0, 3.6), layout="constrained")
     analysis.plot_basins(outputs, {names[k]: inputs[:, k] for k in range(inputs.shape[1])}, which, ax, labels=labels,
-                neuron=neuron, boundaries=list(starts), levels=[e.value for e in bif.events if e.kind == "fold"],
+                neuron=neuron, boundaries=list(starts), levels=[e.value for e in bif.events if e.kind == "fold"] if bif else [],
                 level_label=f"folds of the {name} sweep",
                 title=f"{run.path.name}: recorded trials; background: where the state would settle "
                       f"with input {off.label}")
@@ -308,7 +314,25 @@ def letters(a: Attractors) -> dict[int, str]:
     return {k: chr(65 + i) for i, k in enumerate(stable)}
 
 
-def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None, name: str,
+def _sweep_lines(bif: Bifurcation, name: str) -> list[str]:
+    """The bifurcation sweep of ``name`` in words."""
+    events = ", ".join(event_texts(bif.events)) or "none"
+    lines = [f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}"]
+    if bif.retried:
+        lines.append(f"    searched again with {analysis.RETRY_STARTS} starts at {len(bif.retried)} value"
+                     f"{'s' * (len(bif.retried) != 1)} where the count of equilibria was even")
+    if bif.even:
+        shown = ", ".join(f"{v:g}" for v in bif.even[:8]) + (", ..." if len(bif.even) > 8 else "")
+        lines.append(f"    (the count stays even at {len(bif.even)} value{'s' * (len(bif.even) != 1)} ({shown}): "
+                     "equilibria were missed there, see docs/analysis.md)")
+    for b in bif.branches:
+        first, last = (bif.cycles[s][bif.cycle_branch[s].index(b.id)].period for s in (b.first, b.last))
+        lines.append(f"    cycle branch {b.id}: from {_end_text(b.start, 'the sweep start', bif.events, first)} "
+                     f"to {_end_text(b.end, 'the sweep end', bif.events, last)}")
+    return lines
+
+
+def summary(found: list[Attractors], bif: Bifurcation | None, table: LesionTable | None, name: str,
             basins: tuple[int, np.ndarray] | None = None, *, output: int | None = None) -> list[str]:
     """The printed report. The first condition's stable equilibria are named A, B, ... (as in
     analysis-basins.png); ``output`` is the neuron whose firing rate is the task's answer."""
@@ -328,19 +352,7 @@ def summary(found: list[Attractors], bif: Bifurcation, table: LesionTable | None
             lines.append(f"    cycle: period {c.period:.3g}, neuron 0's state between "
                          f"{np.min(c.orbit[:, 0]):.3g} and {np.max(c.orbit[:, 0]):.3g}, "
                          f"largest Floquet multiplier besides the trivial 1: {c.max_multiplier:.3g}")
-    events = ", ".join(event_texts(bif.events)) or "none"
-    lines.append(f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}")
-    if bif.retried:
-        lines.append(f"    searched again with {analysis.RETRY_STARTS} starts at {len(bif.retried)} value"
-                     f"{'s' * (len(bif.retried) != 1)} where the count of equilibria was even")
-    if bif.even:
-        shown = ", ".join(f"{v:g}" for v in bif.even[:8]) + (", ..." if len(bif.even) > 8 else "")
-        lines.append(f"    (the count stays even at {len(bif.even)} value{'s' * (len(bif.even) != 1)} ({shown}): "
-                     "equilibria were missed there, see docs/analysis.md)")
-    for b in bif.branches:
-        first, last = (bif.cycles[s][bif.cycle_branch[s].index(b.id)].period for s in (b.first, b.last))
-        lines.append(f"    cycle branch {b.id}: from {_end_text(b.start, 'the sweep start', bif.events, first)} "
-                     f"to {_end_text(b.end, 'the sweep end', bif.events, last)}")
+    lines += _sweep_lines(bif, name) if bif is not None else ["no sweep: the network has no input to vary"]
     if basins is not None:
         every, which = basins
         shares = ", ".join(f"{chr(65 + k)} {np.mean(which == k):.0%}" for k in range(int(which.max(initial=-1)) + 1))

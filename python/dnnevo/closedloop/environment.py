@@ -9,14 +9,15 @@ run more episodes than it has rows.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Protocol
+import numbers
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo.errors import InvalidArgumentError
+from dnnevo.errors import InvalidArgumentError, TaskError
 
-__all__ = ["Environment", "RestartingEnvironment", "check_neurons"]
+__all__ = ["Environment", "RestartingEnvironment", "check_neurons", "whole_size", "sensors"]
 
 
 class Environment(Protocol):
@@ -74,6 +75,41 @@ class RestartingEnvironment(Environment, Protocol):
         that step (``active`` is False for them), and the observations it returns for them are
         the new episodes' first.
         """
+
+
+def whole_size(size: Any) -> int | None:
+    """``size`` as an int when it is a whole number >= 0 (an int or a NumPy integer; a bool, a
+    float or a string is not), else None.
+
+    >>> whole_size(np.int64(3)), whole_size(0), whole_size(2.0), whole_size("2"), whole_size(True)
+    (3, 0, None, None, None)
+    """
+    if isinstance(size, bool) or not isinstance(size, numbers.Integral) or size < 0:
+        return None
+    return int(size)
+
+
+def sensors(env: Any) -> int:
+    """``env.observation_size``, checked: the number of sensors, a whole number >= 0 (0 for a
+    task that gives its networks no input, a pattern generator); a :class:`~dnnevo.TaskError`
+    names what is wrong.
+
+    >>> class Blind:
+    ...     observation_size = 2.0
+    >>> sensors(Blind())
+    Traceback (most recent call last):
+    ...
+    dnnevo.errors.TaskError: Blind.observation_size is 2.0; expected the number of observations the task gives at each step, a whole number >= 0
+    """
+    name = type(env).__name__
+    if not hasattr(env, "observation_size"):
+        raise TaskError(f"{name} has no observation_size; give it the number of observations the "
+                        "task gives at each step (the networks' n_inputs)")
+    size = env.observation_size
+    if whole_size(size) is None:
+        raise TaskError(f"{name}.observation_size is {size!r}; expected the number of observations "
+                        "the task gives at each step, a whole number >= 0")
+    return int(size)
 
 
 def check_neurons(rates: npt.NDArray[np.float64], neurons: Iterable[int], reader: str) -> None:

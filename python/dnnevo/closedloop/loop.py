@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo._checks import nonnegative
-from dnnevo.closedloop.environment import Environment
+from dnnevo.closedloop.environment import Environment, sensors
 from dnnevo.config import IntegratorConfig
 from dnnevo.errors import InvalidArgumentError, TaskError, with_article
 
@@ -107,9 +107,7 @@ def rollout(
     batch = _core.Batch(networks, replicas=episodes, **integrator)
     batch.reset()
     rows, m = batch.rows, batch.n_inputs
-    if getattr(env, "observation_size", m) != m:
-        raise TaskError(f"{_name(env)}.observation_size is {env.observation_size}; the networks "
-                        f"have {m} inputs")
+    _check_sensors(env, m)
     rng = np.random.default_rng(_core.condition_seed(seed, generation, draw))
     labels = np.tile(np.arange(episodes, dtype=np.int64), batch.networks)
     obs = observations(_call(env, "reset", labels, rng), env, "reset", rows, m)
@@ -146,6 +144,13 @@ def rollout(
     return Rollout(returns=returns.reshape(shape), lengths=lengths.reshape(shape))
 
 
+def _check_sensors(env: Any, m: int) -> None:
+    """Refuses an environment whose ``observation_size`` is not the networks' ``m`` inputs."""
+    if sensors(env) != m:
+        raise TaskError(f"{_name(env)}.observation_size is {env.observation_size}; the networks "
+                        f"have {m} input{'' if m == 1 else 's'}")
+
+
 def _queued(networks: Sequence[_core.Network], env: Any, *, episodes: int, max_steps: int,
             rows: int, rng: np.random.Generator, batch: _core.Batch) -> Rollout:
     """:func:`rollout` with ``rows`` rows, fewer than its episodes: a row whose episode ends
@@ -155,9 +160,7 @@ def _queued(networks: Sequence[_core.Network], env: Any, *, episodes: int, max_s
         raise TaskError(f"{_name(env)} has no restart method; without one, rows must be None or "
                         f"at least P x episodes = {len(networks) * episodes}")
     total, m = len(networks) * episodes, batch.n_inputs
-    if getattr(env, "observation_size", m) != m:
-        raise TaskError(f"{_name(env)}.observation_size is {env.observation_size}; the networks "
-                        f"have {m} inputs")
+    _check_sensors(env, m)
     batch.reset()
     episode = np.arange(rows, dtype=np.int64)  # the episode each row runs
     following = rows  # the next waiting episode

@@ -28,12 +28,12 @@ folder.
 from __future__ import annotations
 
 import importlib
-import numbers
 import os
 import sys
 from collections.abc import Mapping
 from typing import Any
 
+from dnnevo.closedloop.environment import sensors, whole_size
 from dnnevo.closedloop.fitness import ROLLOUT_KEYS, ClosedLoop, close_copy
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, TaskError, did_you_mean, with_article
@@ -108,21 +108,14 @@ def observation_size(task: str, task_params: Mapping[str, Any] | None = None) ->
     the ``n_inputs`` its networks need: that of an instance made with ``task_params`` (less the
     rollout's settings), as :func:`closed_loop` makes it, since an instance may set its own (a
     :class:`~dnnevo.robots.RobotWorld` counts its sensors); else the class's. None when neither
-    is a whole number >= 1 (a mistake that :func:`closed_loop` then names)."""
+    is a whole number >= 0 (a mistake that :func:`closed_loop` then names)."""
     cls = environment_class(task)
     params = {k: v for k, v in (task_params or {}).items() if k not in ROLLOUT_KEYS}
     try:
-        size = _whole_size(getattr(cls(**params), "observation_size", None))
+        size = whole_size(getattr(cls(**params), "observation_size", None))
     except Exception:  # noqa: BLE001 - closed_loop names what is wrong with the arguments
         size = None
-    return size if size is not None else _whole_size(getattr(cls, "observation_size", None))
-
-
-def _whole_size(size: Any) -> int | None:
-    """``size`` as an int when it is a whole number >= 1 (a bool is not), else None."""
-    if isinstance(size, bool) or not isinstance(size, numbers.Integral) or size < 1:
-        return None
-    return int(size)
+    return size if size is not None else whole_size(getattr(cls, "observation_size", None))
 
 
 def closed_loop(config: EvolutionConfig, *, digest: str | None = None,
@@ -152,10 +145,7 @@ def closed_loop(config: EvolutionConfig, *, digest: str | None = None,
 def _checked_loop(config: EvolutionConfig, cls: type, env: Any, settings: dict[str, Any],
                   digest: str | None, parts: Mapping[str, str] | None) -> ClosedLoop:
     """:func:`closed_loop`'s checks of the environment it made, and the task around it."""
-    size = env.observation_size
-    if _whole_size(size) is None:
-        raise ConfigError(f"{cls.__name__}.observation_size is {size!r}; expected the number of "
-                          "observations the task gives at each step, a whole number >= 1")
+    size = sensors(env)
     if size != config.n_inputs:
         raise ConfigError(f"n_inputs is {config.n_inputs}; {cls.__name__}.observation_size is "
                           f"{env.observation_size} (set n_inputs = {env.observation_size})")

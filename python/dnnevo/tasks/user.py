@@ -186,7 +186,8 @@ def analysed(config: EvolutionConfig) -> UserTask:
         if len(values) != m or not all(math.isfinite(x) for x in values):
             raise ConfigError(f"{where}: condition {name!r} is {v!r}; expected {m} finite numbers, one per input")
         conditions[str(name)] = values
-    index("main_input", a.main_input, m, "inputs")
+    if m > 0:  # a network without sensors has no input to sweep
+        index("main_input", a.main_input, m, "inputs")
     index("output_neuron", a.output_neuron, config.size, "neurons")
     if isinstance(a.episodes, bool) or not isinstance(a.episodes, int) or a.episodes < 1:
         raise ConfigError(f"{where}.episodes is {a.episodes!r}; expected a whole number >= 1")

@@ -765,6 +765,9 @@ def test_a_fitness_function_run_is_neither_resumed_nor_judged_by_the_command_lin
     assert resumed.returncode == 2 and "resume it from Python" in resumed.stderr
     judged = dnnevo_command(tmp_path, "assess", "f")
     assert judged.returncode == 2 and "has no success rule" in judged.stderr
+    analysed = dnnevo_command(tmp_path, "analyze", "f", "--input", "1", "--no-lesions")
+    assert analysed.returncode == 2 and "evolved with a Python fitness function" in analysed.stderr \
+        and "dnnevo.analysis.attractors" in analysed.stderr, analysed.stderr
 
 
 class Echo:

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 
-__all__ = ["axes", "close", "plot_fitness", "plot_fitness_seeds", "plot_paths", "plot_room",
+__all__ = ["axes", "close", "columns", "plot_fitness", "plot_fitness_seeds", "plot_paths", "plot_room",
            "plot_traces", "pyplot", "subplots"]
 
 
@@ -51,13 +51,30 @@ def axes(ax: Axes | None) -> Axes:
     return ax
 
 
+def columns(history: Mapping[str, npt.ArrayLike], names: tuple[str, ...]) -> list[npt.NDArray[Any]]:
+    """The arrays ``history[name]`` for each of ``names``, as :attr:`EvolutionResult.history
+    <dnnevo.EvolutionResult.history>` holds them; a missing one is an
+    :class:`~dnnevo.InvalidArgumentError` that lists what is needed.
+
+    >>> columns({"best": [1.0]}, ("generation", "best"))
+    Traceback (most recent call last):
+    ...
+    dnnevo.errors.InvalidArgumentError: history has no 'generation'; it needs the columns generation, best, as EvolutionResult.history has them
+    """
+    for name in names:
+        if name not in history:
+            raise InvalidArgumentError(f"history has no {name!r}; it needs the columns "
+                                       f"{', '.join(names)}, as EvolutionResult.history has them")
+    return [np.asarray(history[name]) for name in names]
+
+
 def plot_fitness(
     history: Mapping[str, npt.ArrayLike], ax: Axes | None = None, *, title: str | None = None
 ) -> Axes:
-    """Best and mean fitness over generations, with a ±1 std band around the mean."""
+    """Best and mean fitness over generations, with a ±1 std band around the mean: ``history``
+    has the columns generation, best, mean and std (:attr:`dnnevo.EvolutionResult.history`)."""
     ax = axes(ax)
-    gen = np.asarray(history["generation"])
-    best, mean, std = (np.asarray(history[k]) for k in ("best", "mean", "std"))
+    gen, best, mean, std = columns(history, ("generation", "best", "mean", "std"))
     ax.fill_between(gen, mean - std, mean + std, color="tab:blue", alpha=0.2, label="mean ± std")
     ax.plot(gen, mean, color="tab:blue", label="mean")
     ax.plot(gen, best, color="tab:red", label="best")
@@ -74,13 +91,14 @@ def plot_fitness_seeds(
     histories: Mapping[int, Mapping[str, npt.ArrayLike]], ax: Axes | None = None, *, title: str | None = None
 ) -> Axes:
     """The best fitness over generations of several runs, one line per seed (solid), with each
-    run's mean fitness (dotted, same colour)."""
+    run's mean fitness (dotted, same colour): each history has the columns generation, best and
+    mean (:attr:`dnnevo.EvolutionResult.history`)."""
     ax = axes(ax)
     for i, (seed, h) in enumerate(sorted(histories.items())):
-        gen = np.asarray(h["generation"])
+        gen, best, mean = columns(h, ("generation", "best", "mean"))
         colour = f"C{i % 10}"
-        ax.plot(gen, np.asarray(h["best"]), color=colour, lw=1.2, label=f"seed {seed}")
-        ax.plot(gen, np.asarray(h["mean"]), color=colour, lw=0.8, ls=":")
+        ax.plot(gen, best, color=colour, lw=1.2, label=f"seed {seed}")
+        ax.plot(gen, mean, color=colour, lw=0.8, ls=":")
     ax.set_xlabel("generation")
     ax.set_ylabel("fitness (solid: best, dotted: mean)")
     if len(histories) <= 10:

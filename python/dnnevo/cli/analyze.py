@@ -111,6 +111,9 @@ def analyze(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     run = RunDir(args.dir)
     config, raw = run.read_run_config()
+    named.refuse_fitness_function(
+        config, args.dir, "whose trials the command line cannot record; analyse the champion from "
+        "Python: dnnevo.analysis.attractors(dnnevo.Network.load(path), inputs) (docs/analysis.md)")
     named.check_own_task(config, raw)
     net = run.read_best(config, raw)
     m = net.n_inputs

@@ -53,9 +53,8 @@ def assess(args: argparse.Namespace) -> int:
     champion = run.read_best(config, table)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     task = tasks.get(config.task)
-    if named.is_python_task(config.task) and not named.is_closed_loop(config):
-        raise ConfigError(f"{args.dir} was evolved with a Python fitness function ({config.task}), "
-                          "which has no success rule; a task class can have one (docs/closed-loop.md)")
+    named.refuse_fitness_function(config, args.dir, "which has no success rule; a task class can "
+                                  "have one (docs/closed-loop.md)")
     named.check_own_task(config, table)  # before --dt changes the settings
     if args.robot_like and not task.ROBOT_LIKE:
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")

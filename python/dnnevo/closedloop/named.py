@@ -39,7 +39,7 @@ from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, TaskError, did_you_mean, with_article
 
 __all__ = ["ROLLOUT_KEYS", "check_own_task", "closed_loop", "environment_class", "is_closed_loop",
-           "is_python_task", "observation_size"]
+           "is_python_task", "observation_size", "refuse_fitness_function"]
 
 #: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
 _MEMBERS = ("observation_size", "reset", "step")
@@ -54,6 +54,14 @@ def is_closed_loop(config: EvolutionConfig) -> bool:
     """Whether ``config`` names a Python task class that the command line can build (its
     ``task_params`` say the rollout's ``max_steps``), without importing anything."""
     return is_python_task(config.task) and "max_steps" in config.task_params
+
+
+def refuse_fitness_function(config: EvolutionConfig, folder: object, why: str) -> None:
+    """Raises a :class:`~dnnevo.ConfigError` when ``config`` is the run in ``folder`` of a Python
+    fitness function, which the command line cannot call again (a task class's it can); ``why``
+    ends the sentence: what the command needs and where else to get it."""
+    if is_python_task(config.task) and not is_closed_loop(config):
+        raise ConfigError(f"{folder} was evolved with a Python fitness function ({config.task}), {why}")
 
 
 def environment_class(task: str) -> type:

@@ -726,9 +726,16 @@ def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path,
     for speed, tagged, folder in [(0.1, False, "same"), (0.2, False, "told"), (0.2, True, "other")]:
         loop = ClosedLoop(seeker(speed, tagged), episodes=2, max_steps=50)
         dnnevo.evolve(loop, config, out=tmp_path / folder, progress=False)
-        # The run says at its start when the command line will not build its task again.
-        note = "the command line will not judge, draw or resume" in capsys.readouterr().err
-        assert note == tagged, folder
+        # The run says at its start when the command line will not build its task again, and
+        # names the attributes set after __init__.
+        err = capsys.readouterr().err
+        assert ("the command line will not judge, draw or resume" in err) == tagged, folder
+        assert ("has attributes that one made from config.toml has not (tag)" in err) == tagged, err
+    # An environment that ran episodes before it was wrapped keeps their state as attributes.
+    used = seeker_arg.Seeker(speed=0.1)
+    rollout(networks(2, n=3, m=1), used, max_steps=5)
+    dnnevo.evolve(ClosedLoop(used, episodes=2, max_steps=50), config, out=tmp_path / "used", progress=False)
+    assert "has attributes that one made from config.toml has not (light, x)" in capsys.readouterr().err
     for folder in ("same", "told"):
         judged = dnnevo_command(tmp_path, "assess", folder, "--trials", "20")
         assert judged.returncode in (0, 1, 3) and "20 fresh episodes" in judged.stdout, judged.stderr

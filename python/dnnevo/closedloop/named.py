@@ -170,7 +170,8 @@ DIFFERENCES = {
     "source": "the class's source, or what it reads from its module, was edited since the run; "
               "a success rule added or changed counts: it is part of the task",
     "attributes": "the environment's attributes differ: task_params, or the run began from Python "
-                  "with an environment made with arguments config.toml could not record",
+                  "with an environment made with arguments config.toml could not record, or one "
+                  "that had run episodes before ClosedLoop wrapped it",
     "settings": "the rollout's settings differ: episodes, max_steps, validation_episodes, rows, "
                 "precision or the integrator",
 }

@@ -373,10 +373,16 @@ def _not_rebuilt(task: ClosedLoop, config: EvolutionConfig) -> str | None:
         again = named.closed_loop(config)
     except DnnevoError as e:
         return str(e)
+    extra = sorted(set(getattr(task.env, "__dict__", {})) - set(getattr(again.env, "__dict__", {})))
     close_copy(again.env)
     if again.digest() == task.digest():
         return None
-    return (f"config.toml cannot record the arguments this {type(task.env).__name__} was made with: "
+    kind = type(task.env).__name__
+    if extra:
+        return (f"this {kind} has attributes that one made from config.toml has not "
+                f"({', '.join(extra)}): they were set after __init__, as an earlier reset or "
+                "rollout sets them; give ClosedLoop a freshly made environment")
+    return (f"config.toml cannot record the arguments this {kind} was made with: "
             "keep each argument of __init__ as an attribute of the same name, holding a Python "
             "number, string or boolean, or a list or dict of them")
 

@@ -178,12 +178,16 @@ def test_a_batch_of_fewer_rows_hands_rows_to_other_networks() -> None:
         (([0], [4]), "network 4 is out of range; the batch has 4 networks"),
         (([0, 0], [1, 2]), "row 0 is named twice"),
         (([0], [0, 1]), "1 rows and 2 networks"),
-        (([-1], [0]), r"rows holds -1; indices are >= 0"),
+        (([-4], [0]), r"rows holds index -4; there are 3 rows, so indices run from -3 to 2"),
+        (([0], [-5]), r"networks holds index -5; there are 4 networks, so indices run from -4 to 3"),
         (([0.5], [0]), "rows is an array of dtype float64 and 1 dimensions; expected a 1-D array of indices"),
     ]:
         with pytest.raises(InvalidArgumentError, match=message):
             batch.assign(*args)
     assert batch.network_of.tolist() == [1, 0, 3]
+    # Negative indices count from the end, as reset's and set_states' rows do.
+    batch.assign([-1], [-4])
+    assert batch.network_of.tolist() == [1, 0, 0]
     for rows in (0, 9):
         with pytest.raises(InvalidArgumentError, match=rf"rows is {rows}; expected 1 to networks x "
                                                        "replicas = 8"):

@@ -172,9 +172,10 @@ fn chosen_rows(obj: Option<&Bound<'_, PyAny>>, rows: usize) -> PyResult<Option<V
     Ok(Some(out))
 }
 
-/// Non-negative integer indices from a 1-D integer array or a sequence of ints (an empty list
-/// is no index).
-fn indices(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<usize>> {
+/// Indices into `len` items from a 1-D integer array or a sequence of ints (an empty list is no
+/// index); a negative one counts from the end, as NumPy's and [`chosen_rows`]' do. One past the
+/// end and beyond is left to the caller to name.
+fn indices(obj: &Bound<'_, PyAny>, name: &str, len: usize) -> PyResult<Vec<usize>> {
     let np = obj.py().import("numpy")?;
     let arr = np.call_method1("asarray", (obj,))?;
     let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
@@ -190,7 +191,13 @@ fn indices(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<usize>> {
     values
         .into_iter()
         .map(|v| {
-            usize::try_from(v).map_err(|_| arg_err(format!("{name} holds {v}; indices are >= 0")))
+            let at = if v < 0 { v + len as i128 } else { v };
+            usize::try_from(at).map_err(|_| {
+                arg_err(format!(
+                    "{name} holds index {v}; there are {len} {name}, so indices run from -{len} to {}",
+                    len as i128 - 1
+                ))
+            })
         })
         .collect()
 }
@@ -359,22 +366,25 @@ impl PyBatch {
     }
 
     /// Gives row `rows[i]` to network `networks[i]` (row and network indices, 1-D integer arrays
-    /// of one length); those rows start from their new network's state, the others keep theirs.
+    /// of one length, a negative index counting from the end); those rows start from their new
+    /// network's state, the others keep theirs.
     #[pyo3(signature = (rows, networks), text_signature = "($self, rows, networks)")]
     fn assign(&mut self, rows: &Bound<'_, PyAny>, networks: &Bound<'_, PyAny>) -> PyResult<()> {
-        let rows = indices(rows, "rows")?;
-        let networks = indices(networks, "networks")?;
+        let rows = indices(rows, "rows", self.inner.rows())?;
+        let networks = indices(networks, "networks", self.inner.networks())?;
         self.inner.assign(&rows, &networks).py_err()
     }
 
-    /// Sets the chosen rows' states to zero (every row when `rows` is None).
+    /// Sets the chosen rows' states to zero (every row when `rows` is None). `rows` is a boolean
+    /// mask of shape (B,) or row indices, a negative one counting from the end.
     #[pyo3(signature = (rows=None), text_signature = "($self, rows=None)")]
     fn reset(&mut self, rows: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
         let chosen = chosen_rows(rows, self.inner.rows())?;
         self.inner.reset(chosen.as_deref()).py_err()
     }
 
-    /// Sets the chosen rows' states from `states` (B, N) (every row when `rows` is None).
+    /// Sets the chosen rows' states from `states` (B, N) (every row when `rows` is None; chosen as
+    /// in `reset`).
     #[pyo3(signature = (states, rows=None), text_signature = "($self, states, rows=None)")]
     fn set_states(
         &mut self,

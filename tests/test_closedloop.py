@@ -111,7 +111,7 @@ def test_reset_set_states_and_rates() -> None:
     (lambda b: b.step(np.full((4, 2), np.nan)), r"inputs\[0, 0\] is NaN"),
     (lambda b: b.step(np.ones((4, 2)), active=[1, 0, 1, 1]), "active is an array of dtype int64"),
     (lambda b: b.step(np.ones((4, 2)), active=np.ones(3, bool)), r"expected booleans of shape \(4,\)"),
-    (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 4), np.float32)), "out is array"),
+    (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 4), np.float32)), "out is an array of dtype float32 and shape \\(4, 4\\); expected a float64"),
     (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 3))), r"out has shape \(4, 3\)"),
     (lambda b: b.step(np.ones((4, 2)), out=np.empty((4, 8))[:, ::2]), "not C-contiguous"),
     (lambda b: b.reset([4]), "rows holds index 4; this batch has 4 rows"),

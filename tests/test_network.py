@@ -336,3 +336,28 @@ def test_random_takes_ranges_as_config_toml_and_the_config_hold_them() -> None:
         dnnevo.Network.random(3, 1, seed=4, ranges={"tau": [1.0, 2.0, 3.0]})
     with pytest.raises(ConfigError, match="ranges must be a dict"):
         dnnevo.Network.random(3, 1, seed=4, ranges=[1.0, 2.0])
+
+
+@pytest.mark.parametrize("dt, shown", [("x", "'x'"), (True, "True"), (None, "None"),
+                                       (np.ones(3), "an array of dtype float64 and shape (3,)")])
+@pytest.mark.parametrize("call", ["run", "run_population", "Batch"])
+def test_a_time_step_that_is_no_number_is_a_type_error_naming_dt(call: str, dt: object, shown: str) -> None:
+    """pyo3 said only "must be real number, not str"; a bool was taken as 1.0."""
+    net = make(3, 1)
+    calls = {"run": lambda: net.run(np.ones((3, 1)), dt=dt),
+             "run_population": lambda: dnnevo.run_population([net], np.ones((3, 1)), dt=dt),
+             "Batch": lambda: dnnevo.Batch([net], dt=dt)}
+    with pytest.raises(TypeError) as e:
+        calls[call]()
+    assert str(e.value) == f"dt is {shown}; expected a number"
+    # Any number Python takes as a float is one.
+    assert net.copy().run(np.ones((2, 1)), dt=np.float32(0.5)).time[-1] == 1.0
+
+
+def test_an_argument_is_quoted_on_one_line() -> None:
+    """An array where a number belongs is named by its dtype and shape, not a repr of many lines."""
+    with pytest.raises(dnnevo.InvalidArgumentError,
+                       match=r"^size is an array of dtype float64 and shape \(30, 30\); it must be an integer"):
+        dnnevo.Network.random(np.ones((30, 30)), 1, seed=0)
+    with pytest.raises(TypeError, match=r"^seed is 'x{79}\.\.\.; expected an integer$"):
+        dnnevo.Network.random(3, 1, seed="x" * 200)

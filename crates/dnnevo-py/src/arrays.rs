@@ -88,6 +88,30 @@ pub fn to_numpy_read_only<'py>(
     Ok(array)
 }
 
+/// `obj` as an error quotes it, on one line: an array (anything with a dtype and a shape of at
+/// least one dimension) by its dtype and shape, anything else by its repr, its whitespace runs
+/// made one space and cut after [`SHOWN_CHARS`] characters.
+pub fn shown(obj: &Bound<'_, PyAny>) -> String {
+    let text = |a: PyResult<Bound<'_, PyAny>>| a.and_then(|x| x.str().map(|s| s.to_string()));
+    if let (Ok(dtype), Ok(shape)) = (text(obj.getattr("dtype")), text(obj.getattr("shape"))) {
+        if shape != "()" {
+            return format!("an array of dtype {dtype} and shape {shape}");
+        }
+    }
+    let repr = obj
+        .repr()
+        .map(|r| r.to_string())
+        .unwrap_or_else(|_| "?".into());
+    let line = repr.split_whitespace().collect::<Vec<_>>().join(" ");
+    match line.char_indices().nth(SHOWN_CHARS) {
+        Some((cut, _)) => format!("{}...", &line[..cut]),
+        None => line,
+    }
+}
+
+/// The longest repr that [`shown`] quotes whole.
+const SHOWN_CHARS: usize = 80;
+
 /// The error for a malformed argument that is not a network parameter.
 pub fn arg_err(msg: String) -> PyErr {
     InvalidArgumentError::new_err(msg)
@@ -96,11 +120,7 @@ pub fn arg_err(msg: String) -> PyErr {
 /// An integer argument in `T`'s range (e.g. `[0, 2**64)` for `u64`): a negative or too large
 /// value is an `InvalidArgumentError` naming the argument, never an `OverflowError`.
 pub fn uint<T: TryFrom<i128>>(obj: &Bound<'_, PyAny>, name: &str, max: &str) -> PyResult<T> {
-    let what = || {
-        obj.repr()
-            .map(|r| r.to_string())
-            .unwrap_or_else(|_| "?".into())
-    };
+    let what = || shown(obj);
     let is_bool = obj.is_instance_of::<pyo3::types::PyBool>();
     if is_bool || !(obj.is_instance_of::<pyo3::types::PyInt>() || obj.hasattr("__index__")?) {
         return Err(pyo3::exceptions::PyTypeError::new_err(format!(
@@ -154,7 +174,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for AnyInt {
             } else {
                 None
             },
-            repr: obj.repr()?.to_string(),
+            repr: shown(&obj),
             integer,
         })
     }
@@ -171,6 +191,54 @@ impl AnyInt {
         self.value
             .and_then(|v| T::try_from(v).ok())
             .ok_or_else(|| arg_err(message))
+    }
+}
+
+/// A real-number argument, for parameters with a literal default: the value of anything Python
+/// takes as a float (an int, a float, a NumPy number), kept with its `repr` so that
+/// [`AnyFloat::to`] raises a `TypeError` that names the argument for anything else (a string, a
+/// bool), where pyo3 would say only "must be real number".
+#[derive(Clone, Debug)]
+pub struct AnyFloat {
+    value: Option<f64>,
+    repr: String,
+}
+
+impl From<f64> for AnyFloat {
+    fn from(value: f64) -> Self {
+        AnyFloat {
+            value: Some(value),
+            repr: value.to_string(),
+        }
+    }
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for AnyFloat {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let is_bool = obj.is_instance_of::<pyo3::types::PyBool>();
+        Ok(AnyFloat {
+            value: if is_bool {
+                None
+            } else {
+                obj.extract::<f64>().ok()
+            },
+            repr: shown(&obj),
+        })
+    }
+}
+
+impl AnyFloat {
+    /// The value, or a `TypeError` saying `name` must be a number. (Its range is the caller's
+    /// to check.)
+    pub fn to(&self, name: &str) -> PyResult<f64> {
+        self.value.ok_or_else(|| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "{name} is {}; expected a number",
+                self.repr
+            ))
+        })
     }
 }
 

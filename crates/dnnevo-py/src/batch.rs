@@ -11,7 +11,7 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, AnyInt, Dense};
+use crate::arrays::{arg_err, dense, shape_str, shown, to_numpy, AnyFloat, AnyInt, Dense};
 use crate::detach::detached;
 use crate::errors::IntoPy;
 use crate::network::integrator;
@@ -205,17 +205,17 @@ fn indices(obj: &Bound<'_, PyAny>, name: &str, len: usize) -> PyResult<Vec<usize
 #[pymethods]
 impl PyBatch {
     #[new]
-    #[pyo3(signature = (networks, *, replicas=AnyInt::from(1), rows=None, dt=0.1, substeps=AnyInt::from(1), method="euler", precision="f64"), text_signature = "(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method='euler', precision='f64')")]
+    #[pyo3(signature = (networks, *, replicas=AnyInt::from(1), rows=None, dt=AnyFloat::from(0.1), substeps=AnyInt::from(1), method="euler", precision="f64"), text_signature = "(networks, *, replicas=1, rows=None, dt=0.1, substeps=1, method='euler', precision='f64')")]
     fn new(
         networks: &Bound<'_, PyAny>,
         replicas: AnyInt,
         rows: Option<AnyInt>,
-        dt: f64,
+        dt: AnyFloat,
         substeps: AnyInt,
         method: &str,
         precision: &str,
     ) -> PyResult<Self> {
-        let integ = integrator(dt, &substeps, method)?;
+        let integ = integrator(&dt, &substeps, method)?;
         let precision = precision.parse::<Precision>().py_err()?;
         let replicas: usize = replicas.to("replicas", "[1, 2**64)")?;
         let nets = networks_from(networks)?;
@@ -309,10 +309,9 @@ impl PyBatch {
         let out = match out.filter(|o| !o.is_none()) {
             Some(o) => {
                 let arr = o.cast::<PyArray2<f64>>().map_err(|_| {
-                    let what = o.repr().map(|r| r.to_string()).unwrap_or_default();
                     arg_err(format!(
                         "out is {}; expected a float64 NumPy array of shape (B, N) = ({b}, {n})",
-                        what.chars().take(60).collect::<String>()
+                        shown(&o)
                     ))
                 })?;
                 if arr.shape() != [b, n] || !arr.is_c_contiguous() {

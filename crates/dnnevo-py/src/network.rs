@@ -9,7 +9,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict, PyTuple};
 use serde_json::{Map, Value};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, to_numpy_read_only, uint, AnyInt, Dense};
+use crate::arrays::{
+    arg_err, dense, shape_str, shown, to_numpy, to_numpy_read_only, uint, AnyFloat, AnyInt, Dense,
+};
 use crate::detach::detached;
 use crate::errors::{ConfigError, FormatError, IntoPy, InvalidNetworkError};
 use crate::pyjson::{dict_to_map, json_to_py};
@@ -70,11 +72,11 @@ fn param(obj: &Bound<'_, PyAny>, name: &str, ndim: usize, expected: &str) -> PyR
 }
 
 /// Builds the integrator from keyword arguments, raising `InvalidArgumentError` on bad values.
-pub fn integrator(dt: f64, substeps: &AnyInt, method: &str) -> PyResult<Integrator> {
+pub fn integrator(dt: &AnyFloat, substeps: &AnyInt, method: &str) -> PyResult<Integrator> {
     let substeps: usize = substeps.to("substeps", "[1, 2**64)")?;
     let integ = Integrator {
         method: method.parse::<Method>().py_err()?,
-        dt,
+        dt: dt.to("dt")?,
         substeps,
     };
     integ.validate().py_err()?;
@@ -135,7 +137,7 @@ pub fn ranges_from(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Ranges> {
             .ok_or_else(|| {
                 ConfigError::new_err(format!(
                     "ranges[{key:?}] must be a pair [low, high]; it is {}",
-                    value.repr().map(|r| r.to_string()).unwrap_or_default()
+                    shown(&value)
                 ))
             })?;
         match key.as_str() {
@@ -314,17 +316,17 @@ impl PyNetwork {
     /// with `method` ("euler" or "rk4"), in `precision` ("f64" or "f32": see
     /// `run_population`), and keeps the final state (the next call goes on from it; `reset`
     /// starts again). Returns a `Trace`: the states and firing rates after every input row.
-    #[pyo3(signature = (inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", precision="f64"), text_signature = "($self, inputs, *, dt=0.1, substeps=1, method='euler', precision='f64')")]
+    #[pyo3(signature = (inputs, *, dt=AnyFloat::from(0.1), substeps=AnyInt::from(1), method="euler", precision="f64"), text_signature = "($self, inputs, *, dt=0.1, substeps=1, method='euler', precision='f64')")]
     fn run(
         &mut self,
         py: Python<'_>,
         inputs: &Bound<'_, PyAny>,
-        dt: f64,
+        dt: AnyFloat,
         substeps: AnyInt,
         method: &str,
         precision: &str,
     ) -> PyResult<PyTrace> {
-        let integ = integrator(dt, &substeps, method)?;
+        let integ = integrator(&dt, &substeps, method)?;
         let precision = precision.parse::<Precision>().py_err()?;
         let (n, m) = (self.inner.size(), self.inner.n_inputs());
         let x = dense(inputs, "inputs", arg_err)?;
@@ -352,7 +354,7 @@ impl PyNetwork {
                 Precision::F32 => ctrnn::math::sigmoid_f32(v as f32 - theta as f32) as f64,
             };
         }
-        let row_time = dt * integ.substeps as f64;
+        let row_time = integ.dt * integ.substeps as f64;
         let mut time = zeros(steps, "recorded times").py_err()?;
         for (t, out) in time.iter_mut().enumerate() {
             *out = (t + 1) as f64 * row_time;

@@ -6,7 +6,7 @@ use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::{PyAny, PyDict};
 
-use crate::arrays::{arg_err, dense, shape_str, to_numpy, AnyInt, Dense};
+use crate::arrays::{arg_err, dense, shape_str, to_numpy, AnyFloat, AnyInt, Dense};
 use crate::detach::detached;
 use crate::errors::IntoPy;
 use crate::network::PyNetwork;
@@ -170,18 +170,18 @@ fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Stacked> {
 /// is the reference. Every kernel (AVX-512, AVX2, portable, NEON) gives the same bits.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments
-#[pyo3(signature = (networks, inputs, *, dt=0.1, substeps=AnyInt::from(1), method="euler", record=true, precision="f64"), text_signature = "(networks, inputs, *, dt=0.1, substeps=1, method='euler', record=True, precision='f64')")]
+#[pyo3(signature = (networks, inputs, *, dt=AnyFloat::from(0.1), substeps=AnyInt::from(1), method="euler", record=true, precision="f64"), text_signature = "(networks, inputs, *, dt=0.1, substeps=1, method='euler', record=True, precision='f64')")]
 pub fn run_population<'py>(
     py: Python<'py>,
     networks: &Bound<'py, PyAny>,
     inputs: &Bound<'py, PyAny>,
-    dt: f64,
+    dt: AnyFloat,
     substeps: AnyInt,
     method: &str,
     record: bool,
     precision: &str,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let integ = integrator(dt, &substeps, method)?;
+    let integ = integrator(&dt, &substeps, method)?;
     let precision = precision.parse::<Precision>().py_err()?;
     let mut pop = population_from(networks, precision)?;
     let (p_len, n, m) = (pop.len(), pop.size(), pop.n_inputs());

@@ -549,6 +549,7 @@ def test_a_task_class_named_on_the_command_line_runs_resumes_and_is_judged(tmp_p
     judged = dnnevo_command(tmp_path, "assess", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
     assert judged.returncode in (0, 1, 3), judged.stderr
     assert "fresh episodes (seed 3)" in judged.stdout and "needs" in judged.stdout
+    assert "warning" not in judged.stdout  # each episode draws its light
     drawn = dnnevo_command(tmp_path, "plot", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
     assert drawn.returncode == 0, drawn.stderr
     assert (folder / "episodes.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -657,6 +658,8 @@ def test_a_task_without_sensors_runs_and_is_judged_from_the_command_line(tmp_pat
     assert "n_inputs = 0" in (tmp_path / "runs" / "seeker_blind.Blind-seed0" / "config.toml").read_text()
     judged = dnnevo_command(tmp_path, "assess", "runs/seeker_blind.Blind-seed0", "--seed", "1", "--trials", "8")
     assert judged.returncode in (0, 1, 3) and "episodes" in judged.stdout, judged.stderr
+    # The light never moves: every episode is the same, and assess says what that does to the count.
+    assert "warning: all 8 episodes gave the same return and length" in judged.stdout
     analysed = dnnevo_command(tmp_path, "analyze", "runs/seeker_blind.Blind-seed0", "--no-lesions")
     assert analysed.returncode == 0 and "no sweep: the network has no input to vary" in analysed.stdout, \
         analysed.stderr

@@ -79,14 +79,24 @@ class UserTask:
             task=config.task, trials=trials, unit=self.UNIT, seed=seed, rates=[overall_rate],
             verdict=overall_rate.verdict or "undecided", method=INDEPENDENT,
             details={"mean_return": float(result.returns.mean()),
-                     "mean_length": float(result.lengths.mean())},
+                     "mean_length": float(result.lengths.mean()),
+                     "all_alike": bool(trials > 1 and np.ptp(result.returns) == 0
+                                       and np.ptp(result.lengths) == 0)},
         )
 
     def preface(self, where: Path, a: Assessment) -> list[str]:
-        """What ``assess`` ran, and the episodes' mean return and length."""
+        """What ``assess`` ran, and the episodes' mean return and length; a warning when every
+        episode gave the same return and length, as the episodes of a task that draws nothing
+        from ``rng`` do: they are then one trial repeated, and the interval, which counts them as
+        independent, is too narrow."""
         d = a.details
-        return [f"{where}: champion on {a.trials} fresh episodes (seed {a.seed}); mean return "
-                f"{d['mean_return']:.4g}, mean length {d['mean_length']:.1f} steps."]
+        lines = [f"{where}: champion on {a.trials} fresh episodes (seed {a.seed}); mean return "
+                 f"{d['mean_return']:.4g}, mean length {d['mean_length']:.1f} steps."]
+        if d.get("all_alike"):
+            lines.append(f"warning: all {a.trials} episodes gave the same return and length; if the "
+                         "task draws nothing from rng they are one trial repeated, and the interval "
+                         "below, which counts them as independent, is too narrow (docs/closed-loop.md)")
+        return lines
 
     def draw(self, run: RunDir, config: EvolutionConfig, seed: int, *,
              animate: bool = False) -> list[str]:

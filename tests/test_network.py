@@ -361,3 +361,33 @@ def test_an_argument_is_quoted_on_one_line() -> None:
         dnnevo.Network.random(np.ones((30, 30)), 1, seed=0)
     with pytest.raises(TypeError, match=r"^seed is 'x{79}\.\.\.; expected an integer$"):
         dnnevo.Network.random(3, 1, seed="x" * 200)
+
+
+def test_a_genome_makes_its_network_and_a_population_its_stacked_arrays() -> None:
+    """An optimiser of one's own: Network.from_genome inverts genome(), and stack_genomes gives
+    the arrays run_population, Batch and rollout take, scoring the bits of the networks."""
+    from dnnevo.closedloop import FarSeeker, rollout
+
+    nets = [make(3, 1, seed=s) for s in range(5)]
+    genomes = np.stack([n.genome() for n in nets])
+    assert genomes.shape == (5, 3 * (2 + 1 + 3))
+    again = [dnnevo.Network.from_genome(g, size=3, n_inputs=1) for g in genomes]
+    for a, b in zip(again, nets, strict=True):
+        for name in ("tau", "theta", "weights", "sensor_weights"):
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    stacked = dnnevo.stack_genomes(genomes, size=3, n_inputs=1)
+    for rows in (None, 4):  # every episode at once, and queued in 4 rows
+        by_arrays = rollout(stacked, FarSeeker(), episodes=2, max_steps=40, rows=rows)
+        by_networks = rollout(nets, FarSeeker(), episodes=2, max_steps=40, rows=rows)
+        np.testing.assert_array_equal(by_arrays.returns, by_networks.returns)
+    with pytest.raises(InvalidArgumentError, match=r"genomes has shape \(5, 17\); expected \(P, G\) with "
+                                                   r"G = N x \(2 \+ M \+ N\) = 18"):
+        dnnevo.stack_genomes(genomes[:, :-1], size=3, n_inputs=1)
+    with pytest.raises(InvalidArgumentError, match="genome has 17 genes"):
+        dnnevo.Network.from_genome(genomes[0, :-1], size=3, n_inputs=1)
+    bad = genomes.copy()
+    bad[2, 0] = -1.0
+    with pytest.raises(InvalidNetworkError, match="tau"):
+        dnnevo.run_population(dnnevo.stack_genomes(bad, size=3, n_inputs=1), np.ones((2, 1)))
+    with pytest.raises(InvalidNetworkError, match=r"gene 0 \(neuron 0, tau\[0\]\) is -1"):
+        dnnevo.Network.from_genome(bad[2], size=3, n_inputs=1)

@@ -80,7 +80,6 @@ CALLS = [
     (NAV1D.assess, (NET5_1, 1, 0), ["chains", "seed"]),
     (LANDMARK.record, (NET8, 1, 0, 0, False), ["landmark", "seed", "trial"]),
     (LANDMARK.assess, (NET8, 1, 0, False), ["per_landmark", "seed"]),
-    (_core.decode, (2, 1, [1.0] * 12), ["size", "n_inputs"]),
     (_core.condition_seed, (0, 0), ["seed", "generation"]),
 ]
 

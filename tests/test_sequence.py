@@ -214,7 +214,7 @@ def test_evaluate_matches_reference(generation, seed):
     assert got[0] == pytest.approx(np.mean(perf), abs=1e-12)
     assert np.ptp(got) > 0.05, "the networks should not all score alike"
     # Genomes score like the networks they encode.
-    genomes = np.stack([dnnevo._core.encode(n) for n in nets])
+    genomes = np.stack([n.genome() for n in nets])
     again = dnnevo.evaluate("sequence", genomes, generation=generation, seed=seed, config=cfg)
     np.testing.assert_array_equal(again, got)
 

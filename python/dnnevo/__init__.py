@@ -38,6 +38,7 @@ from dnnevo.errors import (
 )
 from dnnevo.evolution.evolve import EvolutionResult, evaluate, evolve, resume
 from dnnevo.evolution.ga import GeneticAlgorithm
+from dnnevo.genomes import stack_genomes
 
 _core.apply_simd_env()  # DNNEVO_SIMD, if set, names the kernel; a bad value fails the import
 
@@ -57,6 +58,7 @@ __all__ = [
     "plot",
     "presets",
     "resume",
+    "stack_genomes",
     "DnnevoError",
     "FitnessError",
     "FormatError",

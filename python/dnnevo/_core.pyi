@@ -106,6 +106,22 @@ class Network:
         state: npt.ArrayLike | None = None,
     ) -> Network: ...
     @staticmethod
+    def from_genome(genes: npt.ArrayLike, *, size: int, n_inputs: int) -> Network:
+        """The network that the genome ``genes`` (G,) encodes, its state zero: one block per
+        neuron, in order, of its ``tau``, its ``theta``, its M sensor weights and its N incoming
+        weights (``weights[i][:]``), so G = N (2 + M + N), in model units, as dnnevo's genetic
+        algorithm evolves them; the inverse of :meth:`genome`, for an optimiser of your own.
+
+        >>> net = Network.from_genome([1.0, 0.0, 0.5, 2.0], size=1, n_inputs=1)
+        >>> net.tau.tolist(), net.sensor_weights.tolist(), net.weights.tolist()
+        ([1.0], [[0.5]], [[2.0]])
+        >>> Network.from_genome(net.genome(), size=1, n_inputs=1) == net
+        True
+        """
+    def genome(self) -> _Array:
+        """The network's genome, shape (G,) (its state is not part of it); see
+        :meth:`from_genome`."""
+    @staticmethod
     def random(
         size: int,
         n_inputs: int,
@@ -323,8 +339,6 @@ def evaluate(
     threads: int | None = None,
 ) -> _Array: ...
 def task_names() -> list[str]: ...
-def decode(size: int, n_inputs: int, genes: npt.ArrayLike) -> Network: ...
-def encode(net: Network) -> _Array: ...
 
 # -- the sequence-learning task ---------------------------------------------------------------
 

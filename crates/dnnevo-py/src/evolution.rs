@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 use ctrnn::evolve::Stats;
-use ctrnn::genome::{self, Layout};
+use ctrnn::genome;
 use ctrnn::{Evolution, Network, Task, Validation};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -395,22 +395,4 @@ pub fn evaluate<'py>(
 #[pyfunction]
 pub fn task_names() -> Vec<&'static str> {
     tasks::registry::names().to_vec()
-}
-
-/// Decodes one genome into a network.
-#[pyfunction]
-pub fn decode(size: AnyInt, n_inputs: AnyInt, genes: &Bound<'_, PyAny>) -> PyResult<PyNetwork> {
-    let size: usize = size.to("size", "[0, 2**64)")?;
-    let n_inputs: usize = n_inputs.to("n_inputs", "[0, 2**64)")?;
-    let g = dense(genes, "genes", arg_err)?;
-    let net = genome::decode(Layout { size, n_inputs }, &g.data).py_err()?;
-    Ok(PyNetwork::from_core(net))
-}
-
-/// Encodes a network as its genome, shape (G,).
-#[pyfunction]
-pub fn encode<'py>(py: Python<'py>, net: &PyNetwork) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let genes = genome::encode(&net.inner);
-    let n = genes.len();
-    to_numpy(py, genes, &[n])
 }

@@ -47,7 +47,7 @@ mod _core {
     #[pymodule_export]
     use super::evolution::process_threads;
     #[pymodule_export]
-    use super::evolution::{decode, encode, evaluate, task_names, PyEvolution};
+    use super::evolution::{evaluate, task_names, PyEvolution};
     #[pymodule_export]
     use super::landmark::{
         sim2d_cast_rays, sim2d_landmark_world, PyLandmarkRecord, PyLandmarkTask,

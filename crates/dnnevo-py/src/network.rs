@@ -210,6 +210,38 @@ impl PyNetwork {
         Ok(PyNetwork::from_core(inner))
     }
 
+    /// The network that the genome `genes` (G,) encodes, with its state at zero: one block per
+    /// neuron, in order, of its tau, its theta, its M sensor weights and its N incoming weights
+    /// (`weights[i][:]`), so G = N (2 + M + N), in model units, as dnnevo's genetic algorithm
+    /// evolves them. The exact inverse of [`genome`](Self::genome): for an optimiser of one's
+    /// own. A wrong length, a non-finite gene or a time constant that is not positive is named
+    /// with its gene and neuron.
+    #[staticmethod]
+    #[pyo3(signature = (genes, *, size, n_inputs))]
+    fn from_genome(
+        genes: &Bound<'_, PyAny>,
+        size: &Bound<'_, PyAny>,
+        n_inputs: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        let size: usize = uint(size, "size", "[1, 2**64)")?;
+        let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
+        let layout = Layout { size, n_inputs };
+        layout.validate().py_err()?;
+        let g = dense(genes, "genes", arg_err)?;
+        g.expect_ndim(1, "genes", "(G,)", arg_err)?;
+        Ok(PyNetwork::from_core(
+            genome::decode(layout, &g.data).py_err()?,
+        ))
+    }
+
+    /// The network's genome, shape (G,): the inverse of [`from_genome`](Self::from_genome)
+    /// (its state is not part of it).
+    fn genome<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let genes = genome::encode(&self.inner);
+        let n = genes.len();
+        to_numpy(py, genes, &[n])
+    }
+
     /// A network with every parameter drawn uniformly over its range (default ranges: tau
     /// [0.5, 10], theta, weights and sensor_weights [-16, 16]); the state is zero.
     #[staticmethod]

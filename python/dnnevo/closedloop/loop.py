@@ -16,7 +16,7 @@ shape, a value that is not finite or an exception names the method and the probl
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -52,7 +52,7 @@ class Rollout:
 
 
 def rollout(
-    networks: Sequence[_core.Network],
+    networks: Sequence[_core.Network] | Mapping[str, npt.ArrayLike],
     env: Environment,
     *,
     episodes: int = 1,
@@ -70,7 +70,11 @@ def rollout(
     ``max_steps`` time steps of ``substeps`` integration steps of ``dt`` each. ``dt``,
     ``substeps`` and ``method`` default to the run config's ``[integrator]`` (10 Euler steps of
     0.1 per time step), as :class:`~dnnevo.closedloop.ClosedLoop`'s do, so that a champion
-    evolved with the defaults is judged at the step it was evolved with.
+    evolved with the defaults is judged at the step it was evolved with. ``networks`` is a list
+    of networks or, as :class:`dnnevo.Batch` takes them, stacked arrays (``tau`` (P, N),
+    ``theta`` (P, N), ``weights`` (P, N, N), ``sensor_weights`` (P, N, M)), which an optimiser of
+    your own makes from its genomes with :func:`dnnevo.stack_genomes` without a network object
+    per genome.
 
     ``rows`` runs at most that many episodes at once (at least ``episodes``; more than all
     ``P * episodes`` runs them all): when an episode ends, the next waiting one starts in its
@@ -100,8 +104,8 @@ def rollout(
         if nonnegative("rows", rows) < episodes:
             raise InvalidArgumentError(f"rows is {rows}; it must be at least episodes ({episodes}), "
                                        "so that the first reset sees every episode number")
-        if rows < len(networks) * episodes:
-            return _queued(networks, env, episodes=episodes, max_steps=max_steps, rows=rows,
+        if rows < _count(networks) * episodes:
+            return _queued(env, episodes=episodes, max_steps=max_steps, rows=rows,
                            rng=np.random.default_rng(_core.condition_seed(seed, generation, draw)),
                            batch=_core.Batch(networks, replicas=episodes, rows=rows, **integrator))
     batch = _core.Batch(networks, replicas=episodes, **integrator)
@@ -144,6 +148,14 @@ def rollout(
     return Rollout(returns=returns.reshape(shape), lengths=lengths.reshape(shape))
 
 
+def _count(networks: Sequence[_core.Network] | Mapping[str, npt.ArrayLike]) -> int:
+    """How many networks ``networks`` holds: a list's length, or the rows of stacked arrays'
+    ``tau`` (whose shapes the batch checks)."""
+    if isinstance(networks, Mapping) and "tau" in networks:
+        return len(np.asarray(networks["tau"]))
+    return len(networks)
+
+
 def _check_sensors(env: Any, m: int) -> None:
     """Refuses an environment whose ``observation_size`` is not the networks' ``m`` inputs."""
     if sensors(env) != m:
@@ -151,15 +163,15 @@ def _check_sensors(env: Any, m: int) -> None:
                         f"have {m} input{'' if m == 1 else 's'}")
 
 
-def _queued(networks: Sequence[_core.Network], env: Any, *, episodes: int, max_steps: int,
-            rows: int, rng: np.random.Generator, batch: _core.Batch) -> Rollout:
+def _queued(env: Any, *, episodes: int, max_steps: int, rows: int, rng: np.random.Generator,
+            batch: _core.Batch) -> Rollout:
     """:func:`rollout` with ``rows`` rows, fewer than its episodes: a row whose episode ends
     starts the next waiting one (episode ``q`` is episode ``q % E`` of network ``q // E``)."""
     restart = getattr(env, "restart", None)
     if restart is None:
         raise TaskError(f"{_name(env)} has no restart method; without one, rows must be None or "
-                        f"at least P x episodes = {len(networks) * episodes}")
-    total, m = len(networks) * episodes, batch.n_inputs
+                        f"at least P x episodes = {batch.networks * episodes}")
+    total, m = batch.networks * episodes, batch.n_inputs
     _check_sensors(env, m)
     batch.reset()
     episode = np.arange(rows, dtype=np.int64)  # the episode each row runs
@@ -209,7 +221,7 @@ def _queued(networks: Sequence[_core.Network], env: Any, *, episodes: int, max_s
         if not running.any():
             break
         limit = int(start[running].min()) + max_steps
-    shape = (len(networks), episodes)
+    shape = (batch.networks, episodes)
     return Rollout(returns=returns.reshape(shape), lengths=lengths.reshape(shape))
 
 

@@ -107,7 +107,7 @@ def evaluate(
                 raise InvalidArgumentError(f"genomes must be an array (P, G) or a list of networks: {e}") from None
             if rows.ndim != 2:
                 raise InvalidArgumentError(f"genomes must be an array (P, G) or a list of networks; got shape {rows.shape}")
-            networks = [_core.decode(config.size, config.n_inputs, row) for row in rows]
+            networks = [_core.Network.from_genome(row, size=config.size, n_inputs=config.n_inputs) for row in rows]
         return named.closed_loop(config)(networks, generation=generation, seed=seed)
     return _core.evaluate(
         config.native,

@@ -207,6 +207,7 @@ def test_config_validation_messages() -> None:
         ({"fill": "zeros"}, "fill: unknown variant `zeros`"),
         ({"mutation_scale": 0.0}, "mutation_scale is 0; it must be in (0, 1]"),
         ({"mutation_scale": 2}, "mutation_scale is 2"),
+        ({"mutation_scale": 0.1}, 'mutation_scale is 0.1, but mutation is "uniform", which redraws a gene'),
         ({"generations": 0}, "generations is 0"),
         ({"size": 0}, "size is 0"),
         ({"task": ""}, "task is empty"),

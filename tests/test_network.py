@@ -73,7 +73,7 @@ def test_run_trace_and_state() -> None:
         ({"weights": np.zeros((3, 2))}, "weights has shape (3, 2); expected (N, N) = (3, 3)"),
         ({"weights": np.zeros(9)}, "weights has shape (9,); expected (N, N)"),
         ({"sensor_weights": np.zeros((2, 2))}, "sensor_weights has shape (2, 2)"),
-        ({"theta": [0.0]}, "theta has 1 values; expected N = 3"),
+        ({"theta": [0.0]}, "theta has 1 value; expected N = 3"),
         ({"state": [0.0, 0.0]}, "state has 2 values"),
         ({"tau": []}, "at least 1 neuron"),
         ({"tau": ["a", "b", "c"]}, "tau is not a numeric array"),
@@ -172,8 +172,8 @@ def test_copy_and_pickle() -> None:
         (lambda d: d.update(format="other"), 'expected "dnnevo-network"'),
         (lambda d: d.update(version=2), "version is 2"),
         (lambda d: d.pop("tau"), "missing field `tau`"),
-        (lambda d: d.update(theta=[0.0]), "theta has 1 values"),
-        (lambda d: d.update(weights=[[0.0]]), "weights has 1 rows"),
+        (lambda d: d.update(theta=[0.0]), "theta has 1 value;"),
+        (lambda d: d.update(weights=[[0.0]]), "weights has 1 row;"),
         (lambda d: d.update(tau=[1.0, -1.0, 1.0]), "tau[1]"),
         (lambda d: d.update(theta=[0.0, "x", 0.0]), "theta[1]"),
         (lambda d: d.update(extra=1), "unknown field `extra`"),
@@ -391,3 +391,31 @@ def test_a_genome_makes_its_network_and_a_population_its_stacked_arrays() -> Non
         dnnevo.run_population(dnnevo.stack_genomes(bad, size=3, n_inputs=1), np.ones((2, 1)))
     with pytest.raises(InvalidNetworkError, match=r"gene 0 \(neuron 0, tau\[0\]\) is -1"):
         dnnevo.Network.from_genome(bad[2], size=3, n_inputs=1)
+
+
+def _beer_euler(taus, biases, gains, w, y, inputs, dt):
+    """A plain port of Beer's CTRNN::EulerStep (w[j][i] from j to i): the states after each step."""
+    out = []
+    for row in inputs:
+        rates = 1.0 / (1.0 + np.exp(-(gains * (y + biases))))
+        y = y + dt / taus * (row + w.T @ rates - y)
+        out.append(y)
+    return np.array(out)
+
+
+def test_a_network_in_beer_s_conventions_gives_beer_s_firing_rates() -> None:
+    from dnnevo.beer import from_beer
+
+    rng = np.random.default_rng(3)
+    n = 4
+    taus, biases = rng.uniform(0.5, 5, n), rng.uniform(-5, 5, n)
+    gains, w, y0 = rng.uniform(-2, 3, n), rng.uniform(-8, 8, (n, n)), rng.uniform(-1, 1, n)
+    inputs = rng.uniform(-1, 1, (300, n))
+    beer = _beer_euler(taus, biases, gains, w, y0, inputs, 0.01)
+    trace = from_beer(taus, biases, gains, w, states=y0).run(inputs, dt=0.01)
+    np.testing.assert_allclose(trace.outputs, 1.0 / (1.0 + np.exp(-(gains * (beer + biases)))), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(trace.states, gains * beer, rtol=0, atol=1e-12)
+    with pytest.raises(InvalidNetworkError, match=r"weights has shape \(3, 4\); expected \(N, N\) = \(4, 4\)"):
+        from_beer(taus, biases, gains, w[:3])
+    with pytest.raises(InvalidNetworkError, match=r"gains has shape \(3,\); expected \(N,\)"):
+        from_beer(taus, biases, gains[:3], w)

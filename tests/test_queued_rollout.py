@@ -177,7 +177,7 @@ def test_a_batch_of_fewer_rows_hands_rows_to_other_networks() -> None:
         (([3], [0]), "row 3 is out of range; the batch has 3 rows"),
         (([0], [4]), "network 4 is out of range; the batch has 4 networks"),
         (([0, 0], [1, 2]), "row 0 is named twice"),
-        (([0], [0, 1]), "1 rows and 2 networks"),
+        (([0], [0, 1]), "1 row and 2 networks"),
         (([-4], [0]), r"rows holds index -4; there are 3 rows, so indices run from -3 to 2"),
         (([0], [-5]), r"networks holds index -5; there are 4 networks, so indices run from -4 to 3"),
         (([0.5], [0]), "rows is an array of dtype float64 and 1 dimensions; expected a 1-D array of indices"),

@@ -412,7 +412,8 @@ impl Batch {
             Ok(())
         } else {
             Err(Error::InvalidArgument(format!(
-                "{name} has {len} values; expected {shape} = {want} (B = {}, M = {}, N = {})",
+                "{name} has {}; expected {shape} = {want} (B = {}, M = {}, N = {})",
+                crate::error::counted(len, "value"),
                 self.rows(),
                 self.n_inputs,
                 self.size
@@ -500,9 +501,9 @@ impl Batch {
     pub fn assign(&mut self, rows: &[usize], networks: &[usize]) -> Result<()> {
         if rows.len() != networks.len() {
             return Err(Error::InvalidArgument(format!(
-                "{} rows and {} networks; expected one network per row",
-                rows.len(),
-                networks.len()
+                "{} and {}; expected one network per row",
+                crate::error::counted(rows.len(), "row"),
+                crate::error::counted(networks.len(), "network")
             )));
         }
         let (b_len, p_len) = (self.rows(), self.networks.len());

@@ -73,3 +73,13 @@ pub(crate) fn index_label(k: usize, cols: usize) -> String {
         Some(row) => format!("[{row}][{}]", k % cols),
     }
 }
+
+/// `n` and `noun`, the noun plural unless `n` is 1, for messages: `counted(1, "value")` is
+/// "1 value", `counted(3, "value")` "3 values".
+pub(crate) fn counted(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}

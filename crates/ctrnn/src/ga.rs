@@ -203,6 +203,13 @@ impl GaConfig {
                 self.mutation_scale
             )));
         }
+        if self.mutation == MutationKind::Uniform && self.mutation_scale != MUTATION_SCALE {
+            return Err(Error::Config(format!(
+                "mutation_scale is {}, but mutation is \"uniform\", which redraws a gene and has \
+                 no step to scale; set mutation = \"creep\" to use it",
+                self.mutation_scale
+            )));
+        }
         if self.champion_step_check && self.validation_candidates == 0 {
             return Err(Error::Config(
                 "champion_step_check is on but validation_candidates is 0; the step check \
@@ -363,14 +370,14 @@ pub fn next_generation(
     let (p, g) = (config.population, layout.len());
     if fitness.len() != p {
         return Err(Error::InvalidArgument(format!(
-            "fitness has {} values; expected population = {p}",
-            fitness.len()
+            "fitness has {}; expected population = {p}",
+            crate::error::counted(fitness.len(), "value")
         )));
     }
     if parents.len() != p * g {
         return Err(Error::InvalidArgument(format!(
-            "parents has {} values; expected population x genome length = {p} x {g} = {}",
-            parents.len(),
+            "parents has {}; expected population x genome length = {p} x {g} = {}",
+            crate::error::counted(parents.len(), "value"),
             p * g
         )));
     }

@@ -147,15 +147,15 @@ pub fn from_json(text: &str) -> Result<NetworkFile> {
     let flatten = |field: &str, rows: Vec<Vec<f64>>, cols: Option<usize>| -> Result<Vec<f64>> {
         if rows.len() != n {
             return Err(Error::Format(format!(
-                "{field} has {} rows; expected N = {n} (the length of tau)",
-                rows.len()
+                "{field} has {}; expected N = {n} (the length of tau)",
+                crate::error::counted(rows.len(), "row")
             )));
         }
         let cols = cols.unwrap_or_else(|| rows.first().map_or(0, Vec::len));
         if let Some(i) = rows.iter().position(|r| r.len() != cols) {
             return Err(Error::Format(format!(
-                "{field}[{i}] has {} values; expected {cols}",
-                rows[i].len()
+                "{field}[{i}] has {}; expected {cols}",
+                crate::error::counted(rows[i].len(), "value")
             )));
         }
         Ok(rows.concat())

@@ -257,7 +257,8 @@ fn expect_len(field: &str, got: usize, want: usize, shape: &str) -> Result<()> {
         Ok(())
     } else {
         Err(Error::InvalidNetwork(format!(
-            "{field} has {got} values; expected {shape} = {want}"
+            "{field} has {}; expected {shape} = {want}",
+            crate::error::counted(got, "value")
         )))
     }
 }

@@ -195,6 +195,11 @@ def evolve(
     ``founders`` are networks placed first in the initial population (e.g. from :func:`compose`;
     ``seeds``, its old name, is deprecated). ``run_info`` adds entries to the ``[run]`` table of
     ``config.toml``, e.g. where the founders came from.
+
+    ``threads`` (default: every core) sizes a built-in task's own thread pool. A task written in
+    Python steps its networks on the process's shared pool, which takes a size only before its
+    first use: the first call sizes it for the whole process (later calls, ``run_population`` and
+    ``Batch`` included), and a later ``threads`` that differs is said on stderr and does not apply.
     """
     _check_task(task)
     named_task = isinstance(task, str)  # a task built from its name is built so again

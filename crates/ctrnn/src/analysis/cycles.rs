@@ -4,9 +4,9 @@
 //! transient has passed. If some neuron still moves, the section is the level halfway between
 //! that neuron's extremes (the neuron that moves most), crossed upwards. A cycle is closed when
 //! the state at a crossing returns, within [`CycleSearch::tolerance`], to the state one, two, three
-//! or four crossings earlier; a closure after several crossings that is a cycle of fewer still
-//! converging (its crossings alternating about the cycle's, as a negative multiplier makes them)
-//! is that cycle of fewer crossings. One period from that crossing, integrated together with the
+//! or four crossings earlier; a closure after several crossings may be a cycle of fewer whose
+//! crossings alternate about it as they converge (a negative multiplier), which is looked for by
+//! waiting while it converges and by extrapolating its crossings (docs/analysis.md). One period from that crossing, integrated together with the
 //! variational equation `dPhi/dt = J(v(t)) Phi`, gives the orbit, the amplitude of each neuron and
 //! the monodromy matrix, whose eigenvalues are the Floquet multipliers. One multiplier is 1 (along
 //! the orbit); the cycle is stable when every other one lies inside the unit circle. An orbit
@@ -334,6 +334,8 @@ fn from_start(
     let level = (lo[k] + hi[k]) / 2.0;
     let window = (settings.window * tau_max / dt).ceil() as usize;
     let mut sections: Vec<(f64, Vec<f64>)> = Vec::new();
+    // The last closure after several crossings: how many, at which crossing.
+    let mut closed: Option<(usize, usize)> = None;
     let mut prev = v.clone();
     for s in 0..window {
         if s % 4096 == 0 {
@@ -344,21 +346,93 @@ fn from_start(
             let (h, x) = rk.cross(field, &prev, dt, k, level, v[k]);
             let t = s as f64 * dt + h;
             sections.push((t, x));
-            // A closure after p > 1 crossings waits until p more crossings tell whether it is a
-            // cycle of fewer crossings converging ([`converging`]).
-            let decided = |p: usize| p == 1 || sections.len() > 2 * p;
-            if let Some(p) = closing(&sections, settings.tolerance).filter(|&p| decided(p)) {
-                let q = (1..p)
-                    .find(|&q| p % q == 0 && converging(&sections, q, p))
-                    .unwrap_or(p);
-                let (t0, _) = &sections[sections.len() - 1 - q];
-                let (t, x) = &sections[sections.len() - 1];
-                return describe(field, x, t - t0, q, k, dt, settings);
+            let last = sections.len() - 1;
+            match closing(&sections, settings.tolerance) {
+                Some(1) => return describe_closed(field, &sections, 1, last, k, dt, settings),
+                // A closure after p > 1 crossings may be a cycle of q crossings (q dividing p)
+                // whose crossings alternate about it as they converge ([`converging`]): with p
+                // more crossings to tell, integration goes on while such a q still converges,
+                // until q closes too or the window ends.
+                Some(p) => {
+                    closed = Some((p, last));
+                    let waiting =
+                        (1..p).any(|q| p.is_multiple_of(q) && converging(&sections, q, p));
+                    if sections.len() > 2 * p && !waiting {
+                        return settle(field, &sections, p, last, k, dt, settings);
+                    }
+                }
+                None => {}
             }
         }
         prev.copy_from_slice(&v);
     }
-    Ok(None)
+    match closed {
+        Some((p, at)) => settle(field, &sections, p, at, k, dt, settings),
+        None => Ok(None),
+    }
+}
+
+/// The cycle of an orbit that closed at crossing `at` after `p > 1` crossings: a stable cycle of
+/// fewer crossings `q` (dividing `p`) when the last crossings `q` apart, extrapolated to their
+/// limit ([`extrapolated`]), give one (so slowly converging that `q` never closed, as near a
+/// multiplier of -1), else the orbit that closed. Near a genuine cycle of `p` crossings the
+/// extrapolated orbit does not close, or closes on an unstable cycle, and is not taken.
+fn settle(
+    field: &Field<'_>,
+    sections: &[(f64, Vec<f64>)],
+    p: usize,
+    at: usize,
+    k: usize,
+    dt: f64,
+    settings: &CycleSearch,
+) -> Result<Option<Cycle>> {
+    for q in (1..p).filter(|&q| p.is_multiple_of(q)) {
+        if let Some((x, period)) = extrapolated(sections, q) {
+            if let Some(cycle) = describe(field, &x, period, q, k, dt, settings)? {
+                if cycle.stable {
+                    return Ok(Some(cycle));
+                }
+            }
+        }
+    }
+    describe_closed(field, sections, p, at, k, dt, settings)
+}
+
+/// [`describe`] of the orbit that closed at crossing `at` after `p` crossings.
+fn describe_closed(
+    field: &Field<'_>,
+    sections: &[(f64, Vec<f64>)],
+    p: usize,
+    at: usize,
+    k: usize,
+    dt: f64,
+    settings: &CycleSearch,
+) -> Result<Option<Cycle>> {
+    let (t, x) = &sections[at];
+    describe(field, x, t - sections[at - p].0, p, k, dt, settings)
+}
+
+/// The limit of crossings `q` apart that alternate about a cycle's as they converge, and its
+/// period: with `r` the ratio of the last two gaps `q` apart (the modulus of the cycle's
+/// dominant multiplier), `x* = (x_k + r x_{k-q}) / (1 + r)`, and the same of the last two
+/// periods. None without the crossings to tell or when the gaps do not shrink.
+fn extrapolated(sections: &[(f64, Vec<f64>)], q: usize) -> Option<(Vec<f64>, f64)> {
+    let k = sections.len().checked_sub(1)?;
+    if k < 2 * q {
+        return None;
+    }
+    let (a, b, c) = (&sections[k], &sections[k - q], &sections[k - 2 * q]);
+    let r = gap(&a.1, &b.1) / gap(&b.1, &c.1);
+    if !(r.is_finite() && r < 1.0) {
+        return None;
+    }
+    let x =
+        a.1.iter()
+            .zip(&b.1)
+            .map(|(p, q)| (p + r * q) / (1.0 + r))
+            .collect();
+    let period = ((a.0 - b.0) + r * (b.0 - c.0)) / (1.0 + r);
+    Some((x, period))
 }
 
 /// The state at crossing `a` minus the one at crossing `b`, in the max norm; NaN when either has
@@ -384,6 +458,9 @@ fn closing(sections: &[(f64, Vec<f64>)], tolerance: f64) -> Option<usize> {
 /// first; on a cycle of `p` crossings the gap `q` apart stays the distance between two of them.
 fn converging(sections: &[(f64, Vec<f64>)], q: usize, p: usize) -> bool {
     let last = sections.len() - 1;
+    if last < p + q {
+        return false;
+    }
     let lag = |at: usize| gap(&sections[at].1, &sections[at - q].1);
     lag(last) < CONVERGING * lag(last - p)
 }

@@ -90,7 +90,7 @@ fn validation_names_field_and_index() {
         vec![],
         Some(vec![0.0]),
     ));
-    assert!(e.contains("state has 1 values"), "{e}");
+    assert!(e.contains("state has 1 value;"), "{e}");
 }
 
 #[test]

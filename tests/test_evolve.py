@@ -251,7 +251,7 @@ def test_creep_mutation_runs_deterministically_and_differs_from_uniform() -> Non
         return ga.ask().genomes
 
     np.testing.assert_array_equal(genomes_after(creep), genomes_after(creep))
-    uniform = genomes_after(dataclasses.replace(creep, mutation="uniform"))
+    uniform = genomes_after(dataclasses.replace(creep, mutation="uniform", mutation_scale=SMALL.mutation_scale))
     assert not np.array_equal(genomes_after(creep), uniform)
     assert EvolutionConfig.from_toml(creep.to_toml()) == creep
 

@@ -419,3 +419,18 @@ def test_a_network_in_beer_s_conventions_gives_beer_s_firing_rates() -> None:
         from_beer(taus, biases, gains, w[:3])
     with pytest.raises(InvalidNetworkError, match=r"gains has shape \(3,\); expected \(N,\)"):
         from_beer(taus, biases, gains[:3], w)
+
+
+def test_beer_s_parameter_names_point_to_the_conversion() -> None:
+    """A setting, a range or a network-file field named as in Beer's code says what dnnevo has."""
+    import json
+
+    from dnnevo.config import apply_overrides
+
+    for item in ("ranges.bias=[-16,16]", "gains=1"):
+        with pytest.raises(dnnevo.ConfigError, match=r"dnnevo has no biases or gains: theta = -bias"):
+            apply_overrides(dnnevo.EvolutionConfig(), [item])
+    doc = json.loads(make(2, 1).to_json())
+    doc["biases"] = [0.0, 0.0]
+    with pytest.raises(dnnevo.FormatError, match=r"unknown field `biases`: this format has thresholds, theta = -bias"):
+        dnnevo.Network.from_json(json.dumps(doc))

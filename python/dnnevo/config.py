@@ -21,7 +21,7 @@ import numpy as np
 import tomli_w
 
 from dnnevo import _core
-from dnnevo.errors import ConfigError, DnnevoError, did_you_mean
+from dnnevo.errors import ConfigError, DnnevoError, beer_hint, did_you_mean
 
 __all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides", "with_later_defaults"]
 
@@ -432,13 +432,13 @@ def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> Evolutio
         value = _parse_value(raw.strip())
         head, _, sub = key.partition(".")
         if head not in d:
-            raise ConfigError(f"unknown setting {key!r}{did_you_mean(key, d)}; "
+            raise ConfigError(f"unknown setting {key!r}{beer_hint(key) or did_you_mean(key, d)}; "
                               f"known settings: {', '.join(sorted(d))}")
         if sub:
             if not isinstance(d[head], dict):
                 raise ConfigError(f"{head} is not a table, so {key!r} cannot be set")
             if head != "task_params" and sub not in d[head]:
-                hint = did_you_mean(key, [f"{head}.{k}" for k in d[head]])
+                hint = beer_hint(key) or did_you_mean(key, [f"{head}.{k}" for k in d[head]])
                 raise ConfigError(
                     f"unknown setting {key!r}{hint}; {head} has {', '.join(sorted(d[head]))}"
                 )

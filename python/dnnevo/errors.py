@@ -65,6 +65,19 @@ def with_article(noun: str) -> str:
     return f"{'an' if vowel else 'a'} {noun}"
 
 
+def beer_hint(name: str) -> str:
+    """The hint an "unknown name" message carries when ``name`` (or its last dotted part) is a
+    parameter of Beer's CTRNN code that dnnevo's networks do not have, else ``""``.
+
+    >>> beer_hint("ranges.bias")
+    ' (dnnevo has no biases or gains: theta = -bias, and a gain folds into theta and the weights; docs/network-format.md, dnnevo.beer.from_beer)'
+    """
+    if name.rpartition(".")[2].lower() not in ("bias", "biases", "gain", "gains"):
+        return ""
+    return (" (dnnevo has no biases or gains: theta = -bias, and a gain folds into theta and the "
+            "weights; docs/network-format.md, dnnevo.beer.from_beer)")
+
+
 def did_you_mean(name: str, known: Iterable[str]) -> str:
     """The hint an "unknown name" message carries: `` (did you mean 'x'?)`` naming the closest
     of ``known`` (up to three when they are about as close), or ``""`` when none is close.

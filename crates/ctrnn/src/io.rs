@@ -134,6 +134,15 @@ pub fn from_json(text: &str) -> Result<NetworkFile> {
             )))
         }
     }
+    if let Some(key) = ["bias", "biases", "gain", "gains"]
+        .into_iter()
+        .find(|k| obj.contains_key(*k))
+    {
+        return Err(Error::Format(format!(
+            "unknown field `{key}`: this format has thresholds, theta = -bias, and no gains (a \
+             gain folds into theta and the weights; docs/network-format.md)"
+        )));
+    }
     let doc: Document = serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
         let inner = e.into_inner();

@@ -549,7 +549,7 @@ def test_a_task_class_named_on_the_command_line_runs_resumes_and_is_judged(tmp_p
     judged = dnnevo_command(tmp_path, "assess", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
     assert judged.returncode in (0, 1, 3), judged.stderr
     assert "fresh episodes (seed 3)" in judged.stdout and "needs" in judged.stdout
-    assert "warning" not in judged.stdout  # each episode draws its light
+    assert "note: all" not in judged.stdout  # each episode draws its light
     drawn = dnnevo_command(tmp_path, "plot", "runs/seeker_cli.Seeker-seed0", "--seed", "3")
     assert drawn.returncode == 0, drawn.stderr
     assert (folder / "episodes.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -659,7 +659,7 @@ def test_a_task_without_sensors_runs_and_is_judged_from_the_command_line(tmp_pat
     judged = dnnevo_command(tmp_path, "assess", "runs/seeker_blind.Blind-seed0", "--seed", "1", "--trials", "8")
     assert judged.returncode in (0, 1, 3) and "episodes" in judged.stdout, judged.stderr
     # The light never moves: every episode is the same, and assess says what that does to the count.
-    assert "warning: all 8 episodes gave the same return and length" in judged.stdout
+    assert "note: all 8 episodes gave the same return and length" in judged.stdout
     analysed = dnnevo_command(tmp_path, "analyze", "runs/seeker_blind.Blind-seed0", "--no-lesions")
     assert analysed.returncode == 0 and "no sweep: the network has no input to vary" in analysed.stdout, \
         analysed.stderr
@@ -733,12 +733,12 @@ def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path,
         # names the attributes set after __init__.
         err = capsys.readouterr().err
         assert ("the command line will not judge, draw or resume" in err) == tagged, folder
-        assert ("has attributes that one made from config.toml has not (tag)" in err) == tagged, err
+        assert ("attributes speed, tag differ from those of one made from config.toml" in err) == tagged, err
     # An environment that ran episodes before it was wrapped keeps their state as attributes.
     used = seeker_arg.Seeker(speed=0.1)
     rollout(networks(2, n=3, m=1), used, max_steps=5)
     dnnevo.evolve(ClosedLoop(used, episodes=2, max_steps=50), config, out=tmp_path / "used", progress=False)
-    assert "has attributes that one made from config.toml has not (light, x)" in capsys.readouterr().err
+    assert "attributes light, x differ from those of one made from config.toml" in capsys.readouterr().err
     for folder in ("same", "told"):
         judged = dnnevo_command(tmp_path, "assess", folder, "--trials", "20")
         assert judged.returncode in (0, 1, 3) and "20 fresh episodes" in judged.stdout, judged.stderr

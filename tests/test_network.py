@@ -338,7 +338,7 @@ def test_random_takes_ranges_as_config_toml_and_the_config_hold_them() -> None:
         dnnevo.Network.random(3, 1, seed=4, ranges=[1.0, 2.0])
 
 
-@pytest.mark.parametrize("dt, shown", [("x", "'x'"), (True, "True"), (None, "None"),
+@pytest.mark.parametrize("dt, shown", [("x", "'x'"), (True, "True"), (np.True_, "np.True_"), (None, "None"),
                                        (np.ones(3), "an array of dtype float64 and shape (3,)")])
 @pytest.mark.parametrize("call", ["run", "run_population", "Batch"])
 def test_a_time_step_that_is_no_number_is_a_type_error_naming_dt(call: str, dt: object, shown: str) -> None:
@@ -434,3 +434,29 @@ def test_beer_s_parameter_names_point_to_the_conversion() -> None:
     doc["biases"] = [0.0, 0.0]
     with pytest.raises(dnnevo.FormatError, match=r"unknown field `biases`: this format has thresholds, theta = -bias"):
         dnnevo.Network.from_json(json.dumps(doc))
+
+
+def test_more_refusals_from_a_review_name_the_argument() -> None:
+    """A number too large for a float is no type error; a network of 0 neurons is named by its
+    argument; ragged genomes, a class for an environment, a malformed stacked tau and a result
+    for a history are named, not left to NumPy or Python."""
+    from dnnevo.closedloop import FarSeeker, rollout
+
+    net = make(2, 1)
+    with pytest.raises(InvalidArgumentError, match=r"^dt is 1148\d+\.\.\.; it must be a finite number$"):
+        net.run(np.ones((2, 1)), dt=2**2000)
+    for call in (lambda: dnnevo.Network.from_genome([], size=0, n_inputs=0),
+                 lambda: dnnevo.Network.random(0, 1, seed=0)):
+        with pytest.raises(InvalidArgumentError, match="^size is 0; a network needs at least 1 neuron$"):
+            call()
+    with pytest.raises(InvalidArgumentError, match=r"genomes must be an array \(P, G\) of numbers"):
+        dnnevo.stack_genomes([[1.0] * 17, [1.0] * 18], size=3, n_inputs=1)
+    with pytest.raises(dnnevo.TaskError, match=r"env is the class FarSeeker; give an environment made from it"):
+        rollout([make(3, 1)], FarSeeker, max_steps=3)
+    stacked = dnnevo.stack_genomes(np.stack([make(3, 1, seed=s).genome() for s in range(2)]), size=3, n_inputs=1)
+    with pytest.raises(dnnevo.InvalidNetworkError):
+        rollout({**stacked, "tau": 1.0}, FarSeeker(), max_steps=3, rows=3)
+    from types import MappingProxyType
+    assert rollout(MappingProxyType(stacked), FarSeeker(), max_steps=3).returns.shape == (2, 1)
+    with pytest.raises(InvalidArgumentError, match="history is a Network; expected a mapping of columns"):
+        dnnevo.plot.plot_fitness(net)  # type: ignore[arg-type]

@@ -28,7 +28,8 @@ def index(name: str, value: object, size: int, of: str) -> int:
     network has 3 sensors")."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral) \
             or not 0 <= int(value) < size:
-        raise InvalidArgumentError(f"{name} is {value!r}; {of}, so it must be an integer in 0..{size - 1}")
+        allowed = f"so it must be an integer in 0..{size - 1}" if size else "so nothing can be indexed"
+        raise InvalidArgumentError(f"{name} is {value!r}; {of}, {allowed}")
     return int(value)
 
 

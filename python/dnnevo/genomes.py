@@ -37,7 +37,10 @@ def stack_genomes(genomes: npt.ArrayLike, *, size: int, n_inputs: int) -> dict[s
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < least:
             raise InvalidArgumentError(f"{name} is {value!r}; expected a whole number >= {least}")
     n, m = int(size), int(n_inputs)
-    rows = np.asarray(genomes, dtype=np.float64)
+    try:
+        rows = np.asarray(genomes, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InvalidArgumentError(f"genomes must be an array (P, G) of numbers, one genome per row: {e}") from None
     block = 2 + m + n
     if rows.ndim != 2 or rows.shape[1] != n * block:
         raise InvalidArgumentError(

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from dnnevo.errors import InvalidArgumentError
+from dnnevo.errors import InvalidArgumentError, with_article
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -61,6 +61,9 @@ def columns(history: Mapping[str, npt.ArrayLike], names: tuple[str, ...]) -> lis
     ...
     dnnevo.errors.InvalidArgumentError: history has no 'generation'; it needs the columns generation, best, as EvolutionResult.history has them
     """
+    if not isinstance(history, Mapping):
+        raise InvalidArgumentError(f"history is {with_article(type(history).__name__)}; expected a mapping of "
+                                   "columns, as EvolutionResult.history (result.history) is")
     for name in names:
         if name not in history:
             raise InvalidArgumentError(f"history has no {name!r}; it needs the columns "

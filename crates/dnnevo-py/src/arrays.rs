@@ -202,6 +202,8 @@ impl AnyInt {
 pub struct AnyFloat {
     value: Option<f64>,
     repr: String,
+    /// A number too large for a float (an int of 2**2000), which is no type error.
+    overflow: bool,
 }
 
 impl From<f64> for AnyFloat {
@@ -209,6 +211,7 @@ impl From<f64> for AnyFloat {
         AnyFloat {
             value: Some(value),
             repr: value.to_string(),
+            overflow: false,
         }
     }
 }
@@ -217,14 +220,22 @@ impl<'a, 'py> FromPyObject<'a, 'py> for AnyFloat {
     type Error = PyErr;
 
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        let is_bool = obj.is_instance_of::<pyo3::types::PyBool>();
+        // A bool, Python's or NumPy's, is no number here.
+        let is_bool = obj.is_instance_of::<pyo3::types::PyBool>()
+            || obj
+                .get_type()
+                .name()
+                .is_ok_and(|n| n == "bool" || n == "bool_");
+        let value = if is_bool {
+            None
+        } else {
+            Some(obj.extract::<f64>())
+        };
+        let overflow = matches!(&value, Some(Err(e)) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()));
         Ok(AnyFloat {
-            value: if is_bool {
-                None
-            } else {
-                obj.extract::<f64>().ok()
-            },
+            value: value.and_then(Result::ok),
             repr: shown(&obj),
+            overflow,
         })
     }
 }
@@ -233,6 +244,12 @@ impl AnyFloat {
     /// The value, or a `TypeError` saying `name` must be a number. (Its range is the caller's
     /// to check.)
     pub fn to(&self, name: &str) -> PyResult<f64> {
+        if self.overflow {
+            return Err(arg_err(format!(
+                "{name} is {}; it must be a finite number",
+                self.repr
+            )));
+        }
         self.value.ok_or_else(|| {
             pyo3::exceptions::PyTypeError::new_err(format!(
                 "{name} is {}; expected a number",

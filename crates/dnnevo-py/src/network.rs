@@ -71,6 +71,21 @@ fn param(obj: &Bound<'_, PyAny>, name: &str, ndim: usize, expected: &str) -> PyR
     Ok(d)
 }
 
+/// The layout of `size` neurons and `n_inputs` sensors given as Python integers: a size of 0 is
+/// an `InvalidArgumentError` naming `size`, a layout past the core's limits a `ConfigError`.
+fn layout_of(size: &Bound<'_, PyAny>, n_inputs: &Bound<'_, PyAny>) -> PyResult<Layout> {
+    let size: usize = uint(size, "size", "[1, 2**64)")?;
+    if size == 0 {
+        return Err(arg_err(
+            "size is 0; a network needs at least 1 neuron".into(),
+        ));
+    }
+    let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
+    let layout = Layout { size, n_inputs };
+    layout.validate().py_err()?;
+    Ok(layout)
+}
+
 /// Builds the integrator from keyword arguments, raising `InvalidArgumentError` on bad values.
 pub fn integrator(dt: &AnyFloat, substeps: &AnyInt, method: &str) -> PyResult<Integrator> {
     let substeps: usize = substeps.to("substeps", "[1, 2**64)")?;
@@ -223,10 +238,7 @@ impl PyNetwork {
         size: &Bound<'_, PyAny>,
         n_inputs: &Bound<'_, PyAny>,
     ) -> PyResult<Self> {
-        let size: usize = uint(size, "size", "[1, 2**64)")?;
-        let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
-        let layout = Layout { size, n_inputs };
-        layout.validate().py_err()?;
+        let layout = layout_of(size, n_inputs)?;
         let g = dense(genes, "genes", arg_err)?;
         g.expect_ndim(1, "genes", "(G,)", arg_err)?;
         Ok(PyNetwork::from_core(
@@ -252,12 +264,9 @@ impl PyNetwork {
         seed: &Bound<'_, PyAny>,
         ranges: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let size: usize = uint(size, "size", "[1, 2**64)")?;
-        let n_inputs: usize = uint(n_inputs, "n_inputs", "[0, 2**64)")?;
+        let layout = layout_of(size, n_inputs)?;
         let seed: u64 = uint(seed, "seed", "[0, 2**64)")?;
         let ranges = ranges_from(ranges)?;
-        let layout = Layout { size, n_inputs };
-        layout.validate().py_err()?;
         let mut stream = Stream::new(seed, 0, Purpose::Init, 0, 0);
         let genes = genome::random(layout, &ranges, &mut stream);
         Ok(PyNetwork::from_core(

@@ -82,6 +82,8 @@ def add_parser(sub: Any) -> None:
 
 
 def _vector(text: str, what: str) -> list[float]:
+    if not text.strip():
+        return []  # the input of a network without sensors
     try:
         return [float(x) for x in text.split(",")]
     except ValueError:

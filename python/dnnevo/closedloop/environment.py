@@ -101,6 +101,9 @@ def sensors(env: Any) -> int:
     ...
     dnnevo.errors.TaskError: Blind.observation_size is 2.0; expected the number of observations the task gives at each step, a whole number >= 0
     """
+    if isinstance(env, type):
+        raise TaskError(f"env is the class {env.__name__}; give an environment made from it, "
+                        f"{env.__name__}(...)")
     name = type(env).__name__
     if not hasattr(env, "observation_size"):
         raise TaskError(f"{name} has no observation_size; give it the number of observations the "

@@ -99,6 +99,8 @@ def rollout(
     # The binding checks method, precision and purpose and names a value it does not know
     # (InvalidArgumentError): they are plain strings here, as in ClosedLoop and the configs.
     integrator: dict[str, Any] = dict(dt=dt, substeps=substeps, method=method, precision=precision)
+    if isinstance(networks, Mapping):
+        networks = dict(networks)  # the batch takes stacked arrays as a dict
     draw: Any = purpose
     if rows is not None:
         if nonnegative("rows", rows) < episodes:
@@ -151,8 +153,9 @@ def rollout(
 def _count(networks: Sequence[_core.Network] | Mapping[str, npt.ArrayLike]) -> int:
     """How many networks ``networks`` holds: a list's length, or the rows of stacked arrays'
     ``tau`` (whose shapes the batch checks)."""
-    if isinstance(networks, Mapping) and "tau" in networks:
-        return len(np.asarray(networks["tau"]))
+    if isinstance(networks, Mapping):
+        tau = np.asarray(networks.get("tau", ()))
+        return len(tau) if tau.ndim else 0  # a malformed tau is the batch's to name
     return len(networks)
 
 

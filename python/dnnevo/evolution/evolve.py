@@ -28,7 +28,7 @@ from dnnevo import _core, presets
 from dnnevo._checks import nonnegative
 from dnnevo.closedloop import named
 from dnnevo.closedloop.fitness import ClosedLoop, close_copy
-from dnnevo.closedloop.source import plain_source, task_source
+from dnnevo.closedloop.source import fingerprint, plain_source, task_source
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, DnnevoError, FitnessError, InvalidArgumentError, did_you_mean
 from dnnevo.evolution.ga import GeneticAlgorithm, Validate, founders_argument
@@ -378,18 +378,21 @@ def _not_rebuilt(task: ClosedLoop, config: EvolutionConfig) -> str | None:
         again = named.closed_loop(config)
     except DnnevoError as e:
         return str(e)
-    extra = sorted(set(getattr(task.env, "__dict__", {})) - set(getattr(again.env, "__dict__", {})))
+    mine, theirs = getattr(task.env, "__dict__", {}), getattr(again.env, "__dict__", {})
+    differ = sorted(k for k in set(mine) | set(theirs)
+                    if k not in mine or k not in theirs or fingerprint(mine[k]) != fingerprint(theirs[k]))
     close_copy(again.env)
     if again.digest() == task.digest():
         return None
     kind = type(task.env).__name__
-    if extra:
-        return (f"this {kind} has attributes that one made from config.toml has not "
-                f"({', '.join(extra)}): they were set after __init__, as an earlier reset or "
-                "rollout sets them; give ClosedLoop a freshly made environment")
-    return (f"config.toml cannot record the arguments this {kind} was made with: "
-            "keep each argument of __init__ as an attribute of the same name, holding a Python "
-            "number, string or boolean, or a list or dict of them")
+    record = ("keep each argument of __init__ as an attribute of the same name, holding a Python "
+              "number, string or boolean, or a list or dict of them")
+    if not differ:
+        return f"config.toml cannot record the arguments this {kind} was made with: {record}"
+    return (f"this {kind}'s attributes {', '.join(differ)} differ from those of one made from "
+            f"config.toml: either an argument that config.toml cannot record ({record}), or "
+            "attributes set after __init__, as an earlier reset or rollout sets them (give "
+            "ClosedLoop a freshly made environment)")
 
 
 def _named_fitness(run: RunDir, config: EvolutionConfig, table: Mapping[str, Any]) -> FitnessFn:

@@ -93,9 +93,10 @@ class UserTask:
         lines = [f"{where}: champion on {a.trials} fresh episodes (seed {a.seed}); mean return "
                  f"{d['mean_return']:.4g}, mean length {d['mean_length']:.1f} steps."]
         if d.get("all_alike"):
-            lines.append(f"warning: all {a.trials} episodes gave the same return and length; if the "
-                         "task draws nothing from rng they are one trial repeated, and the interval "
-                         "below, which counts them as independent, is too narrow (docs/closed-loop.md)")
+            lines.append(f"note: all {a.trials} episodes gave the same return and length, as a task that "
+                         "draws nothing from rng gives (or one whose episodes all end alike); if it is "
+                         "such a task they are one trial repeated, and the interval below, which counts "
+                         "them as independent, is too narrow (docs/closed-loop.md)")
         return lines
 
     def draw(self, run: RunDir, config: EvolutionConfig, seed: int, *,

@@ -403,3 +403,16 @@ def test_a_sweep_neither_walks_past_a_fold_nor_misses_a_hopf_point_beside_a_node
     for steps in (3, 5):
         events = analysis.bifurcation(node, 0, 0.24, 0.30, steps=steps).events
         assert [(e.kind, round(e.value, 4)) for e in events] == [("hopf", 0.269)]
+
+
+def test_a_real_setting_that_is_no_number_is_a_type_error_naming_it() -> None:
+    """pyo3 said "must be real number" without the name, and took a bool as a number."""
+    from dnnevo.analysis import bifurcation, equilibria, limit_cycles
+
+    net = dnnevo.Network.random(3, 1, seed=0)
+    for call, message in [(lambda: limit_cycles(net, [0.0], tolerance=True), "tolerance is True"),
+                          (lambda: limit_cycles(net, [0.0], window="x"), "window is 'x'"),
+                          (lambda: equilibria(net, [0.0], distinct=None), "distinct is None"),
+                          (lambda: bifurcation(net, 0, True, 2.0), "start is True")]:
+        with pytest.raises(TypeError, match=f"^{message}; expected a number$"):
+            call()

@@ -5,7 +5,7 @@
 use ctrnn::analysis::{self, CycleSearch, EquilibriumSearch, Sweep};
 use pyo3::prelude::*;
 
-use crate::arrays::{arg_err, AnyInt};
+use crate::arrays::{arg_err, AnyFloat, AnyInt};
 use crate::detach::detached;
 use crate::dynamics::{PyBifurcation, PyCycle, PyEquilibrium};
 use crate::network::PyNetwork;
@@ -37,23 +37,23 @@ fn retry(value: Option<&AnyInt>) -> PyResult<usize> {
 /// Every equilibrium Newton's method reaches, with eigenvalues and stability, as `Equilibrium` objects; searched
 /// again with `retry_starts` starts (None: the core's default) when the count is even.
 #[pyfunction]
-#[pyo3(signature = (net, input, *, starts=AnyInt::from(512), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, retry_starts=None)")]
+#[pyo3(signature = (net, input, *, starts=AnyInt::from(512), tolerance=AnyFloat::from(1e-10), distinct=AnyFloat::from(1e-6), max_iterations=AnyInt::from(100), seed=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, *, starts=512, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, retry_starts=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_equilibria<'py>(
     py: Python<'py>,
     net: &PyNetwork,
     input: Vec<f64>,
     starts: AnyInt,
-    tolerance: f64,
-    distinct: f64,
+    tolerance: AnyFloat,
+    distinct: AnyFloat,
     max_iterations: AnyInt,
     seed: AnyInt,
     retry_starts: Option<AnyInt>,
 ) -> PyResult<Vec<PyEquilibrium>> {
     let settings = EquilibriumSearch {
         starts: count("starts", &starts, 1)?,
-        tolerance,
-        distinct,
+        tolerance: tolerance.to("tolerance")?,
+        distinct: distinct.to("distinct")?,
         max_iterations: count("max_iterations", &max_iterations, 1)?,
         seed: self::seed(&seed)?,
         retry_starts: retry(retry_starts.as_ref())?,
@@ -73,7 +73,7 @@ pub fn analysis_equilibria<'py>(
 
 /// The attracting limit cycles reached from the search's starts, as `Cycle` objects.
 #[pyfunction]
-#[pyo3(signature = (net, input, *, starts=AnyInt::from(8), steps_per_tau=AnyInt::from(20), transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=AnyInt::from(200), seed=AnyInt::from(1)), text_signature = "(net, input, *, starts=8, steps_per_tau=20, transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=200, seed=1)")]
+#[pyo3(signature = (net, input, *, starts=AnyInt::from(8), steps_per_tau=AnyInt::from(20), transient=AnyFloat::from(100.0), window=AnyFloat::from(100.0), at_rest=AnyFloat::from(1e-6), tolerance=AnyFloat::from(1e-5), orbit_points=AnyInt::from(200), seed=AnyInt::from(1)), text_signature = "(net, input, *, starts=8, steps_per_tau=20, transient=100.0, window=100.0, at_rest=1e-6, tolerance=1e-5, orbit_points=200, seed=1)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_cycles<'py>(
     py: Python<'py>,
@@ -81,20 +81,20 @@ pub fn analysis_cycles<'py>(
     input: Vec<f64>,
     starts: AnyInt,
     steps_per_tau: AnyInt,
-    transient: f64,
-    window: f64,
-    at_rest: f64,
-    tolerance: f64,
+    transient: AnyFloat,
+    window: AnyFloat,
+    at_rest: AnyFloat,
+    tolerance: AnyFloat,
     orbit_points: AnyInt,
     seed: AnyInt,
 ) -> PyResult<Vec<PyCycle>> {
     let settings = CycleSearch {
         starts: count("starts", &starts, 1)?,
         steps_per_tau: count("steps_per_tau", &steps_per_tau, 1)?,
-        transient,
-        window,
-        at_rest,
-        tolerance,
+        transient: transient.to("transient")?,
+        window: window.to("window")?,
+        at_rest: at_rest.to("at_rest")?,
+        tolerance: tolerance.to("tolerance")?,
         orbit_points: count("orbit_points", &orbit_points, 2)?,
         seed: self::seed(&seed)?,
     };
@@ -109,19 +109,19 @@ pub fn analysis_cycles<'py>(
 /// with `cycle_starts > 0` it also searches for limit cycles at each value from that many starts
 /// and follows them as branches. `retry_starts` as for `analysis_equilibria`.
 #[pyfunction]
-#[pyo3(signature = (net, input, index, start, stop, *, steps=AnyInt::from(101), starts=AnyInt::from(128), tolerance=1e-10, distinct=1e-6, max_iterations=AnyInt::from(100), seed=AnyInt::from(0), cycle_starts=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0, retry_starts=None)")]
+#[pyo3(signature = (net, input, index, start, stop, *, steps=AnyInt::from(101), starts=AnyInt::from(128), tolerance=AnyFloat::from(1e-10), distinct=AnyFloat::from(1e-6), max_iterations=AnyInt::from(100), seed=AnyInt::from(0), cycle_starts=AnyInt::from(0), retry_starts=None), text_signature = "(net, input, index, start, stop, *, steps=101, starts=128, tolerance=1e-10, distinct=1e-6, max_iterations=100, seed=0, cycle_starts=0, retry_starts=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn analysis_bifurcation<'py>(
     py: Python<'py>,
     net: &PyNetwork,
     input: Vec<f64>,
     index: AnyInt,
-    start: f64,
-    stop: f64,
+    start: AnyFloat,
+    stop: AnyFloat,
     steps: AnyInt,
     starts: AnyInt,
-    tolerance: f64,
-    distinct: f64,
+    tolerance: AnyFloat,
+    distinct: AnyFloat,
     max_iterations: AnyInt,
     seed: AnyInt,
     cycle_starts: AnyInt,
@@ -130,13 +130,13 @@ pub fn analysis_bifurcation<'py>(
     let cycle_starts = count("cycle_starts", &cycle_starts, 0)?;
     let sweep = Sweep {
         input: count("index", &index, 0)?,
-        from: start,
-        to: stop,
+        from: start.to("start")?,
+        to: stop.to("stop")?,
         steps: count("steps", &steps, 2)?,
         search: EquilibriumSearch {
             starts: count("starts", &starts, 1)?,
-            tolerance,
-            distinct,
+            tolerance: tolerance.to("tolerance")?,
+            distinct: distinct.to("distinct")?,
             max_iterations: count("max_iterations", &max_iterations, 1)?,
             seed: self::seed(&seed)?,
             retry_starts: retry(retry_starts.as_ref())?,

@@ -458,5 +458,7 @@ def test_more_refusals_from_a_review_name_the_argument() -> None:
         rollout({**stacked, "tau": 1.0}, FarSeeker(), max_steps=3, rows=3)
     from types import MappingProxyType
     assert rollout(MappingProxyType(stacked), FarSeeker(), max_steps=3).returns.shape == (2, 1)
+    with pytest.raises(InvalidNetworkError, match="^sensor_weights is None; expected an array of numbers$"):
+        dnnevo.Network(tau=[1.0], theta=[0.0], weights=[[0.0]], sensor_weights=None)  # type: ignore[arg-type]
     with pytest.raises(InvalidArgumentError, match="history is a Network; expected a mapping of columns"):
         dnnevo.plot.plot_fitness(net)  # type: ignore[arg-type]

@@ -258,6 +258,13 @@ impl<'de> serde::de::Visitor<'de> for UniqueVisitor {
 /// `not valid JSON: ...`, saying so when the text there is a NaN or an infinity, which JSON has
 /// no words for (Python's `json` writes them, and every value of a network must be finite).
 fn json_error(text: &str, e: &serde_json::Error) -> Error {
+    if text.starts_with('\u{feff}') {
+        return Error::Format(
+            "not valid JSON: the text starts with a byte-order mark (U+FEFF), as some editors \
+             write; save it as UTF-8 without one"
+                .into(),
+        );
+    }
     let line = text.lines().nth(e.line().saturating_sub(1)).unwrap_or("");
     let column = e.column().saturating_sub(1);
     let at = line.get(column..).unwrap_or("");

@@ -18,6 +18,10 @@ pub struct Dense {
 /// Converts any array-like to a float64 array (as `numpy.asarray(x, dtype=float)` would) and
 /// copies it out. `make_err` builds the exception for a value that cannot be converted.
 pub fn dense(obj: &Bound<'_, PyAny>, name: &str, make_err: fn(String) -> PyErr) -> PyResult<Dense> {
+    if obj.is_none() {
+        // NumPy would make it a NaN of shape ().
+        return Err(make_err(format!("{name} is None; expected an array of numbers")));
+    }
     let py = obj.py();
     let np = py.import("numpy")?;
     let arr = np

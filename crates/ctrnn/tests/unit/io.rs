@@ -91,6 +91,16 @@ fn bad_documents_name_the_problem() {
     assert!(err(&edit("dnnevo-network", "other")).contains("expected \"dnnevo-network\""));
     assert!(err(&edit("\"version\": 1", "\"version\": 2")).contains("version is 2"));
     assert!(err(&good[..good.len() / 2]).contains("not valid JSON"));
+    assert!(err(&format!("\u{feff}{good}")).contains("starts with a byte-order mark"));
+    for beer in ["biases", "gains"] {
+        let e = err(&good.replacen("\"theta\"", &format!("\"{beer}\": [0], \"theta\""), 1));
+        assert!(
+            e.contains(&format!(
+                "unknown field `{beer}`: this format has thresholds"
+            )),
+            "{e}"
+        );
+    }
     assert!(err("[1, 2]").contains("not a JSON object"));
     let no_tau = good.replacen("\"tau\"", "\"tua\"", 1);
     let e = err(&no_tau);

@@ -354,7 +354,7 @@ fn fewer_rows_and_bad_assignments_are_refused_and_change_nothing() {
             "network 3 is out of range; the batch has 3 networks",
         ),
         (vec![1, 1], vec![0, 2], "row 1 is named twice"),
-        (vec![1], vec![], "1 rows and 0 networks"),
+        (vec![1], vec![], "1 row and 0 networks"),
     ] {
         let err = batch.assign(&rows, &to).unwrap_err();
         assert!(err.to_string().contains(says), "{err}");

@@ -846,6 +846,13 @@ def test_a_sweep_over_a_task_class_judges_every_seed_by_its_rule(tmp_path) -> No
                               "--out", "sw2", *SETTINGS)
     assert ruleless.returncode == 2 and "has no success rule" in ruleless.stderr
     assert not (tmp_path / "sw2").exists()
+    # A task whose episodes are all alike is noted for each seed, as assess notes it.
+    blind_settings = [a for a in SETTINGS if a != "n_inputs=1"]
+    blind_settings.remove("--set")
+    blind = dnnevo_command(tmp_path, "sweep", "python:seeker_sweep.Blind", "--seeds", "0", "--out", "sw3",
+                           "--eval-trials", "8", "--no-dt-check", *blind_settings)
+    assert blind.returncode == 0, blind.stderr
+    assert "note: every fresh episode gave the same return and length" in blind.stdout + blind.stderr
 
 
 def test_a_sweep_of_a_task_class_on_dask_workers_matches_one_in_process(tmp_path) -> None:

@@ -210,7 +210,9 @@ def _seed_line(r: sweep.SeedResult) -> str:
     """One finished seed in a line, printed as soon as it is judged."""
     met = "never met the rule" if r.first_success is None else f"met the rule at generation {r.first_success}"
     return (f"seed {r.seed}: {met}; final champion {r.final.verdict} ({_weakest_rate(r)})"
-            + ("; a step artefact" if r.artefact else ""))
+            + ("; a step artefact" if r.artefact else "")
+            + ("; note: every fresh episode gave the same return and length, as a task that draws "
+               "nothing from rng gives (docs/closed-loop.md)" if r.final.details.get("all_alike") else ""))
 
 
 def _weakest_rate(r: sweep.SeedResult) -> str:

@@ -462,3 +462,35 @@ def test_more_refusals_from_a_review_name_the_argument() -> None:
         dnnevo.Network(tau=[1.0], theta=[0.0], weights=[[0.0]], sensor_weights=None)  # type: ignore[arg-type]
     with pytest.raises(InvalidArgumentError, match="history is a Network; expected a mapping of columns"):
         dnnevo.plot.plot_fitness(net)  # type: ignore[arg-type]
+
+
+def test_stacked_arrays_may_be_any_mapping_and_beer_s_arguments_are_named() -> None:
+    """From a second review: run_population and Batch take any mapping of stacked arrays (a dict
+    alone before), with state None as absent; from_beer names Beer's argument and index; a bool
+    in a 0-d array is no time step, and compose names its cross_scale."""
+    from types import MappingProxyType
+
+    from dnnevo.beer import from_beer
+
+    nets = [make(3, 1, seed=s) for s in range(3)]
+    stacked = dnnevo.stack_genomes(np.stack([n.genome() for n in nets]), size=3, n_inputs=1)
+    x = np.ones((2, 1))
+    want = dnnevo.run_population(nets, x)
+    np.testing.assert_array_equal(dnnevo.run_population(MappingProxyType(stacked), x), want)
+    np.testing.assert_array_equal(dnnevo.run_population({**stacked, "state": None}, x), want)
+    assert dnnevo.Batch(MappingProxyType(stacked)).rows == 3
+    with pytest.raises(InvalidArgumentError, match="genomes is None"):
+        dnnevo.stack_genomes(None, size=3, n_inputs=1)  # type: ignore[arg-type]
+    good = ([1.0, 1.0], [0.0, 0.0], [1.0, 1.0], [[0.0, 1.0], [2.0, 0.0]])
+    for at, value, message in [(1, [np.nan, 0.0], r"biases\[0\] is nan"),
+                               (3, [[0.0, np.nan], [0.0, 0.0]], r"weights\[0\]\[1\] is nan"),
+                               (2, [True, False], "gains is an array of dtype bool"),
+                               (3, None, "weights is None")]:
+        args = list(good)
+        args[at] = value
+        with pytest.raises(InvalidNetworkError, match=message):
+            from_beer(*args)
+    with pytest.raises(TypeError, match=r"^dt is array\(True\); expected a number$"):
+        nets[0].run(x, dt=np.array(True))
+    with pytest.raises(TypeError, match="^cross_scale is 'x'; expected a number$"):
+        dnnevo.compose(nets[0], nets[1], cross_scale="x")  # type: ignore[arg-type]

@@ -31,9 +31,8 @@ def from_beer(taus: npt.ArrayLike, biases: npt.ArrayLike, gains: npt.ArrayLike, 
     >>> net.theta.tolist(), net.weights.tolist()
     ([2.75, 1.75], [[4.5, -1.0], [1.0, 4.5]])
     """
-    tau = np.asarray(taus, dtype=np.float64)
-    bias, gain = np.asarray(biases, dtype=np.float64), np.asarray(gains, dtype=np.float64)
-    w = np.asarray(weights, dtype=np.float64)
+    tau, bias, gain, w = (_numbers(name, value) for name, value in
+                          (("taus", taus), ("biases", biases), ("gains", gains), ("weights", weights)))
     n = tau.shape[0] if tau.ndim == 1 else -1
     for name, value in (("taus", tau), ("biases", bias), ("gains", gain)):
         if value.shape != (max(n, 0),) or n < 1:
@@ -42,8 +41,27 @@ def from_beer(taus: npt.ArrayLike, biases: npt.ArrayLike, gains: npt.ArrayLike, 
     if w.shape != (n, n):
         raise InvalidNetworkError(f"weights has shape {w.shape}; expected (N, N) = ({n}, {n}), "
                                   "weights[j][i] from neuron j to neuron i")
-    y = np.zeros(n) if states is None else np.asarray(states, dtype=np.float64)
+    y = np.zeros(n) if states is None else _numbers("states", states)
     if y.shape != (n,):
         raise InvalidNetworkError(f"states has shape {y.shape}; expected (N,) = ({n},)")
     return _core.Network(tau=tau, theta=-gain * bias, weights=gain[:, None] * w.T,
                          sensor_weights=np.diag(gain), state=gain * y)
+
+
+def _numbers(name: str, value: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """``value`` as finite float64 numbers, or an :class:`~dnnevo.InvalidNetworkError` naming
+    ``name`` (Beer's argument) and the index of the first that is not one."""
+    if value is None:
+        raise InvalidNetworkError(f"{name} is None; expected numbers")
+    try:
+        given = np.asarray(value)
+    except ValueError as e:  # ragged rows
+        raise InvalidNetworkError(f"{name} is not an array of numbers: {e}") from None
+    if given.dtype.kind not in "iuf":
+        raise InvalidNetworkError(f"{name} is an array of dtype {given.dtype}; expected numbers "
+                                  "(a bool or a string is not one)")
+    x = given.astype(np.float64)
+    if not np.isfinite(x).all():
+        at = tuple(int(i) for i in np.argwhere(~np.isfinite(x))[0])
+        raise InvalidNetworkError(f"{name}{''.join(f'[{i}]' for i in at)} is {x[at]}; every value must be finite")
+    return x

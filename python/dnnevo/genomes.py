@@ -37,6 +37,8 @@ def stack_genomes(genomes: npt.ArrayLike, *, size: int, n_inputs: int) -> dict[s
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < least:
             raise InvalidArgumentError(f"{name} is {value!r}; expected a whole number >= {least}")
     n, m = int(size), int(n_inputs)
+    if genomes is None:
+        raise InvalidArgumentError("genomes is None; expected an array (P, G), one genome per row")
     try:
         rows = np.asarray(genomes, dtype=np.float64)
     except (TypeError, ValueError) as e:

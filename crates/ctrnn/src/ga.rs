@@ -203,13 +203,6 @@ impl GaConfig {
                 self.mutation_scale
             )));
         }
-        if self.mutation == MutationKind::Uniform && self.mutation_scale != MUTATION_SCALE {
-            return Err(Error::Config(format!(
-                "mutation_scale is {}, but mutation is \"uniform\", which redraws a gene and has \
-                 no step to scale; set mutation = \"creep\" to use it",
-                self.mutation_scale
-            )));
-        }
         if self.champion_step_check && self.validation_candidates == 0 {
             return Err(Error::Config(
                 "champion_step_check is on but validation_candidates is 0; the step check \

@@ -170,10 +170,10 @@ impl Layout {
         match genes {
             Some(g) if g <= MAX_GENES => Ok(()),
             _ => Err(Error::Config(format!(
-                "a network of size {} with {} inputs has {} parameters ({}); the limit is {MAX_GENES} \
+                "a network of size {} with {} has {} parameters ({}); the limit is {MAX_GENES} \
                  parameters (512 MiB)",
                 self.size,
-                self.n_inputs,
+                crate::error::counted(self.n_inputs, "input"),
                 genes.map_or("more than 2^64".to_string(), |g| g.to_string()),
                 bytes(genes.map(|g| g as f64 * 8.0)),
             ))),

@@ -20,7 +20,9 @@ pub struct Dense {
 pub fn dense(obj: &Bound<'_, PyAny>, name: &str, make_err: fn(String) -> PyErr) -> PyResult<Dense> {
     if obj.is_none() {
         // NumPy would make it a NaN of shape ().
-        return Err(make_err(format!("{name} is None; expected an array of numbers")));
+        return Err(make_err(format!(
+            "{name} is None; expected an array of numbers"
+        )));
     }
     let py = obj.py();
     let np = py.import("numpy")?;
@@ -224,12 +226,13 @@ impl<'a, 'py> FromPyObject<'a, 'py> for AnyFloat {
     type Error = PyErr;
 
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        // A bool, Python's or NumPy's, is no number here.
-        let is_bool = obj.is_instance_of::<pyo3::types::PyBool>()
-            || obj
-                .get_type()
-                .name()
-                .is_ok_and(|n| n == "bool" || n == "bool_");
+        // A bool, Python's or NumPy's (a scalar or an array of dtype bool), is no number here.
+        let dtype_kind = obj
+            .getattr("dtype")
+            .and_then(|d| d.getattr("kind"))
+            .and_then(|k| k.extract::<String>());
+        let is_bool =
+            obj.is_instance_of::<pyo3::types::PyBool>() || dtype_kind.is_ok_and(|k| k == "b");
         let value = if is_bool {
             None
         } else {

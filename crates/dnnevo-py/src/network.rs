@@ -517,11 +517,11 @@ impl PyTrace {
 /// with `cross_scale > 0`, each drawn uniformly in [-cross_scale, cross_scale] from the seeding
 /// stream `(seed, 0, Seeding, member, 1)`, so each member of a seeded population gets its own.
 #[pyfunction]
-#[pyo3(signature = (a, b, *, cross_scale=0.0, seed=AnyInt::from(0), member=AnyInt::from(0)), text_signature = "(a, b, *, cross_scale=0.0, seed=0, member=0)")]
+#[pyo3(signature = (a, b, *, cross_scale=AnyFloat::from(0.0), seed=AnyInt::from(0), member=AnyInt::from(0)), text_signature = "(a, b, *, cross_scale=0.0, seed=0, member=0)")]
 pub fn compose(
     a: &PyNetwork,
     b: &PyNetwork,
-    cross_scale: f64,
+    cross_scale: AnyFloat,
     seed: AnyInt,
     member: AnyInt,
 ) -> PyResult<PyNetwork> {
@@ -529,6 +529,12 @@ pub fn compose(
     let member: u64 = member.to("member", "[0, 2**64)")?;
     let mut stream = Stream::new(seed, 0, Purpose::Seeding, member, 1);
     Ok(PyNetwork::from_core(
-        ctrnn::compose_with(&a.inner, &b.inner, cross_scale, &mut stream).py_err()?,
+        ctrnn::compose_with(
+            &a.inner,
+            &b.inner,
+            cross_scale.to("cross_scale")?,
+            &mut stream,
+        )
+        .py_err()?,
     ))
 }

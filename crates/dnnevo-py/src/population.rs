@@ -14,8 +14,8 @@ use crate::network::{integrator, net_err};
 
 /// Extracts a population: a sequence of Networks, or a dict of stacked parameter arrays.
 pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
-    if let Ok(d) = obj.cast::<PyDict>() {
-        let arrays = stacked(d)?;
+    if let Some(d) = as_dict(obj)? {
+        let arrays = stacked(&d)?;
         let rows = arrays.rows();
         ctrnn::Params::validate_each(&rows).py_err()?;
         return rows.iter().map(|row| row.to_network().py_err()).collect();
@@ -29,12 +29,29 @@ pub fn networks_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<ctrnn::Network>> {
 /// Packs a population for the integrator straight from its Python form (as [`networks_from`]),
 /// without an owned `Network` per member, to compute in `precision`.
 fn population_from(obj: &Bound<'_, PyAny>, precision: Precision) -> PyResult<Population> {
-    if let Ok(d) = obj.cast::<PyDict>() {
-        return Population::from_params(&stacked(d)?.rows(), precision).py_err();
+    if let Some(d) = as_dict(obj)? {
+        return Population::from_params(&stacked(&d)?.rows(), precision).py_err();
     }
     let objects = network_objects(obj)?;
     let refs: Vec<&ctrnn::Network> = objects.iter().map(|net| &net.inner).collect();
     Population::with_precision(&refs, precision).py_err()
+}
+
+/// `obj` as a dict when it is a mapping (stacked arrays: a dict, or any `collections.abc.Mapping`,
+/// copied into one), else None (a sequence of Networks).
+fn as_dict<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyDict>>> {
+    if let Ok(d) = obj.cast::<PyDict>() {
+        return Ok(Some(d.clone()));
+    }
+    if obj.cast::<pyo3::types::PyMapping>().is_err() {
+        return Ok(None);
+    }
+    let copy = PyDict::new(obj.py());
+    for item in obj.call_method0("items")?.try_iter()? {
+        let (key, value): (Bound<'py, PyAny>, Bound<'py, PyAny>) = item?.extract()?;
+        copy.set_item(key, value)?;
+    }
+    Ok(Some(copy))
 }
 
 /// Borrows every item of a non-empty sequence of Networks.
@@ -113,7 +130,9 @@ fn stacked(d: &Bound<'_, PyDict>) -> PyResult<Stacked> {
     }
     let get = |key: &str, ndim: usize, shape: &str| -> PyResult<Option<Dense>> {
         match d.get_item(key)? {
+            // An optional array given as None is absent, as `Network(state=None)` is.
             None => Ok(None),
+            Some(v) if v.is_none() && key == "state" => Ok(None),
             Some(v) => {
                 let x = dense(&v, key, net_err)?;
                 x.expect_ndim(ndim, key, shape, net_err)?;

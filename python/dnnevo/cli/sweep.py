@@ -16,6 +16,7 @@ from dnnevo import presets
 from dnnevo.closedloop import named
 from dnnevo.experiments import scheduler
 from dnnevo.evolution import seeding
+from dnnevo.evolution.evolve import refuse_idle_scale
 from dnnevo.experiments import sweep
 from dnnevo._checks import nonnegative
 from dnnevo.closedloop.fitness import success_rule
@@ -78,6 +79,7 @@ def sweep_command(args: argparse.Namespace) -> int:
         success_rule(named.closed_loop(config).env, config.task)
     elif config.task not in DEFAULT_TRIALS:
         raise ConfigError(f"task {config.task!r} has no success rule, so a sweep cannot judge it")
+    refuse_idle_scale(config)  # before the manifest: the seeds' runs would refuse it
     for seed in args.seeds:  # before any run, so a bad --eval-seed costs nothing
         nonnegative("--eval-seed + seed", sweep.eval_seed(seed, args.eval_seed))
     trials = args.eval_trials if args.eval_trials is not None else registry.get(config.task).DEFAULT_TRIALS

@@ -99,8 +99,6 @@ def rollout(
     # The binding checks method, precision and purpose and names a value it does not know
     # (InvalidArgumentError): they are plain strings here, as in ClosedLoop and the configs.
     integrator: dict[str, Any] = dict(dt=dt, substeps=substeps, method=method, precision=precision)
-    if isinstance(networks, Mapping):
-        networks = dict(networks)  # the batch takes stacked arrays as a dict
     draw: Any = purpose
     if rows is not None:
         if nonnegative("rows", rows) < episodes:

@@ -224,6 +224,7 @@ def evolve(
         _check_layout(config)
         task = config.task  # a preset name stands for its config's task
     _share_threads(task, threads)
+    refuse_idle_scale(config)
     ga = GeneticAlgorithm(config, seed=seed, founders=founders_argument(founders, seeds))
     if out is None:
         return _loop(ga, task, [], None, progress=progress, callback=callback, threads=threads)
@@ -353,6 +354,15 @@ def resume(
         _write_best(run, ga)
         return _loop(ga, fitness, history, run, progress=progress, callback=callback,
                      threads=threads, table=table)
+
+
+def refuse_idle_scale(config: EvolutionConfig) -> None:
+    """Refuses a new run whose ``mutation_scale`` would do nothing: uniform mutation redraws a
+    gene and has no step to scale. (A run folder that recorded one, from before this check, is
+    still read and resumed: the scale never acted on it.)"""
+    if config.mutation == "uniform" and config.mutation_scale != EvolutionConfig.mutation_scale:
+        raise ConfigError(f"mutation_scale is {config.mutation_scale}, but mutation is \"uniform\", which "
+                          "redraws a gene and has no step to scale; set mutation = \"creep\" to use it")
 
 
 def _share_threads(task: str | FitnessFn, threads: int | None) -> None:

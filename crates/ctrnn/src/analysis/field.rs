@@ -34,8 +34,8 @@ impl<'a> Field<'a> {
         let (n, m) = (net.size(), net.n_inputs());
         if input.len() != m {
             return Err(Error::InvalidArgument(format!(
-                "input has {} values; this network has M = {m} sensors, so it needs {m}",
-                input.len()
+                "input has {}; this network has M = {m} sensors, so it needs {m}",
+                crate::error::counted(input.len(), "value")
             )));
         }
         if let Some(k) = input.iter().position(|x| !x.is_finite()) {

@@ -410,18 +410,6 @@ fn creep_mutation_moves_genes_a_little_and_is_configured_by_name() {
         assert!(e.contains("mutation_scale is"), "{e}");
     }
     assert!(serde_json::from_str::<GaConfig>(r#"{"mutation": "gauss"}"#).is_err());
-    // A scale for the uniform operator, which has no step, would be ignored: it is refused.
-    let e = GaConfig {
-        mutation_scale: 0.2,
-        ..GaConfig::default()
-    }
-    .validate()
-    .unwrap_err()
-    .to_string();
-    assert!(
-        e.contains(r#"mutation_scale is 0.2, but mutation is "uniform""#),
-        "{e}"
-    );
 }
 
 #[test]

@@ -6,7 +6,8 @@
 //! the state at a crossing returns, within [`CycleSearch::tolerance`], to the state one, two, three
 //! or four crossings earlier; a closure after several crossings may be a cycle of fewer whose
 //! crossings alternate about it as they converge (a negative multiplier), which is looked for by
-//! waiting while it converges and by extrapolating its crossings (docs/analysis.md). One period from that crossing, integrated together with the
+//! waiting while it converges and by extrapolating its crossings, refined by Newton's method
+//! (docs/analysis.md). One period from that crossing, integrated together with the
 //! variational equation `dPhi/dt = J(v(t)) Phi`, gives the orbit, the amplitude of each neuron and
 //! the monodromy matrix, whose eigenvalues are the Floquet multipliers. One multiplier is 1 (along
 //! the orbit); the cycle is stable when every other one lies inside the unit circle. An orbit
@@ -387,7 +388,10 @@ fn settle(
     settings: &CycleSearch,
 ) -> Result<Option<Cycle>> {
     for q in (1..p).filter(|&q| p.is_multiple_of(q)) {
-        if let Some((x, period)) = extrapolated(sections, q) {
+        let guess = extrapolated(sections, q);
+        if let Some((x, period)) =
+            guess.and_then(|(x, t)| refined(field, &x, t, k, dt, settings.tolerance))
+        {
             if let Some(cycle) = describe(field, &x, period, q, k, dt, settings)? {
                 if cycle.stable {
                     return Ok(Some(cycle));
@@ -396,6 +400,62 @@ fn settle(
         }
     }
     describe_closed(field, sections, p, at, k, dt, settings)
+}
+
+/// Newton steps at most, in [`refined`].
+const NEWTON_STEPS: usize = 8;
+
+/// `start` and `period` of a periodic orbit refined by Newton's method: the state `x` on the
+/// section (the section neuron `k` held at its value) and the period `T` with `v(T; x) = x`, each
+/// step solving `(Phi - I) dx + f(v(T)) dT = x - v(T)` with `dx_k = 0`, `Phi` the monodromy from
+/// the variational equation. Some when the orbit closes within `tolerance / 10` in at most
+/// [`NEWTON_STEPS`] steps (Newton converges to a periodic orbit, stable or not, when it starts near
+/// one), else None: no orbit of that many crossings there.
+fn refined(
+    field: &Field<'_>,
+    start: &[f64],
+    period: f64,
+    k: usize,
+    dt: f64,
+    tolerance: f64,
+) -> Option<(Vec<f64>, f64)> {
+    let n = field.size();
+    let (mut x, mut t) = (start.to_vec(), period);
+    let mut rk = Rk4::new(n);
+    for _ in 0..=NEWTON_STEPS {
+        if !(t.is_finite() && t > 0.0) {
+            return None;
+        }
+        let steps = (t / dt).ceil().max(1.0) as usize;
+        let h = t / steps as f64;
+        let mut v = x.clone();
+        let mut phi = DMatrix::<f64>::identity(n, n);
+        for _ in 0..steps {
+            rk.step(field, &mut v, Some(&mut phi), h);
+        }
+        let residual: Vec<f64> = v.iter().zip(&x).map(|(a, b)| a - b).collect();
+        if !residual.iter().all(|r| r.is_finite()) {
+            return None;
+        }
+        if max_abs(&residual) < tolerance / 10.0 {
+            return Some((x, t));
+        }
+        let mut rate = vec![0.0; n];
+        field.rate(&v, &mut rate);
+        let a = DMatrix::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
+            (true, true) => phi[(i, j)] - if i == j { 1.0 } else { 0.0 },
+            (true, false) => rate[i],
+            (false, true) => f64::from(u8::from(j == k)),
+            (false, false) => 0.0,
+        });
+        let b = nalgebra::DVector::from_fn(n + 1, |i, _| if i < n { -residual[i] } else { 0.0 });
+        let step = a.lu().solve(&b)?;
+        for i in 0..n {
+            x[i] += step[i];
+        }
+        t += step[n];
+    }
+    None
 }
 
 /// [`describe`] of the orbit that closed at crossing `at` after `p` crossings.

@@ -356,6 +356,37 @@ def test_avoid_evolves_and_resumes_to_the_end_of_an_unbroken_run(tmp_path: Path)
 
     assert draw_run(tmp_path / "whole", seed=3) == ["fitness.png", "episodes.png", "paths.png"]
     assert (tmp_path / "whole" / "paths.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # The path ends where the robot ended, after its last step (it ended one step short).
+    from dnnevo.tasks.user import record
+
+    from dnnevo.runs import RunDir
+
+    config, _ = RunDir(tmp_path / "whole").read_config()
+    episode = record(config, whole.best, 1, seed=3, probe=lambda env: {"pose": env.fleet.poses})[0]
+    again = Avoid(steps=20)
+    ended = rollout([whole.best], again, max_steps=20, seed=3, purpose="evaluate")
+    assert len(episode.probed("pose")) == len(episode.rewards) + 1 == int(ended.lengths[0, 0]) + 1
+    np.testing.assert_array_equal(episode.probed("pose")[-1], again.fleet.poses[0])
+
+
+def test_a_count_of_robot_parts_past_the_limit_is_named_not_allocated() -> None:
+    """A typing error (10**9 rays) allocated until the machine ran out of memory."""
+    import re
+
+    for settings, message in [(dict(sonar={"rays": 10**7}), "sonar.rays is 10000000; it must be in [1, 4096]"),
+                              (dict(sectors={"count": 10**9}), "sectors.count is 1000000000; it must be in [0, 4096]"),
+                              (dict(pursuers={"count": 10**9}), "pursuers.count is 1000000000; it must be in [0, 4096]"),
+                              (dict(sonar={"angles_deg": [1000.0]}), "sonar.angles_deg[0] is 1000; it must be in [-360, 360]")]:
+        with pytest.raises(InvalidArgumentError, match=re.escape(message)):
+            RobotWorld("landmark1", **settings)
+
+
+def test_a_world_file_that_does_not_parse_is_named(tmp_path: Path) -> None:
+    """With a training and a transfer world, "world file: line 1" did not say which."""
+    bad = tmp_path / "room_b.toml"
+    bad.write_text("[room]\nsize = [6.0, 5.0]\n")
+    with pytest.raises(InvalidArgumentError, match=f"^world file {bad}: line 1: room: "):
+        RobotWorld(bad)
 
 
 def test_avoid_pays_for_speed_and_charges_for_contacts() -> None:

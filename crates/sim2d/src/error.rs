@@ -112,6 +112,24 @@ fn number(x: f64) -> String {
     }
 }
 
+/// The most of anything a robot has that its settings count (a sonar's rays, the sonars of a
+/// ring, sectors, pursuers): far above any real robot, and small enough that a typing error (a
+/// count of `10**9`) is an error naming the setting, not an allocation that takes the machine.
+pub const MAX_PARTS: u64 = 4096;
+
+/// Checks that a count of parts is in `least..=MAX_PARTS`.
+pub fn check_count(field: &str, value: u64, least: u64) -> Result<(), Error> {
+    if (least..=MAX_PARTS).contains(&value) {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            field,
+            value,
+            &format!("in [{least}, {MAX_PARTS}]"),
+        ))
+    }
+}
+
 /// Checks that `value` is a finite number.
 pub fn check_finite(field: &str, value: f64) -> Result<(), Error> {
     check_range(field, value, f64::NEG_INFINITY, false, f64::INFINITY, false)

@@ -24,7 +24,7 @@
 
 use streams::Stream;
 
-use crate::error::{check_range, Error};
+use crate::error::{check_count, check_range, Error};
 use crate::pose::{wrap_angle, Pose};
 use crate::robot::RobotSpec;
 use crate::world::{World, START_ATTEMPTS};
@@ -82,6 +82,7 @@ impl PursuerSpec {
     /// Checks every field; the error names the first bad one (as `pursuers.<field>`).
     pub fn validate(&self) -> Result<(), Error> {
         let inf = f64::INFINITY;
+        check_count("pursuers.count", u64::from(self.count), 0)?;
         check_range("pursuers.radius", self.radius, 0.0, false, inf, false)?;
         check_range("pursuers.speed", self.speed, 0.0, true, inf, false)?;
         check_range(

@@ -16,7 +16,7 @@
 
 use streams::Stream;
 
-use crate::error::{check_finite, Error};
+use crate::error::{check_count, check_range, Error};
 use crate::pose::Pose;
 use crate::scene::{Disc, Scene};
 use crate::sonar::SonarSpec;
@@ -70,8 +70,16 @@ impl Default for RingSpec {
 impl RingSpec {
     /// Checks every field; the error names the first bad one (as `sonar.<field>`).
     pub fn validate(&self) -> Result<(), Error> {
+        check_count("sonar.angles_deg's length", self.angles_deg.len() as u64, 0)?;
         for (i, a) in self.angles_deg.iter().enumerate() {
-            check_finite(&format!("sonar.angles_deg[{i}]"), *a)?;
+            check_range(
+                &format!("sonar.angles_deg[{i}]"),
+                *a,
+                -360.0,
+                true,
+                360.0,
+                true,
+            )?;
         }
         self.sonar(0.0, 0.0).validate_as("sonar")
     }

@@ -16,7 +16,7 @@
 
 use std::f64::consts::TAU;
 
-use crate::error::{check_range, Error};
+use crate::error::{check_count, check_range, Error};
 use crate::pose::{wrap_angle, Pose};
 
 /// The pursuer sensor's sectors. `Default` is none (the sensor is off).
@@ -54,6 +54,7 @@ impl Default for SectorSpec {
 impl SectorSpec {
     /// Checks every field; the error names the first bad one (as `sectors.<field>`).
     pub fn validate(&self) -> Result<(), Error> {
+        check_count("sectors.count", u64::from(self.count), 0)?;
         check_range(
             "sectors.range",
             self.range,

@@ -15,7 +15,7 @@
 
 use streams::Stream;
 
-use crate::error::{check_finite, check_range, Error};
+use crate::error::{check_count, check_finite, check_range, Error};
 use crate::pose::Pose;
 use crate::world::World;
 
@@ -86,9 +86,7 @@ impl SonarSpec {
         check_finite(&f("mount_angle_deg"), self.mount_angle_deg)?;
         check_range(&f("mount_offset"), self.mount_offset, 0.0, true, inf, false)?;
         check_range(&f("cone_deg"), self.cone_deg, 0.0, false, 180.0, false)?;
-        if self.rays == 0 {
-            return Err(Error::invalid(f("rays"), 0, ">= 1"));
-        }
+        check_count(&f("rays"), u64::from(self.rays), 1)?;
         check_range(&f("min_range"), self.min_range, 0.0, true, inf, false)?;
         if !(self.max_range.is_finite() && self.max_range > self.min_range) {
             return Err(Error::invalid(

@@ -117,7 +117,13 @@ class RobotWorld:
                 if not isinstance(section, Mapping):
                     raise InvalidArgumentError(f"{name} is {section!r}; expected a dict of settings")
                 settings[name] = dict(section)
-        self.fleet = _core.Fleet(world_of(world), settings)
+        try:
+            self.fleet = _core.Fleet(world_of(world), settings)
+        except InvalidArgumentError as e:
+            file = isinstance(world, PathLike) or isinstance(world, str) and world.endswith(".toml")
+            if file and str(e).startswith("world file: "):  # the core parsed its text, not the file
+                raise InvalidArgumentError(f"world file {world}: {str(e).removeprefix('world file: ')}") from None
+            raise
         """The rows' robots, pursuers and readings (``dnnevo._core.Fleet``)."""
         self.world: dict[str, Any] = self.fleet.world
         """The world, as a dict."""

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, cast
 
@@ -130,7 +130,7 @@ class UserTask:
         fig, axes = plot.subplots(1, len(episodes), figsize=(4.5 * len(episodes), 4.2),
                                   layout="constrained", squeeze=False)
         for e, (ax, ep) in enumerate(zip(axes[0], episodes, strict=True)):
-            plot.plot_paths(worlds[0], ep.probes["pose"], ax, pursuers=ep.probes["pursuers"], title=(
+            plot.plot_paths(worlds[0], ep.probed("pose"), ax, pursuers=ep.probed("pursuers"), title=(
                 f"episode {e}: return {np.cumsum(ep.rewards)[-1]:.4g}, {len(ep.rewards)} steps"))
         axes[0, 0].legend(loc="upper left", fontsize=8, framealpha=0.9)
         fig.suptitle(f"{run.path.name}: the champion's robot on fresh episodes (seed {seed}; "
@@ -225,6 +225,12 @@ class Episode:
     """(T,): the reward of each step."""
     probes: dict[str, npt.NDArray[Any]]
     """Each probed name's values, (T, ...)."""
+    after: dict[str, npt.NDArray[Any]] = field(default_factory=dict)
+    """Each probed name's values after the episode's last step, (...): where a robot ended."""
+
+    def probed(self, name: str) -> npt.NDArray[Any]:
+        """``name``'s values at every step and after the last, (T + 1, ...)."""
+        return np.concatenate([self.probes[name], self.after[name][None]])
 
 
 Probe = Callable[[Any], dict[str, npt.ArrayLike]]
@@ -280,9 +286,11 @@ def record(config: EvolutionConfig, net: _core.Network, episodes: int, *, seed: 
         active &= ~ended
         if not active.any():
             break
+    if probe is not None:  # after the last step: an ended row is no longer moved
+        probed.append({k: np.array(v) for k, v in probe(env).items()})
     stacked_in, stacked_out, stacked_paid = np.stack(ins, axis=1), np.stack(outs, axis=1), np.stack(paid, axis=1)
     names = probed[0].keys() if probed else ()
     stacked = {k: np.stack([p[k] for p in probed], axis=1) for k in names}
     return [Episode(stacked_in[e, :n], stacked_out[e, :n], stacked_paid[e, :n],
-                    {k: v[e, :n] for k, v in stacked.items()})
+                    {k: v[e, :n] for k, v in stacked.items()}, {k: v[e, n] for k, v in stacked.items()})
             for e, n in enumerate(lengths.tolist())]

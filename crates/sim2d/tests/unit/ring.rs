@@ -141,7 +141,14 @@ fn bad_rings_are_refused_by_name() {
             angles_deg: vec![0.0, f64::NAN],
             ..RingSpec::default()
         }),
-        "sonar.angles_deg[1] is NaN; it must be a finite number"
+        "sonar.angles_deg[1] is NaN; it must be in [-360, 360]"
+    );
+    assert_eq!(
+        bad(RingSpec {
+            angles_deg: vec![1000.0],
+            ..RingSpec::default()
+        }),
+        "sonar.angles_deg[0] is 1000; it must be in [-360, 360]"
     );
     assert_eq!(
         bad(RingSpec {
@@ -155,7 +162,7 @@ fn bad_rings_are_refused_by_name() {
             rays: 0,
             ..RingSpec::default()
         }),
-        "sonar.rays is 0; it must be >= 1"
+        "sonar.rays is 0; it must be in [1, 4096]"
     );
     assert!(Ring::new(&RingSpec::default(), -1.0).is_err());
 }

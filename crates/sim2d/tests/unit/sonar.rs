@@ -175,7 +175,16 @@ fn mount_geometry_and_validation() {
     };
     assert_eq!(
         bad.validate().unwrap_err().to_string(),
-        "sonar.rays is 0; it must be >= 1"
+        "sonar.rays is 0; it must be in [1, 4096]"
+    );
+    // A typing error in a count is named, not an allocation that takes the machine.
+    let bad = SonarSpec {
+        rays: 1_000_000_000,
+        ..SonarSpec::default()
+    };
+    assert_eq!(
+        bad.validate().unwrap_err().to_string(),
+        "sonar.rays is 1000000000; it must be in [1, 4096]"
     );
     let bad = SonarSpec {
         max_range: 0.1,

@@ -169,3 +169,16 @@ def test_fisher_exact_matches_hand_computed_tables_and_is_symmetric() -> None:
         assert 0 < p <= 1 and p == pytest.approx(stats.fisher_exact(k2, n2, k1, n1), rel=1e-12)
     with pytest.raises(InvalidArgumentError, match="counts 11 of 10"):
         stats.fisher_exact(11, 10, 1, 10)
+
+
+def test_numpy_counts_are_counts() -> None:
+    """A count from a NumPy sum (np.int64) was refused with "k is np.int64(0); it must lie in
+    [0, n]", which it did; a bool is still no count."""
+    import numpy as np
+
+    from dnnevo.evaluation import stats
+
+    assert stats.wilson(np.int64(3), np.int64(10)) == stats.wilson(3, 10)
+    assert stats.wilson(np.float64(2.5), 10) == stats.wilson(2.5, 10)
+    with pytest.raises(InvalidArgumentError, match="k is True"):
+        stats.wilson(True, 10)

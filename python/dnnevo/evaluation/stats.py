@@ -20,6 +20,7 @@ not degenerate at ``k = 0`` or ``k = n``.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
@@ -61,16 +62,22 @@ Verdict = Literal["pass", "fail", "undecided"]
 ``"undecided"``: it straddles the threshold."""
 
 
+def _real(x: object) -> bool:
+    """Whether ``x`` is a real number, Python's or NumPy's (a count from ``ok.sum()``), and not a
+    bool."""
+    return isinstance(x, numbers.Real) and not isinstance(x, bool | np.bool_)
+
+
 def _check_counts(k: float, n: float) -> tuple[float, float]:
-    if not (isinstance(n, (int, float)) and math.isfinite(n) and n > 0):
+    if not (_real(n) and math.isfinite(n) and n > 0):
         raise InvalidArgumentError(f"n is {n!r}; a rate needs n > 0 trials")
-    if not (isinstance(k, (int, float)) and math.isfinite(k) and 0 <= k <= n):
+    if not (_real(k) and math.isfinite(k) and 0 <= k <= n):
         raise InvalidArgumentError(f"k is {k!r}; it must lie in [0, n] = [0, {n}]")
     return float(k), float(n)
 
 
 def _check_unit(name: str, value: float, *, open_ends: bool) -> float:
-    ok = isinstance(value, (int, float)) and (0 < value < 1 if open_ends else 0 <= value <= 1)
+    ok = _real(value) and (0 < value < 1 if open_ends else 0 <= value <= 1)
     if not ok:
         allowed = "(0, 1)" if open_ends else "[0, 1]"
         raise InvalidArgumentError(f"{name} is {value!r}; it must lie in {allowed}")
@@ -78,7 +85,7 @@ def _check_unit(name: str, value: float, *, open_ends: bool) -> float:
 
 
 def _check_z(z: float) -> float:
-    if not (isinstance(z, (int, float)) and math.isfinite(z) and z > 0):
+    if not (_real(z) and math.isfinite(z) and z > 0):
         raise InvalidArgumentError(f"z is {z!r}; it must be a positive number such as 1.96")
     return float(z)
 

@@ -375,9 +375,10 @@ fn from_start(
 
 /// The cycle of an orbit that closed at crossing `at` after `p > 1` crossings: a stable cycle of
 /// fewer crossings `q` (dividing `p`) when the last crossings `q` apart, extrapolated to their
-/// limit ([`extrapolated`]), give one (so slowly converging that `q` never closed, as near a
-/// multiplier of -1), else the orbit that closed. Near a genuine cycle of `p` crossings the
-/// extrapolated orbit does not close, or closes on an unstable cycle, and is not taken.
+/// limit ([`extrapolated`]) and refined ([`refined`]), give one (so slowly converging that `q`
+/// never closed, as near a multiplier of -1), else the orbit that closed. Near a genuine cycle of
+/// `p` crossings Newton's method finds no orbit of `q` crossings, or an unstable one, and it is
+/// not taken.
 fn settle(
     field: &Field<'_>,
     sections: &[(f64, Vec<f64>)],

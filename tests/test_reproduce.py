@@ -72,6 +72,12 @@ def test_the_graph_puts_every_job_after_what_it_needs() -> None:
         "landmark-wide-first-worlds"}
     with pytest.raises(ConfigError, match="families are"):
         plan.jobs([0], only=["vision"])
+    # An experiment's name picks it alone, after the jobs it needs, with a family beside it.
+    assert [j.id for j in plan.jobs([2], only=["nav1d-system", "classic"])] == [
+        "nav1d-classifier/seed-2", "nav1d-far/seed-2", "nav1d-near/seed-2", "nav1d-system/seed-2",
+        "legged-walker/seed-2", "categorical-perception/seed-2", "double-pole/seed-2"]
+    with pytest.raises(ConfigError, match="did you mean 'sequence-2bit'"):
+        plan.jobs([0], only=["sequence-2bt"])
     with pytest.raises(ConfigError, match="distinct"):
         plan.jobs([1, 1])
 
@@ -348,6 +354,7 @@ def test_the_ablation_removes_one_departure_of_the_working_2bit_route_at_a_time(
         "ablation-2bit-no-elites": {"elitism": 0},
         "ablation-2bit-validation-32": {"task_params.validation_trials": 32},
         "ablation-2bit-champions": {"seed_populations": False},
+        "ablation-2bit-smallest": {"selection": "proportional", "task_params.validation_trials": 32},
     }
     assert (base.seed_populations, base.spare_neurons, want["task_params.clamp"]) == (True, 6, "evaluation")
 
@@ -392,14 +399,15 @@ def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collec
     parents = order[:2]
     assert [j.id for j in parents] == ["sequence-1bit/seed-0", "sequence-2bit-alternating/seed-0"]
     assert all(j.spec.family == "ablation" and j.needs == tuple(p.id for p in parents) for j in order[2:])
-    assert len(order) == 2 + 6
+    variants = len(order) - 2
+    assert variants == 7
     out = tmp_path / "repro"
     args = ["reproduce", "--only", "ablation", "--seeds", "0", "--quick", "--set", "generations=2",
             "--set", "task_params.validation_trials=4", "--eval-trials", "10", "--no-dt-check", "--in-process",
             "--no-figures", "--out", out]
     r = run_cli(*args)
     assert r.returncode == 0, r.stderr
-    assert "8 runs in" in r.stdout and "(0 already done)" in r.stdout
+    assert f"{len(order)} runs in" in r.stdout and "(0 already done)" in r.stdout
     for job in order[2:]:
         run = (out / job.id / "config.toml").read_text()
         assert "sequence-1bit/seed-0" in run and "sequence-2bit-alternating/seed-0" in run
@@ -423,13 +431,13 @@ def test_the_ablation_runs_the_sequence_runs_it_composes_or_uses_them_and_collec
     copied = results.collect(out, stored, families=["ablation"], seeds=[0], commit="abc1234")
     assert copied == [j.id for j in order[2:]]
     family = json.loads((stored / results.PROVENANCE_FILE).read_text())["families"]
-    assert list(family) == ["ablation"] and family["ablation"]["runs"] == family["ablation"]["planned"] == 6
+    assert list(family) == ["ablation"] and family["ablation"]["runs"] == family["ablation"]["planned"] == variants
     page = stored.parent / "sequence.md"
     page.write_text("<!-- results:summary:ablation:begin -->\n<!-- results:summary:ablation:end -->\n")
     assert results.render(stored.parent.parent) == [page]
     text = page.read_text()
     assert all(f"| {j.experiment} | not in the paper | 1/1 |" in text for j in order[2:])
-    assert "| sequence-1bit |" not in text and "6 of 6 runs done" in text
+    assert "| sequence-1bit |" not in text and f"{variants} of {variants} runs done" in text
 
 
 @pytest.mark.slow

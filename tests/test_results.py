@@ -80,15 +80,20 @@ def test_tables_are_made_from_the_results_alone(repo: Path, reproduction: Path) 
     assert "| sequence-3bit | §5.4: 1 success, at generation 700 | not yet run |" in readme
     hand = plan.experiment("reactive-navigation-hand")
     assert f"| {hand.name} | {hand.paper} | not yet run | - | - |" in readme
-    planned = len(plan.jobs([0], results.REFERENCE_FAMILIES))  # the paper's families and the ablation, seed 0
+    planned = len(plan.jobs([0], plan.PAPER_FAMILIES))  # the paper's families, seed 0
     assert "commit abc1234" in readme and f"10 of {planned} runs done" in readme and "Quick mode" in readme
-    # The ablation of the 2-bit route is part of the reference reproduction: its rows say "not
-    # yet run". Other families beyond the paper's appear only once their runs are collected.
-    ablation = [e for e in plan.EXPERIMENTS if e.family == "ablation"]
-    assert ablation and all(f"| {e.name} | {e.paper} | not yet run |" in readme for e in ablation)
-    assert not any(f"| {e.name} |" in readme for e in plan.EXPERIMENTS if e.family not in results.REFERENCE_FAMILIES)
-
+    # The README holds the paper's families alone; the results page holds every family. The
+    # ablation of the 2-bit route is part of the reference reproduction: its rows say "not yet
+    # run". Other families beyond the paper's appear only once their runs are collected.
+    assert not any(f"| {e.name} |" in readme for e in plan.EXPERIMENTS if e.family not in plan.PAPER_FAMILIES)
     page = (stored / "index.md").read_text()
+    summary = page.split("<!-- results:summary:end -->")[0]
+    ablation = [e for e in plan.EXPERIMENTS if e.family == "ablation"]
+    assert ablation and all(f"| {e.name} | {e.paper} | not yet run |" in summary for e in ablation)
+    assert not any(f"| {e.name} |" in summary for e in plan.EXPERIMENTS if e.family not in results.REFERENCE_FAMILIES)
+    every = len(plan.jobs([0], results.REFERENCE_FAMILIES))
+    assert f"10 of {every} runs done" in summary
+
     assert "<!-- results:landmark:begin -->\n\n### landmark\n\nPaper: §3" in page
     assert "| seed | right (95% interval) | confusion" in page
     assert "| seed | training: right (95% interval) | follower (held out): right (95% interval) |" in page
@@ -131,8 +136,9 @@ def test_without_results_every_experiment_is_not_yet_run(tmp_path: Path) -> None
     assert results.render(tmp_path) == [tmp_path / "README.md"]
     text = (tmp_path / "README.md").read_text()
     assert "No results yet in docs/results/" in text
-    reference = [e for e in plan.EXPERIMENTS if e.family in results.REFERENCE_FAMILIES]
-    assert sum(f"| {e.name} | {e.paper} | not yet run |" in text for e in reference) == len(reference)
+    paper = [e for e in plan.EXPERIMENTS if e.family in plan.PAPER_FAMILIES]
+    assert sum(f"| {e.name} | {e.paper} | not yet run |" in text for e in paper) == len(paper)
+    assert not any(f"| {e.name} |" in text for e in plan.EXPERIMENTS if e.family not in plan.PAPER_FAMILIES)
 
 
 def test_bad_markers_and_mixed_reproductions_are_named(tmp_path: Path, repo: Path) -> None:
@@ -258,7 +264,8 @@ def test_a_result_that_differs_from_the_one_collected_is_refused(tmp_path: Path,
 
 @pytest.mark.slow
 def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, repo: Path) -> None:
-    """The classic benchmarks, collected beside the paper's families, get their rows."""
+    """The classic benchmarks, collected beside the paper's families, get their rows on the
+    results page, not in the README."""
     source = tmp_path / "classic"
     r = run_cli("reproduce", "--only", "classic", "--seeds", "0", "--quick", "--eval-trials", "10",
                 "--no-dt-check", "--in-process", "--out", source)
@@ -267,9 +274,10 @@ def test_a_family_beyond_the_papers_is_collected_and_rendered(tmp_path: Path, re
                  "--commit", "abc1234")
     assert r.returncode == 0, r.stderr
     assert repo / "README.md" in results.render(repo)
-    readme = (repo / "README.md").read_text()
+    readme, page = (repo / "README.md").read_text(), (repo / "docs" / "results" / "index.md").read_text()
     for e in (e for e in plan.EXPERIMENTS if e.family == "classic"):
-        assert f"| {e.name} | {e.paper} | 1/1 |" in readme, e.name
+        assert f"| {e.name} | {e.paper} | 1/1 |" in page, e.name
+        assert f"| {e.name} |" not in readme, e.name
     assert "| landmark | " in readme
 
 

@@ -52,6 +52,7 @@ EXAMPLE = """examples:
   dnnevo reproduce --only classic --quick --seeds 0 --out runs/repro-classic
   dnnevo reproduce --out reproduce --workers 4 --threads-per-worker 2
   dnnevo reproduce --only ablation --out reproduce      uses the sequence runs it holds
+  dnnevo reproduce --only sequence-2bit --seeds 3 --out reproduce   one experiment and the runs it needs
   dnnevo reproduce --only precision --quick --seeds 0 --out runs/repro-f32   seconds
   dnnevo reproduce --out /shared/reproduce --scheduler tcp://HOST:8786
 
@@ -71,9 +72,9 @@ def add_parser(sub: Any, parse_seeds: Any, positive: Any) -> None:
                        description=DESCRIPTION, epilog=EXAMPLE, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--seeds", type=parse_seeds, default=parse_seeds("0-9"), help="e.g. 0-9 or 1,4,7 (default 0-9)")
     p.add_argument("--quick", action="store_true", help="each preset's quick variant: small populations, few generations")
-    p.add_argument("--only", type=_families, default=plan.PAPER_FAMILIES, metavar="FAMILIES",
-                   help=f"comma-separated, from {','.join(plan.FAMILIES)} (default the paper's: "
-                        f"{','.join(plan.PAPER_FAMILIES)})")
+    p.add_argument("--only", type=_picked, default=plan.PAPER_FAMILIES, metavar="NAMES",
+                   help=f"comma-separated families, from {','.join(plan.FAMILIES)} (default the paper's: "
+                        f"{','.join(plan.PAPER_FAMILIES)}), or experiments, e.g. sequence-2bit")
     p.add_argument("--out", type=Path, default=Path("reproduce"), help="the reproduction's folder (default reproduce)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a setting for every evolution, after its preset's, e.g. population=200")
@@ -91,9 +92,9 @@ def add_parser(sub: Any, parse_seeds: Any, positive: Any) -> None:
                    help="a report of tables only: drawing the figures takes about a second per experiment")
 
 
-def _families(text: str) -> tuple[str, ...]:
+def _picked(text: str) -> tuple[str, ...]:
     try:
-        return plan.families(text.split(","))
+        return plan.picked(text.split(","))
     except ConfigError as e:
         raise argparse.ArgumentTypeError(str(e)) from None
 

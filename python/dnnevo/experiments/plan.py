@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from dnnevo.errors import ConfigError, did_you_mean
 
 __all__ = ["FAMILIES", "PAPER_FAMILIES", "EXPERIMENTS", "EVOLVE", "ROBOT_LIKE", "HELD_OUT", "SYSTEM", "HAND_DESIGNED",
-           "Experiment", "Job", "jobs", "experiment"]
+           "Experiment", "Job", "jobs", "picked", "experiment"]
 
 PAPER_FAMILIES = ("landmark", "robots", "nav1d", "sequence")
 """The paper's experiment families, in the paper's order (``robots`` is §3.2's other robot
@@ -106,7 +106,8 @@ _CHAINED = ("task_params.chained=true", "task_params.reinforcement_input=true", 
 # The working incremental 2-bit route (sequence-2bit: member-by-member composites of the two
 # runs' last populations and 6 spare neurons, 16 neurons, the score clamped once per evaluation,
 # rank selection, 20 elites, 128 validation trials per target) with one departure from the paper
-# removed: (name, overrides of the preset, --seed-populations, --spare-neurons, what is removed).
+# removed, and last with the two that mattered least removed together: (name, overrides of the
+# preset, --seed-populations, --spare-neurons, what is removed).
 _ABLATION: tuple[tuple[str, tuple[str, ...], bool, int, str], ...] = (
     ("no-spare", ("size=10",), True, 0,
      "its 6 spare neurons: the composites alone, 10 neurons as in the paper"),
@@ -121,6 +122,9 @@ _ABLATION: tuple[tuple[str, tuple[str, ...], bool, int, str], ...] = (
     ("champions", (), False, 6,
      "composing the two runs' last populations member by member: their champions are composed (with "
      "6 spare neurons) and the first population is that composite and its mutants, as in the paper"),
+    ("smallest", ("selection=proportional", "task_params.validation_trials=32"), True, 6,
+     "rank selection and its 128 validation trials together, the two departures whose removal lost "
+     "least: the smallest departure from the paper that the ablation points to"),
 )
 
 # The experiments run again in single precision, with the seeds and the fresh trials of their f64
@@ -305,14 +309,33 @@ def families(only: Iterable[str] | None) -> tuple[str, ...]:
     return picked
 
 
+def picked(only: Iterable[str] | None) -> tuple[str, ...]:
+    """The families and experiments ``--only`` names (the paper's families when None), checked:
+    a name is a family's or an experiment's."""
+    if only is None:
+        return PAPER_FAMILIES
+    names = tuple(dict.fromkeys(only))
+    known = (*FAMILIES, *(e.name for e in EXPERIMENTS))
+    unknown = [n for n in names if n not in known]
+    if unknown or not names:
+        hint = did_you_mean(unknown[0], known) if unknown else ""
+        raise ConfigError(f"--only {','.join(names) or '(empty)'}{hint}: families are {', '.join(FAMILIES)}; "
+                          "an experiment's name picks that experiment alone (with what it needs)")
+    return names
+
+
 def jobs(seeds: Sequence[int], only: Iterable[str] | None = None) -> list[Job]:
-    """The jobs of the families ``only`` (default the paper's) over ``seeds``, each after the jobs
-    it needs, with the jobs of other families that they need."""
-    chosen = families(only)
+    """The jobs of the families and experiments ``only`` names (default the paper's families) over
+    ``seeds``, each after the jobs it needs, with the jobs of other families that they need.
+
+    >>> [job.id for job in jobs([4], only=["sequence-2bit"])]
+    ['sequence-1bit/seed-4', 'sequence-2bit-alternating/seed-4', 'sequence-2bit/seed-4']
+    """
+    chosen = picked(only)
     if not seeds or any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
         raise ConfigError(f"seeds must be distinct and >= 0, at least one; got {list(seeds)[:10]}"
                           + (" ..." if len(seeds) > 10 else ""))
-    wanted = {e.name for e in EXPERIMENTS if e.family in chosen}
+    wanted = {e.name for e in EXPERIMENTS if e.family in chosen or e.name in chosen}
     for e in reversed(EXPERIMENTS):  # needs come first, so this takes needs of needs too
         if e.name in wanted:
             wanted.update(e.needs)

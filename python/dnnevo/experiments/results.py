@@ -20,9 +20,10 @@ Two commands::
 ``docs/results/``. ``render`` writes the tables between marker lines in ``README.md`` and every
 Markdown file under ``docs/``, from ``docs/results/`` alone:
 
-- ``<!-- results-table:begin -->`` / ``<!-- results-table:end -->`` (the README) and
-  ``<!-- results:summary:begin -->`` / ``...:end -->``: the paper-vs-dnnevo table, one row per
+- ``<!-- results:summary:begin -->`` / ``...:end -->``: the paper-vs-dnnevo table, one row per
   experiment of the plan, "not yet run" where no result is stored yet;
+- ``<!-- results-table:begin -->`` / ``<!-- results-table:end -->`` (the README): the same
+  table for the paper's families alone;
 - ``<!-- results:summary:FAMILY:begin -->``: the same table, for one family;
 - ``<!-- results:FAMILY:begin -->``: each experiment of the family, with one row per seed;
 - ``<!-- results:machine:begin -->``: the machine, and the time per experiment and family.
@@ -435,18 +436,19 @@ def _duration(seconds: float) -> str:
     return f"{h} h {m:02d} min"
 
 
-def _summary(results: Results, family: str | None) -> list[report.Block]:
+def _summary(results: Results, families: tuple[str, ...] | None) -> list[report.Block]:
+    """The paper-vs-dnnevo table of ``families`` (every family when None)."""
     order, outcomes = results.order, results.outcomes()
     rows = []
     for e in plan.EXPERIMENTS:
-        if e.family not in results.families or (family is not None and e.family != family):
+        if e.family not in results.families or (families is not None and e.family not in families):
             continue
         row = report.summary_row(e, order, outcomes)
         if not any(j.experiment == e.name and j.id in results.found for j in order):
             row = (*row[:2], NOT_RUN, *row[3:])
         rows.append(row)
-    done = sum(1 for j in order if j.id in results.found and (family is None or j.spec.family == family))
-    planned = sum(1 for j in order if family is None or j.spec.family == family)
+    mine = [j for j in order if families is None or j.spec.family in families]
+    done, planned = sum(1 for j in mine if j.id in results.found), len(mine)
     prov = results.provenance
     if results.settings is None:
         text = f"No results yet in {RESULTS_DIR.as_posix()}/: every experiment is {NOT_RUN}."
@@ -547,10 +549,12 @@ def blocks(results: Results, key: str) -> list[report.Block]:
     an unknown one."""
     if key.startswith("example:"):
         return examples.blocks(examples.read(results.folder / examples.EXAMPLES_DIR / f"{key[len('example:'):]}.json"))
-    if key in ("summary", _README_KEY):
+    if key == "summary":
         return _summary(results, None)
+    if key == _README_KEY:
+        return _summary(results, plan.PAPER_FAMILIES)
     if key.startswith("summary:") and key.split(":", 1)[1] in plan.FAMILIES:
-        return _summary(results, key.split(":", 1)[1])
+        return _summary(results, (key.split(":", 1)[1],))
     if key in plan.FAMILIES:
         return _family(results, key)
     if key == "machine":

@@ -20,9 +20,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
-use crate::error::{Error, Result};
+use crate::error::{counted, Error, Result};
 use crate::integrate::{check_step, Integrator, Lanes, Precision, CANCEL_CHECK_STEPS, LANES};
-use crate::limits::{check_work, MAX_BATCH_ROWS};
+use crate::limits::{check_batch_step, MAX_BATCH_ROWS};
 use crate::network::{Network, Params};
 use crate::spin;
 use crate::vector::Elem;
@@ -387,7 +387,7 @@ impl Batch {
         cancel: Option<&AtomicBool>,
     ) -> Result<()> {
         let (rows, n, m) = (self.rows(), self.size, self.n_inputs);
-        check_work(rows, 1, self.integ.substeps)?;
+        check_batch_step(rows, self.integ.substeps)?;
         self.check_len("inputs", inputs.len(), rows * m, "B x M")?;
         self.check_len("rates", rates.len(), rows * n, "B x N")?;
         if let Some(mask) = active {
@@ -511,12 +511,14 @@ impl Batch {
         for (&r, &p) in rows.iter().zip(networks) {
             if r >= b_len {
                 return Err(Error::InvalidArgument(format!(
-                    "row {r} is out of range; the batch has {b_len} rows"
+                    "row {r} is out of range; the batch has {}",
+                    counted(b_len, "row")
                 )));
             }
             if p >= p_len {
                 return Err(Error::InvalidArgument(format!(
-                    "network {p} is out of range; the batch has {p_len} networks"
+                    "network {p} is out of range; the batch has {}",
+                    counted(p_len, "network")
                 )));
             }
             if std::mem::replace(&mut named[r], true) {

@@ -33,7 +33,7 @@ use crate::validation::{candidates, Validation, STEP_CHECK_FINER};
 pub trait Task: Send + Sync {
     /// The network shape the task drives.
     fn layout(&self) -> Layout;
-    /// One fitness per network, each finite and >= 0.
+    /// One fitness per network, each finite (and >= 0 under proportional selection).
     fn evaluate(
         &self,
         networks: &[Network],
@@ -313,12 +313,14 @@ impl Evolution {
         self.tell_validated(fitness, validated.as_deref())
     }
 
-    /// Checks that `fitness` fits the population and can be selected on.
+    /// Checks that the state is consistent and that `fitness` fits the population and can be
+    /// selected on.
     fn check(&self, fitness: &[f64]) -> Result<()> {
+        self.check_consistent("the evolution's", Error::Config)?;
         if fitness.len() != self.config.population {
             return Err(Error::Fitness(format!(
-                "got {} fitness values for a population of {}",
-                fitness.len(),
+                "got {} for a population of {}",
+                crate::error::counted(fitness.len(), "fitness value"),
                 self.config.population
             )));
         }
@@ -453,8 +455,8 @@ impl Evolution {
                 Some(v) if v.len() == batch.len() => checked(v)?,
                 Some(v) => {
                     return Err(Error::Fitness(format!(
-                        "the task validated {} networks; it was given {}",
-                        v.len(),
+                        "the task validated {}; it was given {}",
+                        crate::error::counted(v.len(), "network"),
                         batch.len()
                     )))
                 }
@@ -565,54 +567,63 @@ impl Evolution {
     pub fn from_json(text: &str) -> Result<Self> {
         let evo: Evolution = serde_json::from_str(text)
             .map_err(|e| Error::Format(format!("not a valid checkpoint: {e}")))?;
-        evo.config.validate()?;
-        evo.layout.validate()?;
-        check_population_size(evo.layout, &evo.config)?;
-        if evo.population.len() != evo.config.population * evo.layout.len() {
-            return Err(Error::Format(format!(
-                "checkpoint population has {} genes; expected {} x {}",
-                evo.population.len(),
-                evo.config.population,
-                evo.layout.len()
+        evo.check_consistent("checkpoint", Error::Format)?;
+        Ok(evo)
+    }
+
+    /// Checks that the state is consistent, as [`from_json`](Self::from_json) and every
+    /// [`tell`](Self::tell) do (the fields are public, so a caller may have changed them): the
+    /// config and layout are valid, every genome of the population and the champion's decode to
+    /// a network of the layout, and the champion was scored in a generation already run, with a
+    /// validation rate in [0, 1] and a finite score. `what` names the state in the message, which
+    /// `error` makes into an error.
+    fn check_consistent(&self, what: &str, error: fn(String) -> Error) -> Result<()> {
+        self.config.validate()?;
+        self.layout.validate()?;
+        check_population_size(self.layout, &self.config)?;
+        if self.population.len() != self.config.population * self.layout.len() {
+            return Err(error(format!(
+                "{what} population has {} genes; expected {} x {}",
+                self.population.len(),
+                self.config.population,
+                self.layout.len()
             )));
         }
-        if evo.generation == u64::MAX {
-            return Err(Error::Format(format!(
-                "checkpoint generation is {}; no generation can follow it",
-                evo.generation
+        if self.generation == u64::MAX {
+            return Err(error(format!(
+                "{what} generation is {}; no generation can follow it",
+                self.generation
             )));
         }
-        let bad = |what: &str, e: Error| {
-            Error::Format(format!("checkpoint {what}: {}", crate::io::strip(e)))
-        };
-        if let Some((i, e)) = evo
+        let bad = |part: &str, e: Error| error(format!("{what} {part}: {}", crate::io::strip(e)));
+        if let Some((i, e)) = self
             .population
-            .chunks(evo.layout.len())
+            .chunks(self.layout.len())
             .enumerate()
-            .find_map(|(i, genes)| genome::decode(evo.layout, genes).err().map(|e| (i, e)))
+            .find_map(|(i, genes)| genome::decode(self.layout, genes).err().map(|e| (i, e)))
         {
             return Err(bad(&format!("population[{i}]"), e));
         }
-        if let Some(c) = &evo.champion {
-            genome::decode(evo.layout, &c.genes).map_err(|e| bad("champion", e))?;
-            if c.generation >= evo.generation {
-                return Err(Error::Format(format!(
-                    "checkpoint champion was scored in generation {}; the state is at generation \
+        if let Some(c) = &self.champion {
+            genome::decode(self.layout, &c.genes).map_err(|e| bad("champion", e))?;
+            if c.generation >= self.generation {
+                return Err(error(format!(
+                    "{what} champion was scored in generation {}; the state is at generation \
                      {}, so it can only come from an earlier one",
-                    c.generation, evo.generation
+                    c.generation, self.generation
                 )));
             }
             if let Some(v) = c.validation {
                 if !((0.0..=1.0).contains(&v.rate) && v.score.is_finite()) {
-                    return Err(Error::Format(format!(
-                        "checkpoint champion has validation rate {} and score {}; a rate lies in \
+                    return Err(error(format!(
+                        "{what} champion has validation rate {} and score {}; a rate lies in \
                          [0, 1] and a score is finite",
                         v.rate, v.score
                     )));
                 }
             }
         }
-        Ok(evo)
+        Ok(())
     }
 }
 

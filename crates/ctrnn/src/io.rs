@@ -327,8 +327,9 @@ pub(crate) fn strip(e: Error) -> String {
     }
 }
 
-/// Writes `file` to `path` atomically.
-pub fn save(path: &Path, file: &NetworkFile) -> Result<()> {
+/// Writes `file` to `path` (a `&str`, `&Path` or `PathBuf`) atomically.
+pub fn save(path: impl AsRef<Path>, file: &NetworkFile) -> Result<()> {
+    let path = path.as_ref();
     // A file that `load` would refuse is not written: meta's conventional keys are named here,
     // and anything else (a NaN dt, which JSON writes as null) by reading the text back.
     if let Some(problem) = meta_problem(&file.meta) {
@@ -361,8 +362,15 @@ pub fn from_bytes(bytes: &[u8]) -> Result<NetworkFile> {
 
 /// Reads and validates the network file at `path`. A file that cannot be read is
 /// [`Error::Io`]; one whose content is not a network file (not UTF-8 included) is
-/// [`Error::Format`], naming the path.
-pub fn load(path: &Path) -> Result<NetworkFile> {
+/// [`Error::Format`], naming the path. `path` is a `&str`, `&Path` or `PathBuf`.
+///
+/// # Example
+/// ```
+/// let e = ctrnn::io::load("no-such-network.json").unwrap_err();
+/// assert!(e.to_string().contains("cannot read no-such-network.json"));
+/// ```
+pub fn load(path: impl AsRef<Path>) -> Result<NetworkFile> {
+    let path = path.as_ref();
     let bytes = fs::read(path).map_err(|source| Error::Io {
         context: format!("cannot read {}", path.display()),
         source,

@@ -28,6 +28,29 @@ pub fn check_work(networks: usize, rows: usize, substeps: usize) -> Result<()> {
     Ok(())
 }
 
+/// Checks that one step of a [`Batch`](crate::Batch) of `rows` rows, `substeps` steps each,
+/// stays within [`MAX_CALL_STEPS`]: [`check_work`] in a batch's words, whose rows may be one
+/// network's episodes.
+///
+/// # Example
+/// ```
+/// use ctrnn::limits::check_batch_step;
+/// assert!(check_batch_step(200, 1000).is_ok());
+/// let e = check_batch_step(200, 1_000_000_000).unwrap_err();
+/// assert!(e.to_string().contains("(200 rows x 1000000000 substeps)"));
+/// ```
+pub fn check_batch_step(rows: usize, substeps: usize) -> Result<()> {
+    let total = (rows as u128).saturating_mul(substeps as u128);
+    if total > MAX_CALL_STEPS {
+        return Err(Error::InvalidArgument(format!(
+            "one step of this batch would take {total} integration steps ({rows} rows x {substeps} \
+             substeps); the limit is {MAX_CALL_STEPS} (2^36): use fewer substeps (a longer dt) or \
+             fewer rows"
+        )));
+    }
+    Ok(())
+}
+
 /// `len` zeros, or an error naming `what` when the memory cannot be had (instead of the abort
 /// of a failed allocation).
 ///

@@ -36,8 +36,8 @@ pub struct Validation {
     /// The fraction of validation conditions done right under the task's success rule (for a
     /// task with several targets, the lowest target's fraction), in [0, 1].
     pub rate: f64,
-    /// The mean of the task's trial score over the validation set, in [0, 1]: the margin that
-    /// separates networks with the same rate.
+    /// The mean of the task's trial score over the validation set, finite (the built-in tasks'
+    /// lie in [0, 1]): the margin that separates networks with the same rate.
     pub score: f64,
 }
 

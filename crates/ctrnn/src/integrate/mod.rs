@@ -136,8 +136,8 @@ impl Network {
 pub(crate) fn check_inputs(inputs: &[f64], want: usize, shape: &str) -> Result<()> {
     if inputs.len() != want {
         return Err(Error::InvalidArgument(format!(
-            "inputs have {} values; expected {shape} = {want}",
-            inputs.len()
+            "inputs have {}; expected {shape} = {want}",
+            crate::error::counted(inputs.len(), "value")
         )));
     }
     match inputs.iter().position(|x| !x.is_finite()) {

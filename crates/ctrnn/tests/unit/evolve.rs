@@ -605,3 +605,27 @@ fn the_step_check_needs_candidates_and_a_task_that_can_check() {
         "no validation set, nothing to check"
     );
 }
+
+/// The state's fields are public: a caller who changes them gets an error from the next tell,
+/// naming what is wrong, not a panic or a checkpoint that cannot be read back.
+#[test]
+fn a_state_changed_by_hand_is_an_error_at_the_next_tell() {
+    let fresh = || Evolution::new(Excite.layout(), config(), 2, &[], Fill::Mutants).unwrap();
+    let p = config().population;
+
+    let mut evo = fresh();
+    evo.config.population = 0;
+    let e = evo.tell(&[]).unwrap_err().to_string();
+    assert!(e.contains("population is 0"), "{e}");
+
+    let mut evo = fresh();
+    evo.population[3] = f64::NAN;
+    let e = evo.tell(&vec![1.0; p]).unwrap_err().to_string();
+    assert!(e.contains("the evolution's population[0]"), "{e}");
+    assert_eq!(evo.generation, 0, "a refused tell changes nothing");
+
+    let mut evo = fresh();
+    evo.population.pop();
+    let e = evo.tell(&vec![1.0; p]).unwrap_err().to_string();
+    assert!(e.contains("the evolution's population has"), "{e}");
+}

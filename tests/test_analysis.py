@@ -139,7 +139,7 @@ def test_bad_arguments() -> None:
         analysis.limit_cycles(net, seed=-1)
     # The argument is named as Python calls it, and NumPy integers are integers.
     for index in (3, np.int64(3), 1.0, True):
-        with pytest.raises(InvalidArgumentError, match=rf"^index is {re.escape(repr(index))}; this network has 1 sensors"):
+        with pytest.raises(InvalidArgumentError, match=rf"^index is {re.escape(repr(index))}; this network has 1 sensor,"):
             analysis.bifurcation(net, index, 0.0, 1.0)
     assert len(analysis.bifurcation(net, np.int64(0), 0.0, 1.0, steps=3).values) == 3
     with pytest.raises(InvalidArgumentError, match="different"):
@@ -416,3 +416,18 @@ def test_a_real_setting_that_is_no_number_is_a_type_error_naming_it() -> None:
                           (lambda: bifurcation(net, 0, True, 2.0), "start is True")]:
         with pytest.raises(TypeError, match=f"^{message}; expected a number$"):
             call()
+
+
+def test_the_basins_figure_draws_no_input_in_the_outputs_colour() -> None:
+    """With four or more inputs, matplotlib's own cycle would draw the fourth in the output's red."""
+    from matplotlib.colors import to_rgba
+
+    from dnnevo.analysis.figures import plot_basins
+
+    steps = 12
+    inputs = {f"input {k}": np.full(steps, 0.1 * k) for k in range(10)}
+    ax = plot_basins(np.zeros((steps, 2)), inputs, np.zeros(steps, dtype=int), labels=["A"], neuron=1)
+    lines = {line.get_label(): to_rgba(line.get_color()) for line in ax.get_lines()}
+    output = lines.pop("output of neuron 1")
+    assert len(lines) == 10 and output not in lines.values()
+    assert len(set(list(lines.values())[:9])) == 9

@@ -70,11 +70,13 @@ def test_analyze_options_and_a_two_neuron_portrait(tmp_path: Path, runs: dict[st
     run = runs["sequence-1bit"]
     (run / "analysis-lesions.png").write_bytes(b"an earlier analysis's figure")
     (run / "analysis-notes.png").write_bytes(b"the user's own file")
-    r = run_cli("analyze", run, "--input", "0,0", "--input", "0,0.5", "--neurons", "0,2", "--no-lesions",
+    r = run_cli("analyze", run, "--input", "0,0.25", "--input", "0,0.5", "--neurons", "0,2", "--no-lesions",
                 "--sweep", "0:2", "--sweep-input", "0", "--steps", "5", "--sweep-cycles")
     assert r.returncode == 0, r.stderr
     doc = json.loads((run / "analysis.json").read_text())
-    assert [c["label"] for c in doc["conditions"]] == ["0,0", "0,0.5"]
+    assert [c["label"] for c in doc["conditions"]] == ["0,0.25", "0,0.5"]
+    # The swept input's partners keep the first --input's values.
+    assert doc["bifurcation"]["input"] == [0.0, 0.25]
     assert doc["neurons"] == [0, 2] and doc["lesions"] is None
     # No figure of an earlier analysis is left beside an analysis.json that does not describe it.
     assert not (run / "analysis-lesions.png").exists()

@@ -65,6 +65,16 @@ def with_article(noun: str) -> str:
     return f"{'an' if vowel else 'a'} {noun}"
 
 
+def counted(n: int, noun: str) -> str:
+    """``n`` and ``noun``, the noun plural unless ``n`` is 1, for messages (as Rust's
+    ``error::counted``).
+
+    >>> counted(1, "sensor"), counted(3, "sensor")
+    ('1 sensor', '3 sensors')
+    """
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def beer_hint(name: str) -> str:
     """The hint an "unknown name" message carries when ``name`` (or its last dotted part) is a
     parameter of Beer's CTRNN code that dnnevo's networks do not have, else ``""``.

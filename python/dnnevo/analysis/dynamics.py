@@ -36,7 +36,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo._checks import index as checked_index
-from dnnevo.errors import InvalidArgumentError
+from dnnevo.errors import InvalidArgumentError, counted
 
 __all__ = ["RETRY_STARTS", "STABILITIES", "Attractors", "Bifurcation", "Cycle", "CycleBranch", "CycleEnd",
            "Equilibrium", "Event", "attractors", "bifurcation", "equilibria", "limit_cycles",
@@ -65,8 +65,8 @@ def _input(net: _core.Network, value: npt.ArrayLike | None) -> list[float]:
         return [0.0] * net.n_inputs
     arr = np.asarray(value, dtype=float).reshape(-1)
     if arr.shape != (net.n_inputs,):
-        raise InvalidArgumentError(f"input has {arr.size} values; this network has {net.n_inputs} sensors, "
-                                   f"so it needs {net.n_inputs}")
+        raise InvalidArgumentError(f"input has {counted(arr.size, 'value')}; this network has "
+                                   f"{counted(net.n_inputs, 'sensor')}, so it needs {net.n_inputs}")
     return arr.tolist()
 
 
@@ -124,7 +124,7 @@ def bifurcation(
     disappears; that costs about as much as 100 equilibrium searches per value. A value whose
     count of equilibria is even is searched again with ``retry_starts`` starts (as
     :func:`equilibria`); those values are in ``retried``, and those still even in ``even``."""
-    k = checked_index("index", index, net.n_inputs, f"this network has {net.n_inputs} sensors")
+    k = checked_index("index", index, net.n_inputs, f"this network has {counted(net.n_inputs, 'sensor')}")
     return _core.analysis_bifurcation(net, _input(net, input), k, start, stop, steps=steps, starts=starts,
                                       seed=seed, cycle_starts=cycle_starts, retry_starts=retry_starts)
 

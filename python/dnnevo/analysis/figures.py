@@ -180,6 +180,13 @@ def plot_lesions(table: LesionTable, ax: Axes | None = None, *, title: str | Non
 _BASIN_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:olive"]
 
 
+_OUTPUT_COLOR = "tab:red"
+"""The neuron's output in :func:`plot_basins`; no input is drawn in it."""
+_INPUT_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
+                 "tab:olive", "tab:cyan")
+"""The inputs' colours in :func:`plot_basins`: matplotlib's cycle without the output's red."""
+
+
 def plot_basins(
     outputs: npt.ArrayLike, inputs: Mapping[str, npt.ArrayLike], basins: npt.ArrayLike, ax: Axes | None = None, *,
     labels: Sequence[str], neuron: int = 0, boundaries: Sequence[int] = (), levels: Sequence[float] = (),
@@ -198,9 +205,10 @@ def plot_basins(
         k = int(b[lo])
         if k >= 0:
             ax.axvspan(lo - 0.5, hi - 0.5, color=_BASIN_COLORS[k % len(_BASIN_COLORS)], alpha=0.18, lw=0)
-    for name, values in inputs.items():
-        ax.plot(t, np.asarray(values, dtype=float), drawstyle="steps-mid", lw=0.9, label=name)
-    ax.plot(t, np.asarray(outputs, dtype=float)[:, neuron], color="tab:red", lw=1.4, label=f"output of neuron {neuron}")
+    for k, (name, values) in enumerate(inputs.items()):
+        ax.plot(t, np.asarray(values, dtype=float), drawstyle="steps-mid", lw=0.9, label=name,
+                color=_INPUT_COLORS[k % len(_INPUT_COLORS)])
+    ax.plot(t, np.asarray(outputs, dtype=float)[:, neuron], color=_OUTPUT_COLOR, lw=1.4, label=f"output of neuron {neuron}")
     for x in boundaries:
         ax.axvline(x - 0.5, color="k", lw=0.8, ls="--")
     for k, y in enumerate(levels):

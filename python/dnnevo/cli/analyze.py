@@ -17,7 +17,7 @@ from dnnevo import _core, analysis, plot
 from dnnevo.analysis import Attractors, Bifurcation, LesionTable
 from dnnevo.closedloop import named
 from dnnevo.config import EvolutionConfig
-from dnnevo.errors import InvalidArgumentError
+from dnnevo.errors import InvalidArgumentError, counted
 from dnnevo.cli.outputs import try_write
 from dnnevo.runs import RunDir, save_figure, write_atomic
 from dnnevo.tasks.protocol import Task, views
@@ -40,7 +40,7 @@ built-in tasks all off, then each input on alone), the champion is an autonomous
 saddle, unstable) and attracting limit cycles are found and printed (an equilibrium's time scale is
 1 / min |Re lambda| over its eigenvalues, in the units of tau: how slowly its slowest direction
 moves). --sweep varies one input
-(default: the task's main one) and marks folds (F: two equilibria meet and vanish) and Hopf
+(default: the task's main one), the others held at the first --input vector's values, and marks folds (F: two equilibria meet and vanish) and Hopf
 points (H: a complex pair of eigenvalues crosses the imaginary axis, where a cycle appears or
 vanishes); --sweep-cycles also follows the attracting cycles along it,
 each branch from where it appears to where it vanishes. Lesions clamp each
@@ -70,7 +70,8 @@ def add_parser(sub: Any) -> None:
                    help="a constant input vector to analyse under (repeatable), e.g. 0,1")
     p.add_argument("--neurons", metavar="I,J", help="the two neurons of the phase portrait")
     p.add_argument("--sweep", metavar="START:STOP", default="0:1", help="the swept input's range (default 0:1)")
-    p.add_argument("--sweep-input", type=int, metavar="K", help="which input to sweep (default: the task's main one)")
+    p.add_argument("--sweep-input", type=int, metavar="K", help="which input to sweep (default: the task's main one); "
+                                                                     "the others keep the first --input's values")
     p.add_argument("--steps", type=int, default=101, help="input values in the sweep (default 101)")
     p.add_argument("--sweep-cycles", action="store_true",
                    help="also search each swept value for limit cycles (4 starts; about 100x slower)")
@@ -132,7 +133,8 @@ def analyze(args: argparse.Namespace) -> int:
         conditions = {name: v[:m] for name, v in task.ANALYSIS_CONDITIONS.items()}
     for name, v in conditions.items():
         if len(v) != m:
-            raise InvalidArgumentError(f"--input {name} has {len(v)} values; this network has {m} sensors")
+            raise InvalidArgumentError(f"--input {name} has {counted(len(v), 'value')}; this network has "
+                                       f"{counted(m, 'sensor')}")
     found = [analysis.attractors(net, v, name) for name, v in conditions.items()]
 
     trials = analysis.recorded_trials(config, net, seed=args.seed)
@@ -151,11 +153,12 @@ def analyze(args: argparse.Namespace) -> int:
         index, name = task.MAIN_INPUT, task.INPUT_NAMES[task.MAIN_INPUT]
     if args.sweep_input is not None:
         if not 0 <= args.sweep_input < m:
-            inputs = f"inputs are 0..{m - 1}" if m else "network has no inputs"
-            raise InvalidArgumentError(f"--sweep-input is {args.sweep_input}; this {inputs}")
+            where = f"the network's inputs are 0..{m - 1}" if m else "the network has no inputs"
+            raise InvalidArgumentError(f"--sweep-input is {args.sweep_input}; {where}")
         index, name = args.sweep_input, f"input {args.sweep_input}"
     if m > 0:
-        bif = analysis.bifurcation(net, index, start, stop, steps=args.steps,
+        # The other inputs are held at the first condition's values, as in the basins figure.
+        bif = analysis.bifurcation(net, index, start, stop, input=found[0].input, steps=args.steps,
                                    cycle_starts=4 if args.sweep_cycles else 0)
 
     table = analysis.lesions(config, net, args.trials, seed=args.seed, cuts=args.cuts) if args.lesions else None

@@ -12,7 +12,7 @@ import pytest
 
 import dnnevo
 from dnnevo import ConfigError, FitnessError
-from dnnevo.closedloop import ClosedLoop, FarSeeker
+from dnnevo.closedloop import ClosedLoop, FarSeeker, rollout
 
 from cli_helpers import assert_one_line_error, run_cli
 
@@ -54,6 +54,18 @@ def test_a_fitness_function_that_returns_no_numbers_is_a_fitness_error(value) ->
 def test_an_environment_class_not_object_is_named() -> None:
     with pytest.raises(ConfigError, match=r"task is the class FarSeeker; .*ClosedLoop\(FarSeeker\(\.\.\.\)"):
         dnnevo.evolve(FarSeeker, SMALL, progress=False)
+
+
+@pytest.mark.parametrize("missing", ["reset", "step"])
+def test_an_environment_without_reset_or_step_is_named_by_rollout_and_closed_loop(missing: str) -> None:
+    methods = {"observation_size": 1, "reset": lambda self, e, rng: np.zeros((len(e), 1)),
+               "step": lambda self, r, a: (np.zeros((len(a), 1)), np.zeros(len(a)), np.zeros(len(a), bool))}
+    del methods[missing]
+    env = type("Half", (), methods)()
+    net = dnnevo.Network.random(2, 1, seed=0)
+    for call in (lambda: rollout([net], env, max_steps=3), lambda: ClosedLoop(env, max_steps=3)):
+        with pytest.raises(dnnevo.TaskError, match=f"Half has no {missing} method"):
+            call()
 
 
 def test_network_attributes_cannot_be_written_to() -> None:

@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from dnnevo.errors import InvalidArgumentError, TaskError
 
-__all__ = ["Environment", "RestartingEnvironment", "check_neurons", "whole_size", "sensors"]
+__all__ = ["Environment", "RestartingEnvironment", "check_neurons", "checked", "whole_size", "sensors"]
 
 
 class Environment(Protocol):
@@ -113,6 +113,27 @@ def sensors(env: Any) -> int:
         raise TaskError(f"{name}.observation_size is {size!r}; expected the number of observations "
                         "the task gives at each step, a whole number >= 0")
     return int(size)
+
+
+def checked(env: Any) -> int:
+    """The number of sensors of ``env``, after checking that it is an environment: an object
+    (not its class) with ``reset`` and ``step`` methods and a whole ``observation_size``; a
+    :class:`~dnnevo.TaskError` names what is missing.
+
+    >>> class Still:
+    ...     observation_size = 1
+    ...     def reset(self, episodes, rng): ...
+    >>> checked(Still())
+    Traceback (most recent call last):
+    ...
+    dnnevo.errors.TaskError: Still has no step method; an environment has reset(episodes, rng) and step(rates, active) (docs/closed-loop.md)
+    """
+    size = sensors(env)
+    for method in ("reset", "step"):
+        if not callable(getattr(env, method, None)):
+            raise TaskError(f"{type(env).__name__} has no {method} method; an environment has "
+                            "reset(episodes, rng) and step(rates, active) (docs/closed-loop.md)")
+    return size
 
 
 def check_neurons(rates: npt.NDArray[np.float64], neurons: Iterable[int], reader: str) -> None:

@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo import _core
-from dnnevo.closedloop.environment import Environment, sensors
+from dnnevo.closedloop.environment import Environment, checked
 from dnnevo.closedloop.loop import DEFAULT_INTEGRATOR, FLAGS, Rollout, as_flags, rollout
 from dnnevo.closedloop.source import fingerprint, legacy_fingerprint, plain_source, task_source
 from dnnevo.config import PYTHON_TASK, EvolutionConfig, IntegratorConfig
@@ -124,7 +124,7 @@ class ClosedLoop:
         if isinstance(env, type):
             raise ConfigError(f"env is the class {env.__name__}; ClosedLoop takes an environment made "
                               f"from it, {env.__name__}(...)")
-        sensors(env)
+        checked(env)
         if isinstance(validation_episodes, bool) or not isinstance(validation_episodes, int | np.integer) \
                 or validation_episodes < 1:
             raise ConfigError(f"validation_episodes is {validation_episodes!r}; expected a whole "

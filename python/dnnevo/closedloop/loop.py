@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from dnnevo import _core
 from dnnevo._checks import nonnegative
-from dnnevo.closedloop.environment import Environment, sensors
+from dnnevo.closedloop.environment import Environment, checked
 from dnnevo.config import IntegratorConfig
 from dnnevo.errors import InvalidArgumentError, TaskError, with_article
 
@@ -159,7 +159,7 @@ def _count(networks: Sequence[_core.Network] | Mapping[str, npt.ArrayLike]) -> i
 
 def _check_sensors(env: Any, m: int) -> None:
     """Refuses an environment whose ``observation_size`` is not the networks' ``m`` inputs."""
-    if sensors(env) != m:
+    if checked(env) != m:
         raise TaskError(f"{_name(env)}.observation_size is {env.observation_size}; the networks "
                         f"have {m} input{'' if m == 1 else 's'}")
 

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 import reference as ref
 
 import dnnevo
-from dnnevo import Batch, InvalidArgumentError, TaskError
+from dnnevo import Batch, ConfigError, InvalidArgumentError, TaskError
 from dnnevo.closedloop import ClosedLoop, FarSeeker, rollout
 
 
@@ -392,7 +392,8 @@ def test_a_closed_loop_run_resumes_to_the_end_of_an_unbroken_one(tmp_path) -> No
     assert len(part.history["best"]) == 2
     text = (tmp_path / "part" / "config.toml").read_text()
     assert 'task = "python:test_closedloop.Drift"' in text
-    with pytest.raises(dnnevo.ConfigError, match="was evolved with python:test_closedloop.Drift, not an edited"):
+    with pytest.raises(dnnevo.ConfigError, match=r"was evolved with python:test_closedloop.Drift, not "
+                                                 r"python:test_closedloop.Drift as made here \(the rollout's settings"):
         dnnevo.resume(tmp_path / "part", ClosedLoop(Drift(), episodes=4, max_steps=20), progress=False)
     resumed = dnnevo.resume(tmp_path / "part", ClosedLoop(Drift(), episodes=3, max_steps=20),
                             progress=False)
@@ -709,6 +710,33 @@ def test_naming_the_task_or_passing_it_evolves_the_same(tmp_path, monkeypatch) -
     assert np.array_equal(by_name.history["best"], by_object.history["best"])
 
 
+def test_an_interrupted_run_says_how_to_resume_it_where_it_can_be(tmp_path, monkeypatch, capsys) -> None:
+    """After an interrupt the run names ``dnnevo resume`` only when the command builds its task
+    again from config.toml; else it names dnnevo.resume from Python with the same task."""
+    from dnnevo.closedloop import ClosedLoop
+
+    (tmp_path / "seeker_stop.py").write_text(SEEKER)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import seeker_stop
+
+    def ctrl_c(stats, ga):
+        raise KeyboardInterrupt
+
+    tagged = seeker_stop.Seeker(speed=0.2)
+    tagged.tag = 1  # set after it was made: config.toml cannot record it
+    config = dnnevo.EvolutionConfig(population=10, generations=3, size=3, n_inputs=1, selection="rank")
+    for task, folder, hint in [
+        (ClosedLoop(seeker_stop.Seeker(speed=0.2), episodes=2, max_steps=50), "told", "dnnevo resume "),
+        (ClosedLoop(tagged, episodes=2, max_steps=50), "other", "dnnevo.resume("),
+        (lambda nets: np.zeros(len(nets)), "function", "dnnevo.resume("),
+    ]:
+        dnnevo.evolve(task, config, out=tmp_path / folder, progress=False, callback=ctrl_c)
+        err = capsys.readouterr().err
+        assert f"Resume with: {hint}" in err, (folder, err)
+    dnnevo.resume(tmp_path / "told", progress=False, callback=ctrl_c)
+    assert f"Resume with: dnnevo resume {tmp_path / 'told'}" in capsys.readouterr().err
+
+
 def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path, monkeypatch, capsys) -> None:
     """config.toml records an environment object's arguments only when they can be told from
     it (ClosedLoop.arguments): else a command that builds the task from it builds Seeker() with
@@ -754,6 +782,10 @@ def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path,
     for folder in ("same", "told"):
         by_name = dnnevo.resume(tmp_path / folder, "python:seeker_arg.Seeker", generations=3, progress=False)
         assert len(by_name.history["best"]) == 3
+    # Other arguments without new_fitness: refused, saying the attributes differ, not the source.
+    with pytest.raises(ConfigError, match=r"not python:seeker_arg.Seeker as made here \(the environment's attributes"):
+        dnnevo.resume(tmp_path / "told", ClosedLoop(seeker(0.3, False), episodes=2, max_steps=50),
+                      generations=4, progress=False)
     # Continued with new arguments (a curriculum): config.toml says what the task is from then
     # on, so the command line still builds, judges and resumes it.
     harder = ClosedLoop(seeker(0.3, False), episodes=3, max_steps=40)
@@ -1017,3 +1049,98 @@ def test_threads_reach_a_python_task_through_the_process_pool() -> None:
     assert r.stdout.count("refused: threads is") == 2 and "pool: 5\n" in r.stdout, r.stdout
     assert "threads=2 does not reach this Python task: the process's thread pool started earlier, with 5" \
         in r.stderr, r.stderr
+
+
+PRESET = SEEKER + '''
+
+class Preset(Seeker):
+    preset = {"size": 3, "selection": "rank", "generations": 7,
+              "task_params": {"max_steps": 40, "episodes": 2, "speed": 0.2}}
+
+
+class Misspelt(Seeker):
+    preset = {"sise": 3}
+
+
+class Tasked(Seeker):
+    preset = {"task": "sequence"}
+
+
+class Listed(Seeker):
+    preset = [("size", 3)]
+
+
+class Named(Preset):
+    analysis = Analysis(input_names=["light side"], conditions={"left": [-1.0]}, main_input=0,
+                        output_neuron=0, episodes=1)
+'''
+
+
+def test_a_task_class_declares_its_own_preset(tmp_path, monkeypatch) -> None:
+    """A class's ``preset`` is what the command line and evolve start from: a run needs no
+    --set to say its episode length, and --set and --quick still go over it."""
+    from dnnevo import presets
+
+    (tmp_path / "seeker_preset.py").write_text(PRESET)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    config = presets.get("python:seeker_preset.Preset")
+    assert (config.size, config.selection, config.generations, config.n_inputs) == (3, "rank", 7, 1)
+    assert config.task_params == {"max_steps": 40, "episodes": 2, "speed": 0.2}
+    quick = presets.get("python:seeker_preset.Preset", quick=True, overrides=["task_params.max_steps=30"])
+    assert (quick.population, quick.generations) == (presets.PYTHON_QUICK["population"], presets.PYTHON_QUICK["generations"])
+    assert quick.task_params == {"max_steps": 30, "episodes": 2, "speed": 0.2}
+    result = dnnevo.evolve("python:seeker_preset.Preset", seed=1, progress=False)
+    assert result.config == config and len(result.history["best"]) == 7
+    for name, message in [("Misspelt", r"Misspelt.preset: config has unknown key 'sise'"),
+                          ("Tasked", r"Tasked.preset sets task; the class is the task"),
+                          ("Listed", r"Listed.preset is a list; expected a dict of settings")]:
+        with pytest.raises(ConfigError, match=message):
+            presets.get(f"python:seeker_preset.{name}")
+    r = dnnevo_command(tmp_path, "run", "python:seeker_preset.Preset", "--quick", "--threads", "1")
+    assert r.returncode == 0, r.stderr
+    recorded = (tmp_path / "runs" / "seeker_preset.Preset-quick-seed0" / "config.toml").read_text()
+    assert "max_steps = 40" in recorded and "speed = 0.2" in recorded and "size = 3" in recorded
+    r = dnnevo_command(tmp_path, "run", "python:seeker_preset.Misspelt", "--quick")
+    assert r.returncode == 2 and r.stderr.strip().count("\n") == 0 and "Misspelt.preset" in r.stderr, r.stderr
+
+
+def test_the_episodes_figure_names_the_inputs_as_the_analysis_does_and_draws_the_reward(
+        tmp_path, monkeypatch) -> None:
+    from dnnevo import plot
+    from dnnevo.figures import draw_run
+
+    (tmp_path / "seeker_named.py").write_text(PRESET)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    drawn: list[list[str]] = []
+    real = plot.plot_traces
+    monkeypatch.setattr(plot, "plot_traces", lambda shown, *a, **k: drawn.append(list(shown)) or real(shown, *a, **k))
+    for name, first in [("Named", "light side ["), ("Preset", "input 0 [")]:
+        dnnevo.evolve(f"python:seeker_named.{name}", seed=0, progress=False, out=tmp_path / name)
+        drawn.clear()
+        assert "episodes.png" in draw_run(tmp_path / name, fitness=False)
+        assert drawn and all(len(bands) == 2 and bands[0].startswith(first) and bands[1].startswith("reward [")
+                             for bands in drawn), drawn
+
+
+def test_assess_judges_a_champion_on_a_variant_of_its_task(tmp_path) -> None:
+    """``assess --set task_params.KEY=VALUE`` is a transfer test from the command line: the same
+    class, in conditions its run never saw, said as such; other settings are refused."""
+    import json
+
+    (tmp_path / "seeker_variant.py").write_text(PRESET)
+    r = dnnevo_command(tmp_path, "run", "python:seeker_variant.Preset", "--quick", "--threads", "1", "--out", "run")
+    assert r.returncode == 0, r.stderr
+    runs = {}
+    for speed in ("0.2", "0.05"):
+        r = dnnevo_command(tmp_path, "assess", "run", "--seed", "2", "--trials", "30", "--json",
+                           "--set", f"task_params.speed={speed}")
+        assert r.returncode in (0, 1, 3), r.stderr
+        runs[speed] = json.loads(r.stdout)
+        assert runs[speed]["variant"] == [f"task_params.speed={speed}"]
+    plain = json.loads(dnnevo_command(tmp_path, "assess", "run", "--seed", "2", "--trials", "30", "--json").stdout)
+    assert "variant" not in plain and plain["rates"] == runs["0.2"]["rates"]  # the run's own speed
+    assert runs["0.05"]["mean_length"] != runs["0.2"]["mean_length"]  # a slower agent: other episodes
+    text = dnnevo_command(tmp_path, "assess", "run", "--trials", "30", "--set", "task_params.speed=0.05").stdout
+    assert "judged on a variant of the run's task: task_params.speed=0.05 (--set)" in text
+    bad = dnnevo_command(tmp_path, "assess", "run", "--set", "size=4")
+    assert bad.returncode == 2 and "assess changes the task's conditions only" in bad.stderr

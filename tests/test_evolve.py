@@ -176,7 +176,8 @@ def test_signal_checkpoints_and_resume_is_identical(tmp_path: Path, sig: int) ->
         time.sleep(0.05)
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
-    assert "checkpoint saved" in err and f"dnnevo resume {out}" in err, err
+    # A fitness function's run resumes from Python alone, and the hint says so.
+    assert "checkpoint saved" in err and f"Resume with: dnnevo.resume({str(out)!r}, task=...) from Python" in err, err
     assert "Traceback" not in err
     cfg = EvolutionConfig.from_dict({**SMALL.to_dict(), "generations": 40})
     with pytest.raises(ConfigError, match="was evolved with python:__main__.slow"):

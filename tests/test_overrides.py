@@ -81,3 +81,30 @@ def test_an_earlier_bad_override_is_the_error_named() -> None:
 def test_a_path_through_a_plain_value_is_named_not_a_traceback(preset: str, key: str, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         apply_overrides(dnnevo.presets.get(preset), [f"{key}=1"])
+
+
+@pytest.mark.parametrize("text", ["False", "True", "TRUE", "None", "null", "NaN"])
+def test_a_value_meant_as_a_boolean_or_nothing_is_refused_not_kept_as_a_string(text: str) -> None:
+    """``switch=False`` as the string "False" would be true in the task's ``if self.switch:``."""
+    config = dnnevo.EvolutionConfig()
+    with pytest.raises(ConfigError, match=rf"--set task_params.switch={text}: {text} is not a TOML value"):
+        apply_overrides(config, [f"task_params.switch={text}"])
+    assert apply_overrides(config, [f'task_params.switch="{text}"']).task_params["switch"] == text
+    assert apply_overrides(config, ["task_params.switch=false"]).task_params["switch"] is False
+    assert apply_overrides(config, ["task_params.name=Falsey"]).task_params["name"] == "Falsey"
+
+
+def test_a_config_file_is_loaded_by_path_and_a_path_given_as_text_is_pointed_there(tmp_path) -> None:
+    config = dnnevo.EvolutionConfig(population=30, task_params={"max_steps": 5})
+    path = tmp_path / "config.toml"
+    path.write_text(config.to_toml({"seed": 3}))
+    assert dnnevo.EvolutionConfig.load(path) == dnnevo.EvolutionConfig.load(str(path)) == config
+    with pytest.raises(ConfigError, match="looks like a file's path: EvolutionConfig.load"):
+        dnnevo.EvolutionConfig.from_toml(str(path))
+    with pytest.raises(ConfigError, match="from_toml takes TOML text, not a PosixPath"):
+        dnnevo.EvolutionConfig.from_toml(path)  # type: ignore[arg-type]
+    with pytest.raises(ConfigError, match="cannot read .*missing.toml: No such file"):
+        dnnevo.EvolutionConfig.load(tmp_path / "missing.toml")
+    path.write_text("population = [")
+    with pytest.raises(ConfigError, match=r"config.toml: not valid TOML"):
+        dnnevo.EvolutionConfig.load(path)

@@ -344,7 +344,7 @@ def test_avoid_evolves_and_resumes_to_the_end_of_an_unbroken_run(tmp_path: Path)
                          callback=lambda stats, ga: ga.generation >= 2)
     assert len(part.history["best"]) == 2
     assert 'task = "python:dnnevo.robots.avoid.Avoid"' in (tmp_path / "part" / "config.toml").read_text()
-    with pytest.raises(dnnevo.ConfigError, match="not an edited"):
+    with pytest.raises(dnnevo.ConfigError, match=r"Avoid as made here \(the environment.s attributes differ"):
         dnnevo.resume(tmp_path / "part", ClosedLoop(Avoid(steps=21), episodes=2, max_steps=20,
                                                     validation_episodes=4), progress=False)
     resumed = dnnevo.resume(tmp_path / "part", ClosedLoop(Avoid(steps=20), episodes=2, max_steps=20,

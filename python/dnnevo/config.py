@@ -12,16 +12,18 @@ import dataclasses
 import inspect
 import json
 import math
+import os
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import tomli_w
 
 from dnnevo import _core
-from dnnevo.errors import ConfigError, DnnevoError, beer_hint, did_you_mean
+from dnnevo.errors import ConfigError, DnnevoError, beer_hint, did_you_mean, with_article
 
 __all__ = ["EvolutionConfig", "IntegratorConfig", "Ranges", "apply_overrides", "with_later_defaults"]
 
@@ -215,13 +217,34 @@ class EvolutionConfig:
 
     @classmethod
     def from_toml(cls, text: str) -> EvolutionConfig:
-        """Reads TOML written by :meth:`to_toml` (a ``[run]`` table is ignored)."""
+        """Reads TOML text written by :meth:`to_toml` (a ``[run]`` table is ignored); :meth:`load`
+        reads a file."""
+        if not isinstance(text, str):
+            raise ConfigError(f"from_toml takes TOML text, not {with_article(type(text).__name__)}; "
+                              "EvolutionConfig.load(path) reads a file")
         try:
             d = tomllib.loads(text)
         except tomllib.TOMLDecodeError as e:
-            raise ConfigError(f"not valid TOML: {e}") from None
+            hint = ("; it looks like a file's path: EvolutionConfig.load(path) reads a file"
+                    if "\n" not in text.strip() and text.strip().endswith(".toml") else "")
+            raise ConfigError(f"not valid TOML: {e}{hint}") from None
         d.pop("run", None)
         return cls.from_dict(d)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> EvolutionConfig:
+        """Reads a config file: a run folder's ``config.toml`` (its ``[run]`` table is ignored; the
+        run's own checks are :class:`~dnnevo.runs.RunDir`'s) or one written by hand. An error
+        names the file."""
+        where = Path(path)
+        try:
+            text = where.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as e:
+            raise ConfigError(f"cannot read {where}: {getattr(e, 'strerror', None) or e}") from None
+        try:
+            return cls.from_toml(text)
+        except ConfigError as e:
+            raise ConfigError(f"{where}: {e}") from None
 
     def to_json(self) -> str:
         """The config as JSON text, the form the Rust core reads."""
@@ -339,12 +362,27 @@ def _build(cls: type, d: Mapping[str, Any], where: str) -> Any:
         raise ConfigError(f"{where}: {e}") from None
 
 
-def _parse_value(text: str) -> Any:
-    """A ``--set`` value: TOML syntax (``3``, ``0.5``, ``true``, ``["0", "1"]``), else a string."""
+_NOT_TOML = {"True": "true", "False": "false", "TRUE": "true", "FALSE": "false", "None": None,
+             "null": None, "NaN": None}
+"""Values that a ``--set`` would read as strings but that were surely meant as something else:
+Python's booleans (TOML's are lowercase) and values TOML has no form for."""
+
+
+def _parse_value(text: str, key: str) -> Any:
+    """A ``--set`` value for ``key``: TOML syntax (``3``, ``0.5``, ``true``, ``["0", "1"]``), else
+    a string; a value in :data:`_NOT_TOML` is refused, since as a string it would be true (a
+    Python class's ``if self.switch:``) where the user wrote false."""
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
-        return text
+        pass
+    if text in _NOT_TOML:
+        meant = _NOT_TOML[text]
+        fix = (f"write {key}={meant} for a boolean" if meant is not None
+               else "a setting holds numbers, strings, booleans (true, false) and lists")
+        raise ConfigError(f"--set {key}={text}: {text} is not a TOML value; {fix}, or "
+                          f"{key}='\"{text}\"' for the string")
+    return text
 
 
 def _with_key(node: Any, path: list[str], value: Any, key: str, default: Any = None) -> Any:
@@ -429,7 +467,7 @@ def apply_overrides(config: EvolutionConfig, assignments: list[str]) -> Evolutio
         key = key.strip()
         if not sep or not key:
             raise ConfigError(f"--set {item!r} is not key=value")
-        value = _parse_value(raw.strip())
+        value = _parse_value(raw.strip(), key)
         head, _, sub = key.partition(".")
         if head not in d:
             raise ConfigError(f"unknown setting {key!r}{beer_hint(key) or did_you_mean(key, d)}; "

@@ -322,14 +322,16 @@ def unseeded_warning(name: str, seeded: bool) -> str | None:
 
 def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -> EvolutionConfig:
     """The config of preset ``name``, optionally its quick variant, with ``key=value`` overrides.
-    A task written in Python (``"python:module.Class"``) has no preset: its config is the
-    defaults with that task, its ``n_inputs`` the environment's ``observation_size`` (which
-    imports the class's module and makes one with the overrides' ``task_params``) unless an
-    override sets it, and its other settings come from the overrides alone."""
+    A task written in Python (``"python:module.Class"``) starts from the defaults, with the
+    class's own ``preset`` (:func:`~dnnevo.closedloop.named.class_preset`) over them and then
+    the quick variant's population and generations; its ``n_inputs`` is the environment's
+    ``observation_size`` (which imports the class's module and makes one with the final
+    ``task_params``) unless the class's preset or an override sets it."""
     if name.startswith(PYTHON_TASK):
-        start: dict[str, Any] = {"task": name, **(PYTHON_QUICK if quick else {})}
+        own = named.class_preset(name)
+        start: dict[str, Any] = {**own, "task": name, **(PYTHON_QUICK if quick else {})}
         config = apply_overrides(EvolutionConfig.from_dict(start), overrides or [])
-        if any(o.partition("=")[0].strip() == "n_inputs" for o in overrides or []):
+        if "n_inputs" in own or any(o.partition("=")[0].strip() == "n_inputs" for o in overrides or []):
             return config
         size = named.observation_size(name, config.task_params)
         if size is None:  # the run's own check names what is wrong with the task

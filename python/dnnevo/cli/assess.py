@@ -15,6 +15,7 @@ from typing import Any
 from dnnevo import tasks
 from dnnevo.cli.outputs import reader_gone
 from dnnevo.closedloop import named
+from dnnevo.config import EvolutionConfig, apply_overrides
 from dnnevo.evaluation.assessment import Assessment, Rate
 from dnnevo.evaluation.stats import Verdict
 from dnnevo.errors import ConfigError
@@ -28,6 +29,7 @@ EXAMPLE = """examples:
   dnnevo assess runs/demo --dt 0.01            the same champion integrated 10x finer
   dnnevo assess runs/demo --dt-check           also at a 10x finer step and with RK4
   dnnevo assess runs/demo --precision f64      an f32 run's champion judged in f64
+  dnnevo assess runs/lm --set task_params.sim.follower.speed=0.4   a transfer test: a slower robot
 
 Each rate gets a 95% Wilson score interval. Verdict: pass when the interval lies at or above the
 task's threshold (sequence: 90% of trials per target; landmark and nav1d: 95%), fail when it lies
@@ -58,6 +60,8 @@ def assess(args: argparse.Namespace) -> int:
     named.check_own_task(config, table)  # before --dt changes the settings
     if args.robot_like and not task.ROBOT_LIKE:
         raise ConfigError(f"--robot-like applies to landmark runs; {args.dir} is a {config.task} run")
+    if args.set:
+        config = variant(config, args.set)
     if args.dt is not None:
         config = with_dt(config, args.dt, "--dt")
     evolved_in = config.precision
@@ -65,6 +69,8 @@ def assess(args: argparse.Namespace) -> int:
         config = dataclasses.replace(config, precision=args.precision)
     a = tasks.assess(config, champion, args.trials, seed=seed, robot_like=args.robot_like)
     extra = task.assess_extra(config, champion, seed)
+    if args.set:
+        extra = {"variant": list(args.set), **extra}
     if args.dt is not None:
         extra = {"integrator": dataclasses.asdict(config.integrator), **extra}
     if config.precision != "f64" or evolved_in != "f64":
@@ -85,12 +91,26 @@ def assess(args: argparse.Namespace) -> int:
     return status
 
 
+def variant(config: EvolutionConfig, assignments: Sequence[str]) -> EvolutionConfig:
+    """``config`` with ``task_params.KEY=VALUE`` ``assignments``: the run's task in conditions its
+    evolution never saw. Other settings belong to the evolution, not the task, and are refused."""
+    for item in assignments:
+        key = item.partition("=")[0].strip()
+        if not key.startswith("task_params."):
+            raise ConfigError(f"--set {item!r}: assess changes the task's conditions only "
+                              f"(task_params.KEY=VALUE); {key or '(no key)'} is not one")
+    return apply_overrides(config, list(assignments))
+
+
 def text(where: Path, a: Assessment, extra: dict[str, Any]) -> list[str]:
     """The human report of ``a`` on the run in ``where``."""
     task = tasks.get(a.task)
     lines = [*task.preface(where, a), *rate_table(a.rates, task.rate_column(a)), task.overall(a)]
     lines += [hint(r, a.unit) for r in a.judged if r.verdict == "undecided"]
     lines.append(f"intervals: {a.method}")
+    if "variant" in extra:
+        lines.append(f"judged on a variant of the run's task: {' '.join(extra['variant'])} (--set); "
+                     "evolution never saw it")
     if "integrator" in extra:
         i = extra["integrator"]
         lines.append(f"integrated with dt = {i['dt']:g}, {i['substeps']} steps per time step "

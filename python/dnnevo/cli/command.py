@@ -136,7 +136,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="override a setting, e.g. population=200, integrator.dt=0.05 or "
                             "task_params.sim.sonars.0.lobe_deg=10 (in task_params, a number picks "
                             "a list's entry and the rest of the task's table keeps its defaults; a "
-                            "top-level pair is set whole: ranges.tau=[1, 10])")
+                            "top-level pair is set whole: ranges.tau=[1, 10]); values are TOML: "
+                            "booleans are true and false")
         p.add_argument("--quick", action="store_true",
                        help="small population, few generations: a demo, not a result")
         p.add_argument("--threads", type=_positive, help="worker threads (default: all cores)")
@@ -231,6 +232,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--precision", choices=["f64", "f32"], default=None,
                    help="compute the champion in this precision instead of the run's (e.g. an f32 "
                         "run's champion in f64)")
+    p.add_argument("--set", action="append", default=[], metavar="task_params.KEY=VALUE",
+                   help="judge the champion on a variant of its task, conditions evolution never "
+                        "saw (repeatable), e.g. task_params.speed=0.3: a transfer test")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        description="Write the run's figures (its fitness and the paper's figures "

@@ -181,7 +181,8 @@ def _sweep(args: argparse.Namespace, config: EvolutionConfig, how: seeding.Seedi
         print(f"wrote {', '.join(map(str, paths))}")
     if stopped:
         print(f"interrupted during seed {stopped[0]}, which the statistics leave out; they cover the "
-              f"{len(finished)} finished seed(s); run the same command again to continue the sweep")
+              f"{len(finished)} finished seed(s); run the same command again to continue the sweep (it resumes seed {stopped[0]} "
+              "from its checkpoint, as the dnnevo resume above would, then runs the seeds after it)")
         return 130
     if failed:
         print(f"{failed} seed(s) failed (named above); the statistics cover the {len(runs)} that did not")

@@ -38,7 +38,7 @@ from dnnevo.closedloop.fitness import ROLLOUT_KEYS, ClosedLoop, close_copy
 from dnnevo.config import PYTHON_TASK, EvolutionConfig
 from dnnevo.errors import ConfigError, TaskError, did_you_mean, with_article
 
-__all__ = ["ROLLOUT_KEYS", "check_own_task", "closed_loop", "environment_class", "is_closed_loop",
+__all__ = ["ROLLOUT_KEYS", "check_own_task", "class_preset", "closed_loop", "environment_class", "is_closed_loop",
            "is_python_task", "observation_size", "refuse_fitness_function"]
 
 #: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
@@ -92,6 +92,32 @@ def environment_class(task: str) -> type:
         raise ConfigError(f"task {task!r} is {what}; a task is a class with observation_size, "
                           "reset(episodes, rng) and step(rates, active) (docs/closed-loop.md)")
     return cls
+
+
+def class_preset(task: str) -> dict[str, Any]:
+    """The settings that the class ``task`` names declares as its own preset, a class attribute
+    ``preset`` that holds what a config file would (``{"size": 3, "selection": "rank",
+    "task_params": {"max_steps": 300, "episodes": 4}}``), checked: the command line and
+    :func:`dnnevo.evolve` start from them, before ``--set``. Empty when the class declares none.
+
+    >>> class_preset("python:dnnevo.closedloop.FarSeeker")
+    {}
+    """
+    cls = environment_class(task)
+    preset = getattr(cls, "preset", None)
+    if preset is None:
+        return {}
+    where = f"{cls.__name__}.preset"
+    if not isinstance(preset, Mapping):
+        raise ConfigError(f"{where} is {with_article(type(preset).__name__)}; expected a dict of settings "
+                          "as in config.toml, e.g. {\"size\": 3, \"task_params\": {\"max_steps\": 300}}")
+    if "task" in preset:
+        raise ConfigError(f"{where} sets task; the class is the task, so leave it out")
+    try:
+        EvolutionConfig.from_dict({**preset, "task": task})
+    except ConfigError as e:
+        raise ConfigError(f"{where}: {e}") from None
+    return dict(preset)
 
 
 def _import(module_name: str, task: str) -> Any:
@@ -162,7 +188,7 @@ def _checked_loop(config: EvolutionConfig, cls: type, env: Any, settings: dict[s
                       precision=config.precision, name=config.task)
     if digest is not None and digest not in loop.digests():
         raise ConfigError(f"the run was evolved with another version of {config.task} "
-                          f"({_what_differs(loop, parts)})")
+                          f"({what_differs(loop, parts)})")
     return loop
 
 
@@ -178,7 +204,7 @@ DIFFERENCES = {
 """What each part of a task's digest (:meth:`ClosedLoop.part_digests`) differing means."""
 
 
-def _what_differs(loop: ClosedLoop, parts: Mapping[str, str] | None) -> str:
+def what_differs(loop: ClosedLoop, parts: Mapping[str, str] | None) -> str:
     """Which parts of the task differ from the run's (its ``fitness_parts``), said; all three
     possibilities for a run that recorded no parts."""
     if isinstance(parts, Mapping):  # a damaged [run] table says nothing more

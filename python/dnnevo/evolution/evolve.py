@@ -184,8 +184,10 @@ def evolve(
 ) -> EvolutionResult:
     """Evolves networks for ``task`` and returns the champion and the history.
 
-    ``task`` is a built-in task or preset name, or a Python callable ``fitness(networks) ->
-    array`` (slower, but works with everything else, checkpoints included). A callable that
+    ``task`` is a built-in task or preset name, a task class's name (``"python:module.Class"``,
+    whose config without ``config`` is the class's own ``preset`` over the defaults), or a
+    Python callable ``fitness(networks) -> array`` (slower, but works with everything else,
+    checkpoints included). A callable that
     takes ``generation`` and ``seed`` keywords gets them, to draw each generation's conditions
     from (see :class:`dnnevo.closedloop.ClosedLoop` for a task in closed loop); one with a
     method ``validate(networks, *, seed) -> (rates, scores)`` has its champion chosen on that
@@ -207,7 +209,8 @@ def evolve(
         config = _task_config(task, config)  # a preset of a task written in Python
         task = config.task
     if isinstance(task, str) and named.is_python_task(task):
-        config = dataclasses.replace(config or EvolutionConfig(), task=task)
+        # Without a config, the class's own preset, as the command line starts from.
+        config = dataclasses.replace(config, task=task) if config is not None else presets.get(task)
         task = named.closed_loop(config)  # imports the task's module, checks it, builds it
     elif isinstance(task, ClosedLoop):
         config = task.configured(config or EvolutionConfig())
@@ -245,7 +248,7 @@ def evolve(
         run.write_config(config, table)
         run.write_log([])
         return _loop(ga, task, [], run, progress=progress, callback=callback, threads=threads,
-                     table=table)
+                     table=table, resume_hint=_resume_hint(task, config, run, named=named_task))
 
 
 def resume(
@@ -310,10 +313,9 @@ def resume(
                 name = ga.config.task  # the same source, imported from another module
             if name != ga.config.task or edited:
                 if not new_fitness:
-                    raise ConfigError(
-                        f"{run.path} was evolved with {ga.config.task}, not "
-                        f"{'an edited ' + name if edited and name == ga.config.task else name}; "
-                        "pass new_fitness=True to continue it with another fitness function")
+                    raise ConfigError(f"{run.path} was evolved with {ga.config.task}, not "
+                                      f"{_other_task(task, name, table) if edited and name == ga.config.task else name}"
+                                      "; pass new_fitness=True to continue it with another fitness function")
                 change: dict[str, Any] = {"generation": ga.generation, "task": name}
                 evolved_with = ga.config.task
                 table = {k: v for k, v in table.items() if k != "fitness_parts"}
@@ -353,7 +355,8 @@ def resume(
         run.write_log(history)
         _write_best(run, ga)
         return _loop(ga, fitness, history, run, progress=progress, callback=callback,
-                     threads=threads, table=table)
+                     threads=threads, table=table,
+                     resume_hint=_resume_hint(fitness, ga.config, run, named=task is None or isinstance(task, str)))
 
 
 def refuse_idle_scale(config: EvolutionConfig) -> None:
@@ -377,6 +380,29 @@ def _share_threads(task: str | FitnessFn, threads: int | None) -> None:
         print(f"dnnevo: note: threads={threads} does not reach this Python task: the process's "
               f"thread pool started earlier, with {running} (set RAYON_NUM_THREADS={threads} "
               "before the process starts)", file=sys.stderr)
+
+
+def _other_task(task: FitnessFn, name: str, table: Mapping[str, Any]) -> str:
+    """What differs in ``task``, called ``name`` as the run's own task is but with another digest:
+    an edited function, or for an environment the parts that differ (source, attributes or
+    settings), when the run recorded its parts."""
+    parts = table.get("fitness_parts")
+    if not isinstance(task, ClosedLoop):
+        return f"an edited {name}"
+    if isinstance(parts, Mapping) and parts.get("source") == task.part_digests()["source"]:
+        return f"{name} as made here ({named.what_differs(task, parts)})"
+    return f"an edited {name} ({named.what_differs(task, parts)})"
+
+
+def _resume_hint(task: str | FitnessFn, config: EvolutionConfig, run: RunDir, *, named: bool) -> str:
+    """How to resume ``run`` after an interrupt: with ``dnnevo resume`` when the command builds
+    its task again from config.toml (a task ``named`` by its name, or an environment one made from
+    config.toml would equal), else from Python with the same task."""
+    if named or isinstance(task, str) or (isinstance(task, ClosedLoop) and _not_rebuilt(task, config) is None
+                                          and task.__module__ != "__main__"):
+        return f"dnnevo resume {run.path}"
+    same = "environment (in ClosedLoop)" if isinstance(task, ClosedLoop) else "fitness function"
+    return f"dnnevo.resume({str(run.path)!r}, task=...) from Python, with the same {same}"
 
 
 def _not_rebuilt(task: ClosedLoop, config: EvolutionConfig) -> str | None:
@@ -621,6 +647,7 @@ def _loop(
     callback: Callback | None,
     threads: int | None,
     table: Mapping[str, Any] | None = None,
+    resume_hint: str = "",
 ) -> EvolutionResult:
     config = ga.config
     bar = Progress(config.generations, start=ga.generation) if progress else None
@@ -729,7 +756,7 @@ def _loop(
     finally:
         if bar is not None:
             bar.close()
-    hint = f"interrupted {saved}. Resume with: dnnevo resume {run.path}" if run is not None else ""
+    hint = f"interrupted {saved}. Resume with: {resume_hint}" if run is not None else ""
     if interrupted and ga.best is None:
         # Stopped before any generation was scored: there is no result to return.
         raise KeyboardInterrupt(hint)

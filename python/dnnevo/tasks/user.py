@@ -102,8 +102,9 @@ class UserTask:
     def draw(self, run: RunDir, config: EvolutionConfig, seed: int, *,
              animate: bool = False) -> list[str]:
         """``episodes.png``: the champion on the first :data:`DRAWN_EPISODES` of the fresh
-        episodes that :meth:`judge` draws from ``seed``, one panel each: every observation
-        (scaled onto its band, its range in the label) and every neuron's firing rate over the
+        episodes that :meth:`judge` draws from ``seed``, one panel each: every observation (named
+        as the class's analysis declaration names it) and the reward at each step, each scaled
+        onto its band with its range in the label, and every neuron's firing rate over the
         episode, with the episode's return and length. For robots in a world (a
         :class:`~dnnevo.robots.RobotWorld`), ``paths.png`` too: the room and each episode's
         path, and the pursuers'. Imports the task's module."""
@@ -113,13 +114,14 @@ class UserTask:
                           probe=lambda env: _robot_state(env, worlds))
         fig, axes = plot.subplots(1, len(episodes), figsize=(4.5 * len(episodes), 1.5 + 0.6 * (
             config.n_inputs + config.size)), layout="constrained", squeeze=False)
+        names = _input_names(config)
         for e, (ax, ep) in enumerate(zip(axes[0], episodes, strict=True)):
             shown = {}
-            for k in range(ep.inputs.shape[1]):
-                x = ep.inputs[:, k]
+            traces = [(names[k] if names else f"input {k}", ep.inputs[:, k]) for k in range(ep.inputs.shape[1])]
+            for name, x in [*traces, ("reward", np.asarray(ep.rewards, dtype=float))]:
                 low, high = float(x.min()), float(x.max())
                 span = high - low
-                shown[f"input {k} [{low:.3g}, {high:.3g}]"] = (x - low) / span if span > 0 else x * 0 + 0.5
+                shown[f"{name} [{low:.3g}, {high:.3g}]"] = (x - low) / span if span > 0 else x * 0 + 0.5
             plot.plot_traces(shown, ep.outputs, ax, title=(
                 f"episode {e}: return {np.cumsum(ep.rewards)[-1]:.4g}, {len(ep.rewards)} steps"))
         fig.suptitle(f"{run.path.name}: the champion on fresh episodes (seed {seed})", fontsize=10)
@@ -164,6 +166,17 @@ def _refusal(task: str) -> str:
     return (f"task {task!r} has no analysis defaults; its class must declare them as "
             "analysis = dnnevo.tasks.protocol.Analysis(input_names=..., conditions=..., "
             "main_input=..., output_neuron=...) (docs/analysis.md)")
+
+
+def _input_names(config: EvolutionConfig) -> list[str] | None:
+    """The inputs' names that the class's analysis declaration gives, for the figures; None
+    without one, or with one that :func:`analysed` refuses (``dnnevo analyze`` says why)."""
+    if getattr(named.environment_class(config.task), "analysis", None) is None:
+        return None
+    try:
+        return list(analysed(config).INPUT_NAMES)
+    except ConfigError:
+        return None
 
 
 def analysed(config: EvolutionConfig) -> UserTask:

@@ -294,6 +294,7 @@ impl Evolution {
     /// fitness told from outside has no validation set), breeds the next population and advances
     /// the generation. Returns the statistics of the scored generation.
     pub fn tell(&mut self, fitness: &[f64]) -> Result<Stats> {
+        self.check(fitness)?;
         self.tell_validated(fitness, None)
     }
 
@@ -329,13 +330,13 @@ impl Evolution {
 
     /// [`tell`](Self::tell), with the champion chosen among `validated` (candidate index and its
     /// validation, best training fitness first) when given: the first candidate with the best
-    /// validation becomes champion if it beats the champion's.
+    /// validation becomes champion if it beats the champion's. The caller has run
+    /// [`check`](Self::check) on `fitness`.
     fn tell_validated(
         &mut self,
         fitness: &[f64],
         validated: Option<&[(usize, Validation)]>,
     ) -> Result<Stats> {
-        self.check(fitness)?;
         let stats = Stats::of(self.generation, fitness);
         let pick = match validated {
             None => self
@@ -600,12 +601,22 @@ impl Evolution {
             .population
             .chunks(self.layout.len())
             .enumerate()
-            .find_map(|(i, genes)| genome::decode(self.layout, genes).err().map(|e| (i, e)))
+            .find_map(|(i, genes)| {
+                genome::check_genes(self.layout, genes)
+                    .err()
+                    .map(|e| (i, e))
+            })
         {
             return Err(bad(&format!("population[{i}]"), e));
         }
         if let Some(c) = &self.champion {
-            genome::decode(self.layout, &c.genes).map_err(|e| bad("champion", e))?;
+            genome::check_genes(self.layout, &c.genes).map_err(|e| bad("champion", e))?;
+            if !c.fitness.is_finite() {
+                return Err(error(format!(
+                    "{what} champion has fitness {}; a fitness is finite",
+                    c.fitness
+                )));
+            }
             if c.generation >= self.generation {
                 return Err(error(format!(
                     "{what} champion was scored in generation {}; the state is at generation \

@@ -240,6 +240,26 @@ pub fn encode(net: &Network) -> Vec<f64> {
 /// Errors name the offending gene and its neuron: a wrong length, a non-finite value, or a time
 /// constant that is not positive.
 pub fn decode(layout: Layout, genes: &[f64]) -> Result<Network> {
+    check_genes(layout, genes)?;
+    let (n, m, per) = (layout.size, layout.n_inputs, layout.genes_per_neuron());
+    let mut tau = Vec::with_capacity(n);
+    let mut theta = Vec::with_capacity(n);
+    let mut sensor_weights = Vec::with_capacity(n * m);
+    let mut weights = Vec::with_capacity(n * n);
+    for block in genes.chunks_exact(per) {
+        tau.push(block[0]);
+        theta.push(block[1]);
+        sensor_weights.extend_from_slice(&block[2..2 + m]);
+        weights.extend_from_slice(&block[2 + m..]);
+    }
+    Network::new(tau, theta, weights, sensor_weights, None)
+}
+
+/// Checks that `genes` make a network of `layout` without making it: their count, every gene
+/// finite and every time constant > 0, the checks of [`decode`] that a genome can fail (what
+/// [`Network::new`] checks besides follows from them). No allocation, so a whole population is
+/// checked cheaply.
+pub fn check_genes(layout: Layout, genes: &[f64]) -> Result<()> {
     layout.validate()?;
     let (n, m, per) = (layout.size, layout.n_inputs, layout.genes_per_neuron());
     if genes.len() != layout.len() {
@@ -264,17 +284,7 @@ pub fn decode(layout: Layout, genes: &[f64]) -> Result<Network> {
             genes[i * per]
         )));
     }
-    let mut tau = Vec::with_capacity(n);
-    let mut theta = Vec::with_capacity(n);
-    let mut sensor_weights = Vec::with_capacity(n * m);
-    let mut weights = Vec::with_capacity(n * n);
-    for block in genes.chunks_exact(per) {
-        tau.push(block[0]);
-        theta.push(block[1]);
-        sensor_weights.extend_from_slice(&block[2..2 + m]);
-        weights.extend_from_slice(&block[2 + m..]);
-    }
-    Network::new(tau, theta, weights, sensor_weights, None)
+    Ok(())
 }
 
 /// The interval `(lo, hi)` that gene `g` is drawn from and mutated over.

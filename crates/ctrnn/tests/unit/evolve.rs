@@ -625,6 +625,15 @@ fn a_state_changed_by_hand_is_an_error_at_the_next_tell() {
     assert_eq!(evo.generation, 0, "a refused tell changes nothing");
 
     let mut evo = fresh();
+    evo.tell(&vec![1.0; p]).unwrap();
+    evo.champion.as_mut().unwrap().fitness = f64::NAN;
+    let e = evo.tell(&vec![1.0; p]).unwrap_err().to_string();
+    assert!(
+        e.contains("the evolution's champion has fitness NaN"),
+        "{e}"
+    );
+
+    let mut evo = fresh();
     evo.population.pop();
     let e = evo.tell(&vec![1.0; p]).unwrap_err().to_string();
     assert!(e.contains("the evolution's population has"), "{e}");

@@ -735,6 +735,18 @@ def test_an_interrupted_run_says_how_to_resume_it_where_it_can_be(tmp_path, monk
         assert f"Resume with: {hint}" in err, (folder, err)
     dnnevo.resume(tmp_path / "told", progress=False, callback=ctrl_c)
     assert f"Resume with: dnnevo resume {tmp_path / 'told'}" in capsys.readouterr().err
+    # A class of a script, even named, is the script's alone.
+    script = SEEKER + (
+        "\nimport dnnevo\n\ndef stop(stats, ga):\n    raise KeyboardInterrupt\n\n"
+        "config = dnnevo.EvolutionConfig(population=10, generations=3, size=3, n_inputs=1, selection='rank',\n"
+        "                                task_params={'max_steps': 20, 'episodes': 2})\n"
+        "dnnevo.evolve('python:__main__.Seeker', config, out='script-run', progress=False, callback=stop)\n")
+    (tmp_path / "script.py").write_text(script)
+    import subprocess
+    import sys
+
+    err = subprocess.run([sys.executable, "script.py"], cwd=tmp_path, capture_output=True, text=True).stderr
+    assert "Resume with: dnnevo.resume('script-run', task=...) from Python" in err, err
 
 
 def test_a_run_begun_from_python_is_judged_only_by_the_task_it_evolved(tmp_path, monkeypatch, capsys) -> None:
@@ -1070,6 +1082,10 @@ class Listed(Seeker):
     preset = [("size", 3)]
 
 
+class Elite(Seeker):
+    preset = {"elitism": 30, "task_params": {"max_steps": 40}}
+
+
 class Named(Preset):
     analysis = Analysis(input_names=["light side"], conditions={"left": [-1.0]}, main_input=0,
                         output_neuron=0, episodes=1)
@@ -1096,6 +1112,10 @@ def test_a_task_class_declares_its_own_preset(tmp_path, monkeypatch) -> None:
                           ("Listed", r"Listed.preset is a list; expected a dict of settings")]:
         with pytest.raises(ConfigError, match=message):
             presets.get(f"python:seeker_preset.{name}")
+    # --quick's small population goes over the preset's elites; the message says so, and --set fits it.
+    with pytest.raises(ConfigError, match=r"elitism is 30; .*: --quick's population 20, generations 5 go over Elite.preset"):
+        presets.get("python:seeker_preset.Elite", quick=True)
+    assert presets.get("python:seeker_preset.Elite", quick=True, overrides=["elitism=2"]).elitism == 2
     r = dnnevo_command(tmp_path, "run", "python:seeker_preset.Preset", "--quick", "--threads", "1")
     assert r.returncode == 0, r.stderr
     recorded = (tmp_path / "runs" / "seeker_preset.Preset-quick-seed0" / "config.toml").read_text()

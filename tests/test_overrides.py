@@ -92,6 +92,9 @@ def test_a_value_meant_as_a_boolean_or_nothing_is_refused_not_kept_as_a_string(t
     assert apply_overrides(config, [f'task_params.switch="{text}"']).task_params["switch"] == text
     assert apply_overrides(config, ["task_params.switch=false"]).task_params["switch"] is False
     assert apply_overrides(config, ["task_params.name=Falsey"]).task_params["name"] == "Falsey"
+    for nested in (f"[{text}]", f"{{a={text}}}", f"[1, {text}]"):
+        with pytest.raises(ConfigError, match=rf"not a TOML value, since {text} is not one"):
+            apply_overrides(config, [f"task_params.switch={nested}"])
 
 
 def test_a_config_file_is_loaded_by_path_and_a_path_given_as_text_is_pointed_there(tmp_path) -> None:
@@ -105,6 +108,9 @@ def test_a_config_file_is_loaded_by_path_and_a_path_given_as_text_is_pointed_the
         dnnevo.EvolutionConfig.from_toml(path)  # type: ignore[arg-type]
     with pytest.raises(ConfigError, match="cannot read .*missing.toml: No such file"):
         dnnevo.EvolutionConfig.load(tmp_path / "missing.toml")
+    path.write_text("population = " + "[" * 5000 + "]" * 5000)
+    with pytest.raises(ConfigError, match=r"config.toml: tables or arrays nested too deeply"):
+        dnnevo.EvolutionConfig.load(path)
     path.write_text("population = [")
     with pytest.raises(ConfigError, match=r"config.toml: not valid TOML"):
         dnnevo.EvolutionConfig.load(path)

@@ -47,13 +47,23 @@ def test_a_stopped_sweep_continues_to_the_same_results(tmp_path: Path) -> None:
     dnnevo.evolve(config.task, config, seed=1, out=parts / "seed-1", progress=False,
                   callback=lambda stats, ga: ga.generation >= 3)
     assert len(dnnevo.runs.rundir.RunDir(parts / "seed-1").read_checkpoint().history) == 3
+    # show on the folder of the stopped sweep: the statistics of its one finished seed.
+    shown = run_cli("show", parts)
+    assert shown.returncode == 0 and "a sweep of sequence-1bit, 1 finished seed (summary.json" in shown.stdout
+    assert "final champions passing on fresh trials:" in shown.stdout, shown.stdout
     printed = sweep(parts, "0-2")
+    # The statistics it prints are those show makes again from summary.json.
+    shown = run_cli("show", parts).stdout.splitlines()
+    assert shown[0].startswith(f"{parts}: a sweep of sequence-1bit, 3 finished seeds")
+    assert all(line in printed.splitlines() for line in shown[1:] if "wall" not in line and "   " not in line)
     assert "seed 0: finished; judging its champion again" in printed
     assert "seed 1: resuming at generation 3" in printed
     assert results(parts) == results(whole)
     for seed in range(3):
         best = f"seed-{seed}/best.json"
         assert (parts / best).read_bytes() == (whole / best).read_bytes()
+    (parts / "summary.json").write_text('{"runs": [}')
+    assert_one_line_error(run_cli("show", parts), "summary.json")
 
 
 def test_more_generations_extend_a_sweep_to_the_results_of_a_longer_one(tmp_path: Path) -> None:

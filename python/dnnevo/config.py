@@ -13,6 +13,7 @@ import inspect
 import json
 import math
 import os
+import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
@@ -224,12 +225,14 @@ class EvolutionConfig:
                               "EvolutionConfig.load(path) reads a file")
         try:
             d = tomllib.loads(text)
+            d.pop("run", None)
+            return cls.from_dict(d)
         except tomllib.TOMLDecodeError as e:
             hint = ("; it looks like a file's path: EvolutionConfig.load(path) reads a file"
                     if "\n" not in text.strip() and text.strip().endswith(".toml") else "")
             raise ConfigError(f"not valid TOML: {e}{hint}") from None
-        d.pop("run", None)
-        return cls.from_dict(d)
+        except RecursionError:
+            raise ConfigError("tables or arrays nested too deeply") from None
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> EvolutionConfig:
@@ -382,6 +385,10 @@ def _parse_value(text: str, key: str) -> Any:
                else "a setting holds numbers, strings, booleans (true, false) and lists")
         raise ConfigError(f"--set {key}={text}: {text} is not a TOML value; {fix}, or "
                           f"{key}='\"{text}\"' for the string")
+    if text[:1] in "[{" and (word := re.search(rf"\b({'|'.join(_NOT_TOML)})\b", text)):
+        # A list or table meant as one, which would be kept as a string of its text.
+        raise ConfigError(f"--set {key}={text}: not a TOML value, since {word.group(1)} is not one; "
+                          "booleans are true and false")
     return text
 
 

@@ -328,9 +328,15 @@ def get(name: str, *, quick: bool = False, overrides: list[str] | None = None) -
     ``observation_size`` (which imports the class's module and makes one with the final
     ``task_params``) unless the class's preset or an override sets it."""
     if name.startswith(PYTHON_TASK):
-        own = named.class_preset(name)
-        start: dict[str, Any] = {**own, "task": name, **(PYTHON_QUICK if quick else {})}
-        config = apply_overrides(EvolutionConfig.from_dict(start), overrides or [])
+        own = named.class_preset(name)  # checked: a config of its own
+        quick_sets = [f"{k}={v}" for k, v in PYTHON_QUICK.items()] if quick else []
+        try:  # the quick settings and the overrides together, so that an override can fit them
+            config = apply_overrides(EvolutionConfig.from_dict({**own, "task": name}), [*quick_sets, *(overrides or [])])
+        except ConfigError as e:
+            if not (quick and own and any(k in str(e) for k in PYTHON_QUICK)):
+                raise
+            raise ConfigError(f"{e}: --quick's {', '.join(f'{k} {v}' for k, v in PYTHON_QUICK.items())} "
+                              f"go over {name.rpartition('.')[2]}.preset; --set the setting to fit") from None
         if "n_inputs" in own or any(o.partition("=")[0].strip() == "n_inputs" for o in overrides or []):
             return config
         size = named.observation_size(name, config.task_params)

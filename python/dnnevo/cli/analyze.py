@@ -325,7 +325,9 @@ def letters(a: Attractors) -> dict[int, str]:
 def _sweep_lines(bif: Bifurcation, name: str) -> list[str]:
     """The bifurcation sweep of ``name`` in words."""
     events = ", ".join(event_texts(bif.events)) or "none"
-    lines = [f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}: {events}"]
+    others = [f"{x:g}" for k, x in enumerate(bif.input) if k != bif.index]
+    held = f" (the other inputs held at {','.join(others)})" if others else ""
+    lines = [f"sweep of {name} from {bif.values[0]:g} to {bif.values[-1]:g}{held}: {events}"]
     if bif.retried:
         lines.append(f"    searched again with {analysis.RETRY_STARTS} starts at {len(bif.retried)} value"
                      f"{'s' * (len(bif.retried) != 1)} where the count of equilibria was even")

@@ -177,8 +177,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("show", help="summarise a run and write fitness.png",
                        description="Summarise a run folder (its champion, generations, success rule "
-                                   "and the next command) and write fitness.png into it.",
-                       epilog="example: dnnevo show runs/demo")
+                                   "and the next command) and write fitness.png into it; for a "
+                                   "sweep's folder, print the sweep's statistics over its finished seeds.",
+                       epilog="examples: dnnevo show runs/demo; dnnevo show runs/sweep (a sweep's folder)")
     p.add_argument("dir", type=Path)
 
     sub.add_parser("presets", help="list the presets",

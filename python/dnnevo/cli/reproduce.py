@@ -35,7 +35,8 @@ three subnetworks, the goal seekers evolved on chains, both integrated systems, 
 network) and sequence learning (1-bit, alternating, the incremental 2-bit route from those two
 runs, direct 2-bit, and beyond the paper direct 2-bit with 16 neurons, 3-bit). --only ablation
 runs the working incremental 2-bit route with one of its departures from the paper removed at a
-time, with the 1-bit and alternating runs it composes (those the folder holds are used).
+time, and with the two that matter least removed together (ablation-2bit-smallest), with the
+1-bit and alternating runs it composes (those the folder holds are used).
 --only precision runs the landmark, navigation (with the integrated system), 1-bit and 3-bit
 experiments again with precision = "f32", to compare their success counts with f64's.
 --only classic runs the field's benchmarks written as Python tasks instead (walker, categorical
@@ -74,7 +75,8 @@ def add_parser(sub: Any, parse_seeds: Any, positive: Any) -> None:
     p.add_argument("--quick", action="store_true", help="each preset's quick variant: small populations, few generations")
     p.add_argument("--only", type=_picked, default=plan.PAPER_FAMILIES, metavar="NAMES",
                    help=f"comma-separated families, from {','.join(plan.FAMILIES)} (default the paper's: "
-                        f"{','.join(plan.PAPER_FAMILIES)}), or experiments, e.g. sequence-2bit")
+                        f"{','.join(plan.PAPER_FAMILIES)}), or experiments, e.g. sequence-2bit (a "
+                        "name that is both, as landmark, is the family)")
     p.add_argument("--out", type=Path, default=Path("reproduce"), help="the reproduction's folder (default reproduce)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a setting for every evolution, after its preset's, e.g. population=200")

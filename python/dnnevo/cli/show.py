@@ -30,6 +30,7 @@ from dnnevo.closedloop import named
 from dnnevo.config import PYTHON_TASK
 from dnnevo.closedloop.fitness import SUCCESS_EPISODES
 from dnnevo.cli.outputs import try_write
+from dnnevo.cli.sweep import stored_summary
 from dnnevo.runs import RunDir, save_figure
 
 __all__ = ["blind_line", "champion_line", "next_line", "outcome", "show", "success_line"]
@@ -139,7 +140,12 @@ def outcome(path: Path, config: EvolutionConfig, champion: Mapping[str, Any],
 
 def show(args: argparse.Namespace) -> int:
     """``dnnevo show``: the run's size and time, its champion, the success rule, the last
-    generation, and fitness.png."""
+    generation, and fitness.png; for a sweep's folder, the sweep's statistics over its finished
+    seeds."""
+    summary = stored_summary(args.dir) if not (args.dir / "config.toml").exists() else None
+    if summary is not None:  # a sweep's folder: its statistics, as the sweep printed them
+        print("\n".join(summary))
+        return 0
     run = RunDir(args.dir)
     config, table = run.read_run_config()
     history = run.read_log(config)

@@ -228,6 +228,24 @@ def _generation(x: float) -> str:
     return "not reached" if x == float("inf") else f"{x:.0f}"
 
 
+def stored_summary(out: Path) -> list[str] | None:
+    """What the sweep in ``out`` printed about its finished seeds, made again from its
+    ``summary.json`` (checked as it is read); None when ``out`` holds no sweep's summary."""
+    path = out / sweep.SUMMARY_FILES[1]
+    if not (out / SETTINGS_FILE).is_file() or not path.is_file():
+        return None
+    with checked(path):
+        d = read_json(path)
+        runs = [sweep.SeedResult.from_dict(r) for r in d["runs"]]
+        base = int(str(d["eval_seed"]).split()[0])  # written as "BASE + seed"
+        trials, unit = int(d["eval_trials"]), str(d["eval_unit"])
+        if not runs:
+            raise ValueError("no seed's result")
+    return [f"{out}: a sweep of {d['preset']}, {len(runs)} finished seed{'s' * (len(runs) != 1)} "
+            f"(summary.json; each seed's run: dnnevo show {out / f'seed-{runs[0].seed}'})",
+            *lines(sweep.summarize(runs), base, trials, unit)]
+
+
 def lines(s: sweep.Summary, eval_seed: int, trials: int, unit: str) -> list[str]:
     """The sweep's table and statistics in words."""
     out = [

@@ -248,7 +248,7 @@ def evolve(
         run.write_config(config, table)
         run.write_log([])
         return _loop(ga, task, [], run, progress=progress, callback=callback, threads=threads,
-                     table=table, resume_hint=_resume_hint(task, config, run, named=named_task))
+                     table=table, resume_hint=lambda: _resume_hint(task, config, run, named=named_task))
 
 
 def resume(
@@ -356,7 +356,8 @@ def resume(
         _write_best(run, ga)
         return _loop(ga, fitness, history, run, progress=progress, callback=callback,
                      threads=threads, table=table,
-                     resume_hint=_resume_hint(fitness, ga.config, run, named=task is None or isinstance(task, str)))
+                     resume_hint=lambda: _resume_hint(fitness, ga.config, run,
+                                                      named=task is None or isinstance(task, str)))
 
 
 def refuse_idle_scale(config: EvolutionConfig) -> None:
@@ -398,8 +399,9 @@ def _resume_hint(task: str | FitnessFn, config: EvolutionConfig, run: RunDir, *,
     """How to resume ``run`` after an interrupt: with ``dnnevo resume`` when the command builds
     its task again from config.toml (a task ``named`` by its name, or an environment one made from
     config.toml would equal), else from Python with the same task."""
-    if named or isinstance(task, str) or (isinstance(task, ClosedLoop) and _not_rebuilt(task, config) is None
-                                          and task.__module__ != "__main__"):
+    script = config.task.startswith(f"{PYTHON_TASK}__main__.")  # no other process imports it
+    if not script and (named or isinstance(task, str)
+                       or (isinstance(task, ClosedLoop) and _not_rebuilt(task, config) is None)):
         return f"dnnevo resume {run.path}"
     same = "environment (in ClosedLoop)" if isinstance(task, ClosedLoop) else "fitness function"
     return f"dnnevo.resume({str(run.path)!r}, task=...) from Python, with the same {same}"
@@ -647,7 +649,7 @@ def _loop(
     callback: Callback | None,
     threads: int | None,
     table: Mapping[str, Any] | None = None,
-    resume_hint: str = "",
+    resume_hint: Callable[[], str] = lambda: "",
 ) -> EvolutionResult:
     config = ga.config
     bar = Progress(config.generations, start=ga.generation) if progress else None
@@ -756,7 +758,8 @@ def _loop(
     finally:
         if bar is not None:
             bar.close()
-    hint = f"interrupted {saved}. Resume with: {resume_hint}" if run is not None else ""
+    # Made only now: it may build the task's environment again, to tell whether the command can.
+    hint = f"interrupted {saved}. Resume with: {resume_hint()}" if run is not None and interrupted else ""
     if interrupted and ga.best is None:
         # Stopped before any generation was scored: there is no result to return.
         raise KeyboardInterrupt(hint)

@@ -311,7 +311,7 @@ def families(only: Iterable[str] | None) -> tuple[str, ...]:
 
 def picked(only: Iterable[str] | None) -> tuple[str, ...]:
     """The families and experiments ``--only`` names (the paper's families when None), checked:
-    a name is a family's or an experiment's."""
+    a name is a family's or an experiment's (one that is both, as ``landmark``, is the family)."""
     if only is None:
         return PAPER_FAMILIES
     names = tuple(dict.fromkeys(only))

@@ -110,10 +110,10 @@ class ClosedLoop:
     episode number.
 
     A run folder names it after the environment's class (or ``name``, ``"python:module.Class"``)
-    and records the rollout's settings in ``config.toml``, with a digest of the class's source,
-    the environment's attributes and the settings; ``resume`` accepts it again only when the
-    digest is the same. Wrap a freshly made environment: one that has run episodes has more
-    attributes.
+    and records the rollout's settings in ``config.toml``, with a digest of the class's source
+    (its code: comments and layout do not count), the environment's attributes and the settings;
+    ``resume`` accepts it again only when the digest is the same. Wrap a freshly made
+    environment: one that has run episodes has more attributes.
     """
 
     def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int,
@@ -182,10 +182,14 @@ class ClosedLoop:
         legacy = [legacy_fingerprint(attributes), legacy_fingerprint(recorded)]
         self._legacy_sources = ["\n".join([text or kind.__qualname__, *legacy])
                                 for text in (plain_source(kind), plain_source(kind, ignored=True))]
+        # As made before comments and layout were left out: the source as written.
+        written = task_source(kind, raw=True) or kind.__qualname__
+        self._legacy_sources.append("\n".join([written, self._parts["attributes"], self._parts["settings"]]))
         if any(isinstance(v, np.generic) for v in given.values()):
-            # NumPy settings, as runs recorded them before they were made Python numbers
+            # NumPy settings, as runs recorded them before they were made Python numbers (and
+            # before comments and layout were left out)
             as_given = {**recorded, **{k: given[k] for k in recorded if k in given}}
-            self._legacy_sources.append("\n".join([self._parts["source"], self._parts["attributes"],
+            self._legacy_sources.append("\n".join([written, self._parts["attributes"],
                                                    fingerprint(as_given)]))
 
     def _recorded(self) -> dict[str, Any]:
@@ -208,14 +212,17 @@ class ClosedLoop:
     def part_digests(self) -> dict[str, str]:
         """SHA-256 of each part of :attr:`fitness_source`, as ``config.toml``'s ``fitness_parts``
         records them, to say which part differs when a digest does: the class's ``source`` (with
-        what it reads from its module), the environment's ``attributes`` and the rollout's
-        ``settings``."""
+        what it reads from its module, comments and layout left out), the environment's
+        ``attributes`` and the rollout's ``settings``. A run recorded before comments and layout
+        were left out has another ``source`` part, so when its digest differs by another part,
+        its source is said to differ too."""
         return {k: hashlib.sha256(v.encode()).hexdigest() for k, v in self._parts.items()}
 
     def digests(self) -> tuple[str, ...]:
-        """Every digest a run of this task may record: :meth:`digest`, and the one runs recorded
+        """Every digest a run of this task may record: :meth:`digest`, the ones runs recorded
         before digests took in what the class reads from its module (which they then could not
-        check)."""
+        check), and the one of runs recorded before comments and layout were left out (the
+        source as written)."""
         return (self.digest(), *(hashlib.sha256(t.encode()).hexdigest() for t in self._legacy_sources))
 
     def arguments(self) -> dict[str, Any]:

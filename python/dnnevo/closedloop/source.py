@@ -16,6 +16,13 @@ Decorated functions are read layer by layer, properties through their getter, se
 deleter. So an edited constant at the top of the task's file is an edited task. What the task
 reads from other modules, files or objects' hidden state is not covered.
 
+Each piece of source counts by its tokens (:func:`normalised`): comments, blank lines, line
+continuations and the width of spaces and indentation do not count, so reformatting a task
+keeps the runs evolved with it. Every token does: a name, an operator, a number as written
+(``0.10`` is not ``0.1``), a string's contents, docstrings included, and the split into lines
+and blocks (``if x: y`` on one line or two, a ``;`` for a new line, a bracket or a trailing
+comma added). The text is the same on every Python from 3.11 on.
+
 A class's ``analysis = ...`` attribute (:class:`dnnevo.tasks.protocol.Analysis`) is left out: it
 says how to analyse a champion, not what the task asks, so adding one to a task class keeps the
 runs evolved with it.
@@ -25,6 +32,9 @@ runs evolved with it.
 >>> text = task_source(FarSeeker)
 >>> text.startswith("class FarSeeker")
 True
+>>> print(normalised("def f(x) :  # a comment\n\n  return (x +\n          1)\n"))
+def f ( x ) :
+    return ( x + 1 )
 """
 
 from __future__ import annotations
@@ -35,15 +45,18 @@ import dis
 import functools
 import hashlib
 import inspect
+import io
 import sys
 import textwrap
+import tokenize
 import types
+import warnings
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-__all__ = ["fingerprint", "legacy_fingerprint", "plain_source", "task_source"]
+__all__ = ["fingerprint", "legacy_fingerprint", "normalised", "plain_source", "task_source"]
 
 #: Class attributes left out of a class's text (see the module docs).
 IGNORED_ATTRIBUTES = ("analysis",)
@@ -97,6 +110,84 @@ def legacy_fingerprint(value: Any, _walking: frozenset[int] = frozenset()) -> st
     return f"<{type(value).__module__}.{type(value).__qualname__}>"
 
 
+#: Tokens that are layout, not code, left out of :func:`normalised`'s text.
+_LAYOUT = frozenset({tokenize.COMMENT, tokenize.NL, tokenize.ENCODING, tokenize.ENDMARKER})
+#: Python 3.12 on splits an f-string into tokens between these two (3.11 has neither).
+_FSTRING_START = getattr(tokenize, "FSTRING_START", None)
+_FSTRING_END = getattr(tokenize, "FSTRING_END", None)
+#: Tokens that make up a name: 3.11's tokenizer splits one with combining marks (``x\u0301``)
+#: into names and error tokens that touch.
+_NAME_PIECES = (tokenize.NAME, tokenize.ERRORTOKEN)
+
+
+def normalised(source: str) -> str:
+    """``source`` as its tokens, whatever its layout: a line for each logical line, indented
+    four spaces a block, its tokens separated by one space; comments, blank lines, line
+    continuations and the width of spaces and indentation are left out. Each token stays as
+    written (a number's digits, a string with its prefix and quotes, an f-string whole), so the
+    text reads back as the same tokens: two sources share it only when Python reads the same
+    tokens, in the same lines and blocks, in both.
+
+    It is made with :mod:`tokenize`, not from the syntax tree, whose text (``ast.dump``,
+    ``ast.unparse``) changes from one Python version to another, and it is the same on 3.11 to
+    3.13: an f-string, which 3.12 on splits into tokens, is taken whole from the source, as
+    3.11 reads it, and a name that 3.11 reads in pieces is joined again. Source that Python
+    cannot parse alone (a lambda cut out of its line) is returned as it is.
+    """
+    try:
+        with warnings.catch_warnings():  # an invalid escape: said when the module was imported
+            warnings.simplefilter("ignore")
+            # An indented piece (a method's class, a nested class) parses in a block.
+            ast.parse(f"if 1:\n{source}" if source[:1].isspace() else source)
+            tokens = list(tokenize.generate_tokens(io.StringIO(source).readline))
+    except (SyntaxError, tokenize.TokenError, ValueError):
+        return source
+    lines = io.StringIO(source).readlines()  # as tokenize numbers them
+    rendered: list[str] = []
+    words: list[str] = []
+    depth, nested, start = 0, 0, (0, 0)
+    previous: tokenize.TokenInfo | None = None
+    for token in tokens:
+        kind = token.type
+        if nested or kind == _FSTRING_START:
+            if kind == _FSTRING_START:
+                start = start if nested else token.start
+                nested += 1
+            elif kind == _FSTRING_END:
+                nested -= 1
+                if not nested:
+                    words.append(_span(lines, start, token.end))
+            previous = token
+            continue
+        if kind == tokenize.INDENT:
+            depth += 1
+        elif kind == tokenize.DEDENT:
+            depth -= 1
+        elif kind == tokenize.NEWLINE:
+            if words:
+                rendered.append("    " * depth + " ".join(words))
+            words = []
+        elif kind in _LAYOUT or (kind == tokenize.ERRORTOKEN and token.string.isspace()):
+            continue
+        elif kind in _NAME_PIECES and previous is not None and previous.type in _NAME_PIECES \
+                and previous.end == token.start and words:
+            words[-1] += token.string
+        else:
+            words.append(token.string)
+        previous = token
+    if words:
+        rendered.append("    " * depth + " ".join(words))
+    return "\n".join(rendered)
+
+
+def _span(lines: list[str], start: tuple[int, int], end: tuple[int, int]) -> str:
+    """The text of ``lines`` from ``start`` to ``end``, tokenize's (line from 1, column)."""
+    (row, column), (end_row, end_column) = start, end
+    if row == end_row:
+        return lines[row - 1][column:end_column]
+    return lines[row - 1][column:] + "".join(lines[row:end_row - 1]) + lines[end_row - 1][:end_column]
+
+
 def plain_source(target: Any, *, ignored: bool = False) -> str | None:
     """The source of a function or class alone (with ``ignored``, a class's without its
     :data:`IGNORED_ATTRIBUTES`), as digests were made before they took in what the task reads
@@ -108,15 +199,16 @@ def plain_source(target: Any, *, ignored: bool = False) -> str | None:
     return _without_ignored(source) if ignored and inspect.isclass(target) else source
 
 
-def task_source(target: Any) -> str | None:
-    """The text of a function or class for its digest (see the module docs); None when Python
-    cannot find its source."""
+def task_source(target: Any, *, raw: bool = False) -> str | None:
+    """The text of a function or class for its digest (see the module docs), each piece of
+    source :func:`normalised`; with ``raw``, each piece as written, as digests were made before
+    comments and layout were left out. None when Python cannot find its source."""
     own = plain_source(target, ignored=True)
     if own is None:
         return None
     statements = _module_statements(target)
     namespace = _module_namespace(target)
-    parts = [own]
+    parts = [own if raw else normalised(own)]
     seen: set[str] = set()
     pending = sorted(_names_used(target, own))
     while pending:
@@ -127,11 +219,14 @@ def task_source(target: Any) -> str | None:
         value = namespace[name]
         function = _function_of(value)
         if name in statements:  # made by a statement (even a function: AMPLIFY = make(2.0))
-            text = "\n".join(statements[name])
-            used = _loaded_names(text)
+            written = statements[name]
+            # Statements the same but for their layout count once.
+            text = "\n".join(written if raw else dict.fromkeys(normalised(t) for t in written))
+            used = _loaded_names("\n".join(written))
         elif (function is not None or inspect.isclass(value)) and _defined_alongside(function or value, target):
-            text = plain_source(function or value, ignored=True) or ""
-            used = _names_used(function or value, text)
+            source = plain_source(function or value, ignored=True) or ""
+            text = source if raw else normalised(source)
+            used = _names_used(function or value, source)
         elif not callable(value):
             text, used = fingerprint(value), set()
         else:

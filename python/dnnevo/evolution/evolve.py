@@ -583,16 +583,16 @@ def _fitness_digest(task: FitnessFn) -> str | None:
 
 
 def _fitness_digests(task: FitnessFn) -> tuple[str, ...]:
-    """Every digest a run of ``task`` may record: :func:`_fitness_digest`'s, then the one of
-    runs made before digests took in what the function reads from its module; none when Python
-    cannot find the source."""
+    """Every digest a run of ``task`` may record: :func:`_fitness_digest`'s, then the ones of
+    runs made before digests left out comments and layout, and before they took in what the
+    function reads from its module; none when Python cannot find the source."""
     if callable(own := getattr(task, "digests", None)):
         return tuple(own())
     if isinstance(given := getattr(task, "fitness_source", None), str):
         return (hashlib.sha256(given.encode()).hexdigest(),)
     target = task if inspect.isfunction(task) or inspect.ismethod(task) else type(task)
     target = getattr(target, "__func__", target)
-    texts = (task_source(target), plain_source(target))
+    texts = (task_source(target), task_source(target, raw=True), plain_source(target))
     return tuple(hashlib.sha256(t.encode()).hexdigest() for t in texts if t is not None)
 
 

@@ -111,9 +111,9 @@ class ClosedLoop:
 
     A run folder names it after the environment's class (or ``name``, ``"python:module.Class"``)
     and records the rollout's settings in ``config.toml``, with a digest of the class's source
-    (its code: comments and layout do not count), the environment's attributes and the settings;
-    ``resume`` accepts it again only when the digest is the same. Wrap a freshly made
-    environment: one that has run episodes has more attributes.
+    (its code: comments, docstrings and layout do not count), the environment's attributes and
+    the settings; ``resume`` accepts it again only when the digest is the same. Wrap a freshly
+    made environment: one that has run episodes has more attributes.
     """
 
     def __init__(self, env: Environment, *, episodes: int = 1, max_steps: int,
@@ -212,7 +212,7 @@ class ClosedLoop:
     def part_digests(self) -> dict[str, str]:
         """SHA-256 of each part of :attr:`fitness_source`, as ``config.toml``'s ``fitness_parts``
         records them, to say which part differs when a digest does: the class's ``source`` (with
-        what it reads from its module, comments and layout left out), the environment's
+        what it reads from its module, comments, docstrings and layout left out), the environment's
         ``attributes`` and the rollout's ``settings``. A run recorded before comments and layout
         were left out has another ``source`` part, so when its digest differs by another part,
         its source is said to differ too."""

@@ -16,12 +16,13 @@ Decorated functions are read layer by layer, properties through their getter, se
 deleter. So an edited constant at the top of the task's file is an edited task. What the task
 reads from other modules, files or objects' hidden state is not covered.
 
-Each piece of source counts by its tokens (:func:`normalised`): comments, blank lines, line
-continuations and the width of spaces and indentation do not count, so reformatting a task
-keeps the runs evolved with it. Every token does: a name, an operator, a number as written
-(``0.10`` is not ``0.1``), a string's contents, docstrings included, and the split into lines
-and blocks (``if x: y`` on one line or two, a ``;`` for a new line, a bracket or a trailing
-comma added). The text is the same on every Python from 3.11 on.
+Each piece of source counts by the code it holds (:func:`normalised`): comments, blank lines,
+line continuations, the width of spaces and indentation, docstrings and how a string is
+written (``'a'`` or ``"a"``) do not count, so documenting or reformatting a task keeps the runs
+evolved with it. Every other token does: a name, an operator, a number as written (``0.10`` is
+not ``0.1``), a string's value, and the split into lines and blocks (``if x: y`` on one line or
+two, a ``;`` for a new line, a bracket or a trailing comma added). The text is the same on
+Python 3.11 to 3.13, so a run evolved on one opens on another.
 
 A class's ``analysis = ...`` attribute (:class:`dnnevo.tasks.protocol.Analysis`) is left out: it
 says how to analyse a champion, not what the task asks, so adding one to a task class keeps the
@@ -32,7 +33,8 @@ runs evolved with it.
 >>> text = task_source(FarSeeker)
 >>> text.startswith("class FarSeeker")
 True
->>> print(normalised("def f(x) :  # a comment\n\n  return (x +\n          1)\n"))
+>>> from dnnevo.closedloop.source import normalised
+>>> print(normalised("def f(x) :  # a comment\\n\\n  'Adds one.'\\n  return (x +\\n          1)"))
 def f ( x ) :
     return ( x + 1 )
 """
@@ -121,12 +123,14 @@ _NAME_PIECES = (tokenize.NAME, tokenize.ERRORTOKEN)
 
 
 def normalised(source: str) -> str:
-    """``source`` as its tokens, whatever its layout: a line for each logical line, indented
-    four spaces a block, its tokens separated by one space; comments, blank lines, line
-    continuations and the width of spaces and indentation are left out. Each token stays as
-    written (a number's digits, a string with its prefix and quotes, an f-string whole), so the
-    text reads back as the same tokens: two sources share it only when Python reads the same
-    tokens, in the same lines and blocks, in both.
+    r"""``source`` as the code it holds, whatever its layout: a line for each logical line,
+    indented four spaces a block, its tokens separated by one space. Comments, blank lines,
+    line continuations and the width of spaces and indentation are left out, and so are
+    docstrings and any other statement that is a string alone (it does nothing but set a
+    ``__doc__``); a string is written by its value (``'a'``, ``"a"`` and ``u"\x61"`` alike),
+    every other token as it is written (a number's digits: ``0.10`` is not ``0.1``; an
+    f-string whole). So two sources share the text only when Python reads the same code in
+    them, docstrings aside, in the same lines and blocks.
 
     It is made with :mod:`tokenize`, not from the syntax tree, whose text (``ast.dump``,
     ``ast.unparse``) changes from one Python version to another, and it is the same on 3.11 to
@@ -134,50 +138,71 @@ def normalised(source: str) -> str:
     3.11 reads it, and a name that 3.11 reads in pieces is joined again. Source that Python
     cannot parse alone (a lambda cut out of its line) is returned as it is.
     """
-    try:
-        with warnings.catch_warnings():  # an invalid escape: said when the module was imported
-            warnings.simplefilter("ignore")
-            # An indented piece (a method's class, a nested class) parses in a block.
+    with warnings.catch_warnings():  # an invalid escape: said when the module was imported
+        warnings.simplefilter("ignore")
+        try:
+            # An indented piece (a nested class) parses in a block.
             ast.parse(f"if 1:\n{source}" if source[:1].isspace() else source)
             tokens = list(tokenize.generate_tokens(io.StringIO(source).readline))
-    except (SyntaxError, tokenize.TokenError, ValueError):
-        return source
-    lines = io.StringIO(source).readlines()  # as tokenize numbers them
-    rendered: list[str] = []
-    words: list[str] = []
-    depth, nested, start = 0, 0, (0, 0)
-    previous: tokenize.TokenInfo | None = None
-    for token in tokens:
-        kind = token.type
-        if nested or kind == _FSTRING_START:
-            if kind == _FSTRING_START:
-                start = start if nested else token.start
-                nested += 1
-            elif kind == _FSTRING_END:
-                nested -= 1
-                if not nested:
-                    words.append(_span(lines, start, token.end))
+        except (SyntaxError, tokenize.TokenError, ValueError):
+            return source
+        lines = io.StringIO(source).readlines()  # as tokenize numbers them
+        rendered: list[str] = []
+        words: list[str] = []
+        strings_only = True  # whether the logical line so far is strings alone
+        depth, nested, start = 0, 0, (0, 0)
+        previous: tokenize.TokenInfo | None = None
+        for token in tokens:
+            kind = token.type
+            if nested or kind == _FSTRING_START:
+                if kind == _FSTRING_START:
+                    start = start if nested else token.start
+                    nested += 1
+                elif kind == _FSTRING_END:
+                    nested -= 1
+                    if not nested:
+                        words.append(_span(lines, start, token.end))
+                        strings_only = False
+                previous = token
+                continue
+            if kind == tokenize.INDENT:
+                depth += 1
+            elif kind == tokenize.DEDENT:
+                depth -= 1
+            elif kind == tokenize.NEWLINE:
+                if words and not strings_only:
+                    rendered.append("    " * depth + " ".join(words))
+                words, strings_only = [], True
+            elif kind in _LAYOUT or (kind == tokenize.ERRORTOKEN and token.string.isspace()):
+                continue
+            elif kind in _NAME_PIECES and previous is not None and previous.type in _NAME_PIECES \
+                    and previous.end == token.start and words:
+                words[-1] += token.string
+            else:
+                value = _string(token.string) if kind == tokenize.STRING else None
+                words.append(token.string if value is None else value)
+                strings_only = strings_only and value is not None
             previous = token
-            continue
-        if kind == tokenize.INDENT:
-            depth += 1
-        elif kind == tokenize.DEDENT:
-            depth -= 1
-        elif kind == tokenize.NEWLINE:
-            if words:
-                rendered.append("    " * depth + " ".join(words))
-            words = []
-        elif kind in _LAYOUT or (kind == tokenize.ERRORTOKEN and token.string.isspace()):
-            continue
-        elif kind in _NAME_PIECES and previous is not None and previous.type in _NAME_PIECES \
-                and previous.end == token.start and words:
-            words[-1] += token.string
-        else:
-            words.append(token.string)
-        previous = token
-    if words:
+    if words and not strings_only:
         rendered.append("    " * depth + " ".join(words))
     return "\n".join(rendered)
+
+
+def _string(token: str) -> str | None:
+    """A string literal by its value, however it is written: a str in double quotes, with
+    every character but printable ASCII escaped (``unicode_escape``, which needs no Unicode
+    tables that change with Python's version), bytes by their ``repr``; None for an f-string."""
+    if "f" in token[:len(token) - len(token.lstrip("rRbBuUfF"))].lower():
+        return None
+    try:
+        value = ast.literal_eval(token)
+    except (SyntaxError, ValueError):
+        return None
+    if isinstance(value, bytes):
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.encode("unicode_escape").decode("ascii").replace('"', '\\"') + '"'
+    return None
 
 
 def _span(lines: list[str], start: tuple[int, int], end: tuple[int, int]) -> str:

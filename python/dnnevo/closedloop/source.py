@@ -141,8 +141,10 @@ def normalised(source: str) -> str:
     with warnings.catch_warnings():  # an invalid escape: said when the module was imported
         warnings.simplefilter("ignore")
         try:
-            # An indented piece (a nested class) parses in a block.
-            ast.parse(f"if 1:\n{source}" if source[:1].isspace() else source)
+            try:
+                ast.parse(source)
+            except SyntaxError:  # an indented piece (a nested class) parses in a block
+                ast.parse(f"if 1:\n{source}")
             tokens = list(tokenize.generate_tokens(io.StringIO(source).readline))
         except (SyntaxError, tokenize.TokenError, ValueError):
             return source

@@ -409,3 +409,17 @@ def test_runs_begun_with_numpy_settings_keep_the_digest_they_recorded() -> None:
     assert hashlib.sha256(before.encode()).hexdigest() in loop.digests()
     plain = ClosedLoop(FarSeeker(), max_steps=10, dt=0.05)
     assert plain.digest() == loop.digest() and len(plain.digests()) < len(loop.digests())
+
+
+def test_a_class_preset_is_not_part_of_the_task_unless_its_code_reads_it(tmp_path) -> None:
+    """``preset`` says where a new run starts (config.toml records what a run used), so editing it
+    keeps the runs evolved with the class; a class whose own code reads it is another matter."""
+    base = MODULE + "\n\nclass Started(Seeker):\n    preset = {'size': 3}\n"
+    reader = ("\n\nclass Reader(Seeker):\n    preset = {'size': 3}\n\n"
+              "    def reset(self, episodes, rng):\n        self.size = self.preset['size']\n"
+              "        return super().reset(episodes, rng)\n")
+    before = load(tmp_path, "digest_preset", base + reader)
+    texts = (task_source(before.Started), task_source(before.Reader))
+    after = load(tmp_path, "digest_preset", (base + reader).replace("{'size': 3}", "{'size': 5}"))
+    assert task_source(after.Started) == texts[0] and "preset" not in texts[0]
+    assert task_source(after.Reader) != texts[1]

@@ -26,7 +26,9 @@ Python 3.11 to 3.13, so a run evolved on one opens on another.
 
 A class's ``analysis = ...`` attribute (:class:`dnnevo.tasks.protocol.Analysis`) is left out: it
 says how to analyse a champion, not what the task asks, so adding one to a task class keeps the
-runs evolved with it.
+runs evolved with it. So is its ``preset = {...}``, the settings a new run starts from (a run's
+own are in its ``config.toml``, whose digest parts cover them), unless the class's own code reads
+it (``self.preset``), which makes it part of what the task does.
 
 >>> from dnnevo.closedloop.source import task_source
 >>> from dnnevo.closedloop import FarSeeker
@@ -61,7 +63,10 @@ import numpy as np
 __all__ = ["fingerprint", "legacy_fingerprint", "normalised", "plain_source", "task_source"]
 
 #: Class attributes left out of a class's text (see the module docs).
-IGNORED_ATTRIBUTES = ("analysis",)
+IGNORED_ATTRIBUTES = ("analysis", "preset")
+
+#: Of :data:`IGNORED_ATTRIBUTES`, those kept when the class's own code reads them as attributes.
+KEPT_WHEN_READ = ("preset",)
 
 
 def fingerprint(value: Any, _walking: frozenset[int] = frozenset()) -> str:
@@ -400,11 +405,14 @@ def _without_ignored(source: str) -> str:
         return source
     if not tree.body or not isinstance(tree.body[0], ast.ClassDef):
         return source
+    read = {node.attr for node in ast.walk(tree.body[0])
+            if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load)}
+    ignored = [a for a in IGNORED_ATTRIBUTES if not (a in KEPT_WHEN_READ and a in read)]
     drop: set[int] = set()
     for statement in tree.body[0].body:
         targets = statement.targets if isinstance(statement, ast.Assign) else \
             [statement.target] if isinstance(statement, ast.AnnAssign) else []
-        if any(isinstance(t, ast.Name) and t.id in IGNORED_ATTRIBUTES for t in targets):
+        if any(isinstance(t, ast.Name) and t.id in ignored for t in targets):
             drop.update(range(statement.lineno, (statement.end_lineno or statement.lineno) + 1))
     if not drop:
         return source

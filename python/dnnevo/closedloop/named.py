@@ -193,8 +193,9 @@ def _checked_loop(config: EvolutionConfig, cls: type, env: Any, settings: dict[s
 
 
 DIFFERENCES = {
-    "source": "the class's source, or what it reads from its module, was edited since the run; "
-              "a success rule added or changed counts: it is part of the task",
+    "source": "the class's source, or what it reads from its module, was edited since the run "
+              "(comments, docstrings and layout do not count); a success rule added or changed "
+              "counts: it is part of the task",
     "attributes": "the environment's attributes differ: task_params, or the run began from Python "
                   "with an environment made with arguments config.toml could not record, or one "
                   "that had run episodes before ClosedLoop wrapped it",

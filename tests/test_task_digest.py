@@ -423,3 +423,18 @@ def test_a_class_preset_is_not_part_of_the_task_unless_its_code_reads_it(tmp_pat
     after = load(tmp_path, "digest_preset", (base + reader).replace("{'size': 3}", "{'size': 5}"))
     assert task_source(after.Started) == texts[0] and "preset" not in texts[0]
     assert task_source(after.Reader) != texts[1]
+
+
+def test_runs_recorded_while_a_preset_counted_still_open(tmp_path) -> None:
+    """For a while a class's preset was part of its digest: a ClosedLoop still accepts the
+    digests of that time, the source as written and by its tokens, with the preset in."""
+    import hashlib
+
+    module = load(tmp_path, "digest_kept", MODULE + "\n\nclass Started(Seeker):\n    preset = {'size': 3}\n")
+    loop = ClosedLoop(module.Started(), episodes=2, max_steps=50)
+    rest = [loop._parts["attributes"], loop._parts["settings"]]
+    for raw in (True, False):
+        text = task_source(module.Started, raw=raw, keep=("preset",))
+        assert "preset" in text
+        assert hashlib.sha256("\n".join([text, *rest]).encode()).hexdigest() in loop.digests()
+    assert "preset" not in task_source(module.Started)

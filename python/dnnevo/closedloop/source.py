@@ -220,22 +220,23 @@ def _span(lines: list[str], start: tuple[int, int], end: tuple[int, int]) -> str
     return lines[row - 1][column:] + "".join(lines[row:end_row - 1]) + lines[end_row - 1][:end_column]
 
 
-def plain_source(target: Any, *, ignored: bool = False) -> str | None:
+def plain_source(target: Any, *, ignored: bool = False, keep: tuple[str, ...] = ()) -> str | None:
     """The source of a function or class alone (with ``ignored``, a class's without its
-    :data:`IGNORED_ATTRIBUTES`), as digests were made before they took in what the task reads
-    from its module; None when Python cannot find it (typed at a prompt)."""
+    :data:`IGNORED_ATTRIBUTES` but those in ``keep``), as digests were made before they took in
+    what the task reads from its module; None when Python cannot find it (typed at a prompt)."""
     try:
         source = inspect.getsource(target)
     except (OSError, TypeError):
         return None
-    return _without_ignored(source) if ignored and inspect.isclass(target) else source
+    return _without_ignored(source, keep) if ignored and inspect.isclass(target) else source
 
 
-def task_source(target: Any, *, raw: bool = False) -> str | None:
+def task_source(target: Any, *, raw: bool = False, keep: tuple[str, ...] = ()) -> str | None:
     """The text of a function or class for its digest (see the module docs), each piece of
     source :func:`normalised`; with ``raw``, each piece as written, as digests were made before
-    comments and layout were left out. None when Python cannot find its source."""
-    own = plain_source(target, ignored=True)
+    comments and layout were left out; with ``keep``, those of :data:`IGNORED_ATTRIBUTES` kept,
+    as digests were made before they were left out. None when Python cannot find its source."""
+    own = plain_source(target, ignored=True, keep=keep)
     if own is None:
         return None
     statements = _module_statements(target)
@@ -256,7 +257,7 @@ def task_source(target: Any, *, raw: bool = False) -> str | None:
             text = "\n".join(written if raw else dict.fromkeys(normalised(t) for t in written))
             used = _loaded_names("\n".join(written))
         elif (function is not None or inspect.isclass(value)) and _defined_alongside(function or value, target):
-            source = plain_source(function or value, ignored=True) or ""
+            source = plain_source(function or value, ignored=True, keep=keep) or ""
             text = source if raw else normalised(source)
             used = _names_used(function or value, source)
         elif not callable(value):
@@ -396,8 +397,9 @@ def _functions(target: Any) -> list[types.FunctionType]:
     return found
 
 
-def _without_ignored(source: str) -> str:
-    """A class's source without its class-level assignments to :data:`IGNORED_ATTRIBUTES`."""
+def _without_ignored(source: str, keep: tuple[str, ...] = ()) -> str:
+    """A class's source without its class-level assignments to :data:`IGNORED_ATTRIBUTES` (but
+    those in ``keep``)."""
     dedented = textwrap.dedent(source)
     try:
         tree = ast.parse(dedented)
@@ -407,7 +409,7 @@ def _without_ignored(source: str) -> str:
         return source
     read = {node.attr for node in ast.walk(tree.body[0])
             if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load)}
-    ignored = [a for a in IGNORED_ATTRIBUTES if not (a in KEPT_WHEN_READ and a in read)]
+    ignored = [a for a in IGNORED_ATTRIBUTES if a not in keep and not (a in KEPT_WHEN_READ and a in read)]
     drop: set[int] = set()
     for statement in tree.body[0].body:
         targets = statement.targets if isinstance(statement, ast.Assign) else \

@@ -67,7 +67,11 @@ def test_observations_kept_and_scaled() -> None:
 @pytest.mark.parametrize("kwargs, message", [
     ({"actions": "softmax"}, "actions is 'softmax'"),
     ({"actions": "box"}, "needs a Box action space"),
-    ({"outputs": [0]}, "outputs names 1 neurons"),
+    ({"outputs": [0]}, "outputs names 1 neuron;"),
+    ({"outputs": [-1, 0]}, r"outputs is \[-1, 0\]; expected neuron numbers >= 0"),
+    ({"observation_scale": [1.0, 2.0]}, "observation_scale is .*one per kept observation"),
+    ({"observation_scale": float("nan")}, "every scale must be finite"),
+    ({"make_kwargs": {"gravity": 3}}, r"gymnasium.make\('CartPole-v1', \*\*make_kwargs\) failed: TypeError"),
     ({"observations": [4]}, "CartPole-v1 has 4 components"),
     ({"autoreset_mode": "sometimes"}, "autoreset_mode is 'sometimes'"),
 ])
@@ -128,3 +132,59 @@ def test_an_observation_space_without_a_shape_is_named_in_one_line(monkeypatch: 
     monkeypatch.setattr(gym, "make", lambda env_id, **kwargs: _Words())
     with pytest.raises(ConfigError, match="Words-v0's observation space has no shape"):
         GymEnvironment("Words-v0")
+
+
+class _Acting:
+    """A stand-in environment with a given action space."""
+
+    def __init__(self, space) -> None:
+        import gymnasium as gym
+
+        self.observation_space = gym.spaces.Box(-1.0, 1.0, (2,))
+        self.action_space = space
+        self.metadata: dict = {}
+
+    def close(self) -> None:
+        pass
+
+
+def test_actions_keep_to_the_space_and_a_space_they_cannot_fill_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Discrete's start, Box's dtype; Box bounds that are not finite cannot be scaled onto."""
+    import gymnasium as gym
+    from gymnasium.spaces import Box, Discrete
+
+    space: list = []
+    monkeypatch.setattr(gym, "make", lambda env_id, **kwargs: _Acting(space[0]))
+    rates = np.array([[0.2, 0.9, 0.1], [0.7, 0.3, 0.8]])
+    for given, actions, want in [
+        (Discrete(3, start=-1), "argmax", [0, 1]),
+        (Discrete(2, start=5), "threshold", [5, 6]),
+        (Box(-2.0, 2.0, (1,), dtype=np.float32), "box", [-1.2, 0.8]),
+        (Box(0, 10, (1,), dtype=np.int64), "box", [2, 7]),
+    ]:
+        space[:] = [given]
+        env = GymEnvironment("Acting-v0", actions=actions, outputs=[2] if actions == "threshold" else None)
+        acted = env._act(rates)
+        assert acted.reshape(-1).tolist() == pytest.approx(want) and all(given.contains(a) for a in acted), given
+    for given in (Box(-np.inf, np.inf, (1,)), Box(0.0, np.inf, (1,))):
+        space[:] = [given]
+        with pytest.raises(ConfigError, match="must be finite; Acting-v0 has Box"):
+            GymEnvironment("Acting-v0", actions="box")
+
+
+def test_an_unknown_environment_is_a_config_error() -> None:
+    with pytest.raises(ConfigError, match=r"gymnasium.make\('CartPol-v1', \*\*make_kwargs\) failed: NameNotFound"):
+        GymEnvironment("CartPol-v1")
+
+
+def test_the_command_line_runs_a_gymnasium_environment_by_its_class(tmp_path) -> None:
+    """GymEnvironment counts its observations per instance; the command line takes it so."""
+    from cli_helpers import run_cli
+
+    r = run_cli("run", "python:dnnevo.closedloop.gym.GymEnvironment", "--set", "task_params.env_id=CartPole-v1",
+                "--set", "task_params.max_steps=20", "--set", "task_params.episodes=2", "--set", "size=3",
+                "--set", "selection=rank", "--quick", "--threads", "1", "--out", tmp_path / "run")
+    assert r.returncode == 0, r.stderr
+    assert "n_inputs = 4" in (tmp_path / "run" / "config.toml").read_text()
+    drawn = run_cli("plot", tmp_path / "run")
+    assert drawn.returncode == 0, drawn.stderr

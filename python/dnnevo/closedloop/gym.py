@@ -4,10 +4,11 @@
 networks' firing rates to its actions:
 
 - ``"argmax"`` (a ``Discrete(n)`` space): the action is the index of the most active of the
-  first ``n`` output neurons;
-- ``"threshold"`` (``Discrete(2)``): action 1 when the first output neuron's rate is above 0.5;
-- ``"box"`` (a ``Box``): each of the first ``d`` output neurons' rates, in [0, 1], scaled onto
-  the action's ``[low, high]``.
+  first ``n`` output neurons (plus the space's ``start``);
+- ``"threshold"`` (``Discrete(2)``): action 1 (plus ``start``) when the first output neuron's
+  rate is above 0.5;
+- ``"box"`` (a ``Box`` with finite bounds): each of the first ``d`` output neurons' rates, in
+  [0, 1], scaled onto the action's ``[low, high]``, in the space's dtype (rounded for integers).
 
 ``outputs`` chooses the output neurons (default: neurons 0, 1, ...). ``vectorization_mode`` and
 ``autoreset_mode`` (``"next_step"``, ``"same_step"`` or ``"disabled"``) are passed to
@@ -40,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dnnevo.closedloop.environment import check_neurons
-from dnnevo.errors import ConfigError
+from dnnevo.errors import ConfigError, counted
 
 try:
     import gymnasium as gym
@@ -70,7 +71,11 @@ class GymEnvironment:
             raise ConfigError(f"autoreset_mode is {autoreset_mode!r}; expected one of "
                               f"{', '.join(modes)} (or None: the environment's own)")
         self.autoreset_mode = modes.get(autoreset_mode or "")
-        probe = gym.make(env_id, **self.make_kwargs)
+        try:
+            probe = gym.make(env_id, **self.make_kwargs)
+        except (gym.error.Error, TypeError, ValueError) as e:
+            # An unknown id, a misspelt keyword of make_kwargs: the environment's own words.
+            raise ConfigError(f"gymnasium.make({env_id!r}, **make_kwargs) failed: {type(e).__name__}: {e}") from None
         try:
             obs_space, act_space = probe.observation_space, probe.action_space
         finally:
@@ -80,18 +85,28 @@ class GymEnvironment:
         width = int(np.prod(obs_space.shape))
         self.columns = np.arange(width) if observations is None else np.asarray(observations)
         if self.columns.size and (self.columns.min() < 0 or self.columns.max() >= width):
-            raise ConfigError(f"observations is {list(self.columns)}; {env_id} has {width} components")
+            raise ConfigError(f"observations is {self.columns.tolist()}; {env_id} has {width} components")
         self.observation_size = int(self.columns.size)
         self.every_column = bool(np.array_equal(self.columns, np.arange(width)))
-        self.scale = np.broadcast_to(np.asarray(observation_scale, dtype=np.float64),
-                                     (self.observation_size,)).copy()
+        try:
+            self.scale = np.broadcast_to(np.asarray(observation_scale, dtype=np.float64),
+                                         (self.observation_size,)).copy()
+        except (ValueError, TypeError):
+            raise ConfigError(f"observation_scale is {observation_scale!r}; expected a number or one per kept "
+                              f"observation ({self.observation_size})") from None
+        if not np.isfinite(self.scale).all():
+            raise ConfigError(f"observation_scale is {observation_scale!r}; every scale must be finite")
         if actions == "box":
             if not isinstance(act_space, gym.spaces.Box):
                 raise ConfigError(f"actions 'box' needs a Box action space; {env_id} has {act_space}")
             count = int(np.prod(act_space.shape))
             self.low = np.asarray(act_space.low, dtype=np.float64).reshape(-1)
             self.span = np.asarray(act_space.high, dtype=np.float64).reshape(-1) - self.low
-            self.action_shape = act_space.shape
+            if not (np.isfinite(self.low).all() and np.isfinite(self.span).all()):
+                raise ConfigError(f"actions 'box' maps a firing rate onto the action's bounds, which must "
+                                  f"be finite; {env_id} has {act_space}")
+            self.action_shape, self.action_dtype = act_space.shape, act_space.dtype
+            self.start = 0
         else:
             if not isinstance(act_space, gym.spaces.Discrete):
                 raise ConfigError(f"actions {actions!r} needs a Discrete action space; {env_id} has "
@@ -99,9 +114,12 @@ class GymEnvironment:
             count = 1 if actions == "threshold" else int(act_space.n)
             if actions == "threshold" and act_space.n != 2:
                 raise ConfigError(f"actions 'threshold' needs Discrete(2); {env_id} has {act_space}")
+            self.start = int(act_space.start)  # Discrete(n, start=s) takes s .. s + n - 1
         self.outputs = np.arange(count) if outputs is None else np.asarray(outputs)
+        if self.outputs.size and (self.outputs.dtype.kind not in "iu" or self.outputs.min() < 0):
+            raise ConfigError(f"outputs is {self.outputs.tolist()}; expected neuron numbers >= 0")
         if len(self.outputs) != count:
-            raise ConfigError(f"outputs names {len(self.outputs)} neurons; actions {actions!r} on "
+            raise ConfigError(f"outputs names {counted(len(self.outputs), 'neuron')}; actions {actions!r} on "
                               f"{act_space} needs {count}")
         self.envs: Any = None
 
@@ -170,12 +188,14 @@ class GymEnvironment:
     def _act(self, rates: npt.NDArray[np.float64]) -> npt.NDArray[Any]:
         check_neurons(rates, self.outputs, f"{type(self).__name__}'s {self.actions!r} actions")
         if self.actions == "threshold":
-            return (rates[:, self.outputs[0]] > 0.5).astype(np.int64)
+            return (rates[:, self.outputs[0]] > 0.5).astype(np.int64) + self.start
         chosen = rates[:, self.outputs]
         if self.actions == "argmax":
-            return np.argmax(chosen, axis=1)
-        action = self.low + chosen * self.span
-        return action.reshape((len(rates), *self.action_shape))
+            return np.argmax(chosen, axis=1) + self.start
+        action = (self.low + chosen * self.span).reshape((len(rates), *self.action_shape))
+        if np.issubdtype(self.action_dtype, np.integer):
+            action = np.rint(action)
+        return action.astype(self.action_dtype)
 
     def close(self) -> None:
         """Closes the vector environment."""

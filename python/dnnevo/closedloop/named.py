@@ -41,8 +41,10 @@ from dnnevo.errors import ConfigError, TaskError, did_you_mean, with_article
 __all__ = ["ROLLOUT_KEYS", "check_own_task", "class_preset", "closed_loop", "environment_class", "is_closed_loop",
            "is_python_task", "observation_size", "refuse_fitness_function"]
 
-#: What a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol).
-_MEMBERS = ("observation_size", "reset", "step")
+#: The methods a class needs to be a task (the :class:`~dnnevo.closedloop.Environment` protocol);
+#: its ``observation_size`` may be set per instance (:class:`~dnnevo.closedloop.gym.GymEnvironment`
+#: counts the kept observations), so it is checked on the environment made from the class.
+_MEMBERS = ("reset", "step")
 
 
 def is_python_task(task: str) -> bool:

@@ -1164,3 +1164,5 @@ def test_assess_judges_a_champion_on_a_variant_of_its_task(tmp_path) -> None:
     assert "judged on a variant of the run's task: task_params.speed=0.05 (--set)" in text
     bad = dnnevo_command(tmp_path, "assess", "run", "--set", "size=4")
     assert bad.returncode == 2 and "assess changes the task's conditions only" in bad.stderr
+    bad = dnnevo_command(tmp_path, "assess", "run", "--set", "task_params.episodes=7")
+    assert bad.returncode == 2 and "--trials says how many are judged" in bad.stderr, bad.stderr

@@ -53,7 +53,7 @@ def test_actions_from_rates() -> None:
     assert chosen._act(rates).tolist() == [1, 0]
     threshold = GymEnvironment("CartPole-v1", actions="threshold", outputs=[2])
     assert threshold._act(rates).tolist() == [0, 1]
-    box = GymEnvironment("Pendulum-v1", actions="box")  # one torque in [-2, 2]
+    box = GymEnvironment("Pendulum-v1", actions="box", vectorization_mode="sync")  # one torque in [-2, 2]
     assert box._act(rates).reshape(-1).tolist() == pytest.approx([-1.2, 0.8])
 
 
@@ -170,6 +170,12 @@ def test_actions_keep_to_the_space_and_a_space_they_cannot_fill_is_refused(monke
         space[:] = [given]
         with pytest.raises(ConfigError, match="must be finite; Acting-v0 has Box"):
             GymEnvironment("Acting-v0", actions="box")
+
+
+def test_an_environment_without_a_native_vector_form_is_told_to_use_sync() -> None:
+    with pytest.raises(ConfigError, match='Pendulum-v1 has no native vector environment.*vectorization_mode="sync"'):
+        GymEnvironment("Pendulum-v1", actions="box")
+    assert GymEnvironment("Pendulum-v1", actions="box", vectorization_mode="sync").observation_size == 3
 
 
 def test_an_unknown_environment_is_a_config_error() -> None:

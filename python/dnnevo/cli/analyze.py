@@ -69,7 +69,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--input", action="append", default=[], metavar="V,V",
                    help="a constant input vector to analyse under (repeatable), e.g. 0,1")
     p.add_argument("--neurons", metavar="I,J", help="the two neurons of the phase portrait")
-    p.add_argument("--sweep", metavar="START:STOP", default="0:1", help="the swept input's range (default 0:1)")
+    p.add_argument("--sweep", metavar="START:STOP", default="0:1", help="the swept input's range (default 0:1); a negative start is written --sweep=-1:1")
     p.add_argument("--sweep-input", type=int, metavar="K", help="which input to sweep (default: the task's main one); "
                                                                      "the others keep the first --input's values")
     p.add_argument("--steps", type=int, default=101, help="input values in the sweep (default 101)")

@@ -99,6 +99,9 @@ def variant(config: EvolutionConfig, assignments: Sequence[str]) -> EvolutionCon
         if not key.startswith("task_params."):
             raise ConfigError(f"--set {item!r}: assess changes the task's conditions only "
                               f"(task_params.KEY=VALUE); {key or '(no key)'} is not one")
+        if key.removeprefix("task_params.") in ("episodes", "validation_episodes", "rows"):
+            raise ConfigError(f"--set {item!r}: the run's {key} does not change what a fresh episode "
+                              "is; --trials says how many are judged")
     return apply_overrides(config, list(assignments))
 
 

@@ -215,7 +215,8 @@ def _seed_line(r: sweep.SeedResult) -> str:
     return (f"seed {r.seed}: {met}; final champion {r.final.verdict} ({_weakest_rate(r)})"
             + ("; a step artefact" if r.artefact else "")
             + ("; note: every fresh episode gave the same return and length, as a task that draws "
-               "nothing from rng gives (docs/closed-loop.md)" if r.final.details.get("all_alike") else ""))
+               "nothing from rng gives, or one whose episodes all end alike (docs/closed-loop.md)"
+               if r.final.details.get("all_alike") else ""))
 
 
 def _weakest_rate(r: sweep.SeedResult) -> str:

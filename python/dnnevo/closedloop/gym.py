@@ -71,6 +71,11 @@ class GymEnvironment:
             raise ConfigError(f"autoreset_mode is {autoreset_mode!r}; expected one of "
                               f"{', '.join(modes)} (or None: the environment's own)")
         self.autoreset_mode = modes.get(autoreset_mode or "")
+        if vectorization_mode == "vector_entry_point" and isinstance(env_id, str) and \
+                env_id in gym.registry and gym.spec(env_id).vector_entry_point is None:
+            raise ConfigError(f"{env_id} has no native vector environment (vectorization_mode "
+                              "\"vector_entry_point\", the default); give vectorization_mode=\"sync\" "
+                              "(or \"async\")")
         try:
             probe = gym.make(env_id, **self.make_kwargs)
         except (gym.error.Error, TypeError, ValueError) as e:

@@ -73,6 +73,9 @@ def test_observations_kept_and_scaled() -> None:
     ({"observation_scale": float("nan")}, "every scale must be finite"),
     ({"make_kwargs": {"gravity": 3}}, r"gymnasium.make\('CartPole-v1', \*\*make_kwargs\) failed: TypeError"),
     ({"observations": [4]}, "CartPole-v1 has 4 components"),
+    ({"observations": [True, False, True, False]}, "expected a list of component numbers"),
+    ({"observations": [[0, 2]]}, "expected a list of component numbers"),
+    ({"vectorization_mode": "Sync"}, "vectorization_mode is 'Sync'; expected one of"),
     ({"autoreset_mode": "sometimes"}, "autoreset_mode is 'sometimes'"),
 ])
 def test_bad_settings_are_config_errors(kwargs: dict, message: str) -> None:
@@ -176,6 +179,8 @@ def test_an_environment_without_a_native_vector_form_is_told_to_use_sync() -> No
     with pytest.raises(ConfigError, match='Pendulum-v1 has no native vector environment.*vectorization_mode="sync"'):
         GymEnvironment("Pendulum-v1", actions="box")
     assert GymEnvironment("Pendulum-v1", actions="box", vectorization_mode="sync").observation_size == 3
+    with pytest.raises(ConfigError, match="Pendulum has no native vector environment"):
+        GymEnvironment("Pendulum", actions="box")  # the latest version, as gymnasium.make takes it
 
 
 def test_an_unknown_environment_is_a_config_error() -> None:

@@ -418,11 +418,22 @@ def test_a_class_preset_is_not_part_of_the_task_unless_its_code_reads_it(tmp_pat
     reader = ("\n\nclass Reader(Seeker):\n    preset = {'size': 3}\n\n"
               "    def reset(self, episodes, rng):\n        self.size = self.preset['size']\n"
               "        return super().reset(episodes, rng)\n")
-    before = load(tmp_path, "digest_preset", base + reader)
-    texts = (task_source(before.Started), task_source(before.Reader))
-    after = load(tmp_path, "digest_preset", (base + reader).replace("{'size': 3}", "{'size': 5}"))
-    assert task_source(after.Started) == texts[0] and "preset" not in texts[0]
-    assert task_source(after.Reader) != texts[1]
+    # Read from outside the class: by a base class, by getattr, by a helper of the module.
+    based = (MODULE + "\n\nclass Base(Seeker):\n    def reset(self, episodes, rng):\n"
+             "        self.size = self.preset['size']\n        return super().reset(episodes, rng)\n"
+             "\n\nclass Sub(Base):\n    preset = {'size': 3}\n")
+    by_name = MODULE + "\n\nclass Named(Seeker):\n    preset = {'size': 3}\n    size = getattr(object, 'preset', 0)\n"
+    # Sharing its line with code that counts, it stays: that code must.
+    shared = MODULE + "\n\nclass Semi(Seeker):\n    preset = {'size': 3}; goal = 1.0\n"
+    for name, text, cls in [("digest_preset", base, "Started"), ("digest_reader", MODULE + reader, "Reader"),
+                            ("digest_based", based, "Sub"), ("digest_named", by_name, "Named"),
+                            ("digest_semi", shared, "Semi")]:
+        before = task_source(getattr(load(tmp_path, name, text), cls))
+        after = task_source(getattr(load(tmp_path, name, text.replace("{'size': 3}", "{'size': 5}")), cls))
+        assert (before == after) == (cls == "Started"), cls
+        assert ("preset" in before) == (cls != "Started"), cls
+    semi = task_source(load(tmp_path, "digest_semi", shared.replace("goal = 1.0", "goal = 3.0")).Semi)
+    assert semi != before
 
 
 def test_runs_recorded_while_a_preset_counted_still_open(tmp_path) -> None:

@@ -235,7 +235,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "run's champion in f64)")
     p.add_argument("--set", action="append", default=[], metavar="task_params.KEY=VALUE",
                    help="judge the champion on a variant of its task, conditions evolution never "
-                        "saw (repeatable), e.g. task_params.speed=0.3: a transfer test")
+                        "saw (repeatable), e.g. task_params.speed=0.3: a transfer test (not the "
+                        "rollout's episodes, validation_episodes or rows: --trials counts episodes)")
 
     p = sub.add_parser("plot", help="write the run's figures as PNGs into its folder",
                        description="Write the run's figures (its fitness and the paper's figures "

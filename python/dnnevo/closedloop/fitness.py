@@ -185,10 +185,13 @@ class ClosedLoop:
         # As made before comments and layout were left out: the source as written.
         written = task_source(kind, raw=True) or kind.__qualname__
         self._legacy_sources.append("\n".join([written, self._parts["attributes"], self._parts["settings"]]))
-        # As made before a class's preset was left out (as written, and by its tokens).
-        for raw in (True, False):
+        # As made before a class's preset was left out (as written, and by its tokens), for a
+        # class that has one.
+        for raw, now in ((True, written), (False, self._parts["source"])):
             with_preset = task_source(kind, raw=raw, keep=("preset",)) or kind.__qualname__
-            self._legacy_sources.append("\n".join([with_preset, self._parts["attributes"], self._parts["settings"]]))
+            if with_preset != now:
+                self._legacy_sources.append("\n".join([with_preset, self._parts["attributes"],
+                                                       self._parts["settings"]]))
         if any(isinstance(v, np.generic) for v in given.values()):
             # NumPy settings, as runs recorded them before they were made Python numbers (and
             # before comments and layout were left out)

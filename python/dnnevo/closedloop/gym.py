@@ -52,6 +52,22 @@ __all__ = ["ACTIONS", "GymEnvironment"]
 
 #: How firing rates become actions.
 ACTIONS = ("argmax", "threshold", "box")
+VECTORIZATION_MODES = ("vector_entry_point", "sync", "async")
+"""``gymnasium.make_vec``'s modes."""
+
+
+def _spec(env_id: str) -> Any:
+    """The registered spec of ``env_id``, of its latest version when it names none (as
+    ``gymnasium.make`` takes it); None when there is none (``gymnasium.make`` then says why)."""
+    from gymnasium.envs.registration import find_highest_version, get_env_id, parse_env_id
+
+    try:
+        namespace, name, version = parse_env_id(env_id)
+        if version is None:
+            version = find_highest_version(namespace, name)
+        return gym.spec(get_env_id(namespace, name, version))
+    except Exception:  # noqa: BLE001 - not registered, or not an id
+        return None
 
 
 class GymEnvironment:
@@ -71,14 +87,17 @@ class GymEnvironment:
             raise ConfigError(f"autoreset_mode is {autoreset_mode!r}; expected one of "
                               f"{', '.join(modes)} (or None: the environment's own)")
         self.autoreset_mode = modes.get(autoreset_mode or "")
-        if vectorization_mode == "vector_entry_point" and isinstance(env_id, str) and \
-                env_id in gym.registry and gym.spec(env_id).vector_entry_point is None:
+        if vectorization_mode not in VECTORIZATION_MODES:
+            raise ConfigError(f"vectorization_mode is {vectorization_mode!r}; expected one of "
+                              f"{', '.join(VECTORIZATION_MODES)}")
+        spec = _spec(env_id)
+        if vectorization_mode == "vector_entry_point" and spec is not None and spec.vector_entry_point is None:
             raise ConfigError(f"{env_id} has no native vector environment (vectorization_mode "
                               "\"vector_entry_point\", the default); give vectorization_mode=\"sync\" "
                               "(or \"async\")")
         try:
             probe = gym.make(env_id, **self.make_kwargs)
-        except (gym.error.Error, TypeError, ValueError) as e:
+        except Exception as e:  # noqa: BLE001 - an unknown id or module, a keyword the environment refuses
             # An unknown id, a misspelt keyword of make_kwargs: the environment's own words.
             raise ConfigError(f"gymnasium.make({env_id!r}, **make_kwargs) failed: {type(e).__name__}: {e}") from None
         try:
@@ -89,6 +108,8 @@ class GymEnvironment:
             raise ConfigError(f"{env_id}'s observation space has no shape; dnnevo needs a box of numbers")
         width = int(np.prod(obs_space.shape))
         self.columns = np.arange(width) if observations is None else np.asarray(observations)
+        if self.columns.ndim != 1 or (self.columns.size and self.columns.dtype.kind not in "iu"):
+            raise ConfigError(f"observations is {observations!r}; expected a list of component numbers")
         if self.columns.size and (self.columns.min() < 0 or self.columns.max() >= width):
             raise ConfigError(f"observations is {self.columns.tolist()}; {env_id} has {width} components")
         self.observation_size = int(self.columns.size)

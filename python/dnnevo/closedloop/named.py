@@ -196,8 +196,8 @@ def _checked_loop(config: EvolutionConfig, cls: type, env: Any, settings: dict[s
 
 DIFFERENCES = {
     "source": "the class's source, or what it reads from its module, was edited since the run "
-              "(comments, docstrings and layout do not count); a success rule added or changed "
-              "counts: it is part of the task",
+              "(comments, docstrings and layout count only for runs recorded before dnnevo left "
+              "them out); a success rule added or changed counts: it is part of the task",
     "attributes": "the environment's attributes differ: task_params, or the run began from Python "
                   "with an environment made with arguments config.toml could not record, or one "
                   "that had run episodes before ClosedLoop wrapped it",

@@ -228,7 +228,9 @@ def plain_source(target: Any, *, ignored: bool = False, keep: tuple[str, ...] = 
         source = inspect.getsource(target)
     except (OSError, TypeError):
         return None
-    return _without_ignored(source, keep) if ignored and inspect.isclass(target) else source
+    if not (ignored and inspect.isclass(target)):
+        return source
+    return _without_ignored(source, keep, _module_reads(target))
 
 
 def task_source(target: Any, *, raw: bool = False, keep: tuple[str, ...] = ()) -> str | None:
@@ -397,9 +399,11 @@ def _functions(target: Any) -> list[types.FunctionType]:
     return found
 
 
-def _without_ignored(source: str, keep: tuple[str, ...] = ()) -> str:
+def _without_ignored(source: str, keep: tuple[str, ...] = (), reads: frozenset[str] = frozenset()) -> str:
     """A class's source without its class-level assignments to :data:`IGNORED_ATTRIBUTES` (but
-    those in ``keep``)."""
+    those in ``keep``). One of :data:`KEPT_WHEN_READ` stays when the class, or its module
+    (``reads``: the attribute names and strings its module's code holds), reads it, or when its
+    assignment shares a line with other code."""
     dedented = textwrap.dedent(source)
     try:
         tree = ast.parse(dedented)
@@ -407,16 +411,45 @@ def _without_ignored(source: str, keep: tuple[str, ...] = ()) -> str:
         return source
     if not tree.body or not isinstance(tree.body[0], ast.ClassDef):
         return source
-    read = {node.attr for node in ast.walk(tree.body[0])
-            if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load)}
+    cls = tree.body[0]
+    read = reads | {node.attr for node in ast.walk(cls)
+                    if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load)}
     ignored = [a for a in IGNORED_ATTRIBUTES if a not in keep and not (a in KEPT_WHEN_READ and a in read)]
+
+    def alone(statement: ast.stmt) -> bool:
+        """Whether no other code shares the statement's lines (the class's header included)."""
+        lines = set(range(statement.lineno, (statement.end_lineno or statement.lineno) + 1))
+        return cls.lineno not in lines and not any(
+            lines & set(range(other.lineno, (other.end_lineno or other.lineno) + 1))
+            for other in cls.body if other is not statement)
+
     drop: set[int] = set()
-    for statement in tree.body[0].body:
+    for statement in cls.body:
         targets = statement.targets if isinstance(statement, ast.Assign) else \
             [statement.target] if isinstance(statement, ast.AnnAssign) else []
-        if any(isinstance(t, ast.Name) and t.id in ignored for t in targets):
+        names = {t.id for t in targets if isinstance(t, ast.Name)} & set(ignored)
+        if names and (alone(statement) or not names & set(KEPT_WHEN_READ)):
             drop.update(range(statement.lineno, (statement.end_lineno or statement.lineno) + 1))
     if not drop:
         return source
     lines = source.splitlines(keepends=True)
     return "".join(line for number, line in enumerate(lines, 1) if number not in drop)
+
+
+def _module_reads(target: Any) -> frozenset[str]:
+    """The attribute names that the code of ``target``'s module loads, and the strings it holds
+    (``getattr(self, "preset")``): what may read a class attribute from outside the class."""
+    module = sys.modules.get(getattr(target, "__module__", ""), None)
+    try:
+        tree = ast.parse(inspect.getsource(module)) if module is not None else None
+    except (OSError, TypeError, SyntaxError):
+        return frozenset()
+    if tree is None:
+        return frozenset()
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load):
+            found.add(node.attr)
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str):
+            found.add(node.value)
+    return frozenset(found)

@@ -449,3 +449,21 @@ def test_runs_recorded_while_a_preset_counted_still_open(tmp_path) -> None:
         assert "preset" in text
         assert hashlib.sha256("\n".join([text, *rest]).encode()).hexdigest() in loop.digests()
     assert "preset" not in task_source(module.Started)
+
+
+def test_a_digest_recorded_with_the_source_as_written_is_known_without_the_digest_code(tmp_path) -> None:
+    """The digest runs recorded before comments and layout were left out, made here from the
+    class's source as Python gives it (no dnnevo code makes the text): still accepted."""
+    import hashlib
+    import inspect
+
+    text = ("import numpy as np\n\n\nclass Plain:  # a comment\n    \"\"\"Its docstring.\"\"\"\n\n"
+            "    observation_size = 1\n\n    def reset(self, episodes, rng):\n"
+            "        return np.zeros((len(episodes), 1))\n\n    def step(self, rates, active):\n"
+            "        n = len(rates)\n        return np.zeros((n, 1)), np.ones(n), np.zeros(n, bool)\n")
+    module = load(tmp_path, "digest_written", text)
+    loop = ClosedLoop(module.Plain(), episodes=2, max_steps=50)
+    written = inspect.getsource(module.Plain)
+    assert written.startswith("class Plain:  # a comment\n")
+    recorded = hashlib.sha256("\n".join([written, loop._parts["attributes"], loop._parts["settings"]]).encode())
+    assert recorded.hexdigest() in loop.digests() and recorded.hexdigest() != loop.digest()

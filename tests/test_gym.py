@@ -168,7 +168,8 @@ def test_actions_keep_to_the_space_and_a_space_they_cannot_fill_is_refused(monke
         space[:] = [given]
         env = GymEnvironment("Acting-v0", actions=actions, outputs=[2] if actions == "threshold" else None)
         acted = env._act(rates)
-        assert acted.reshape(-1).tolist() == pytest.approx(want) and all(given.contains(a) for a in acted), given
+        assert acted.reshape(-1).tolist() == pytest.approx(want), given
+        assert all(given.contains(a.astype(given.dtype)) for a in acted) and acted.dtype.kind == given.dtype.kind
     for given in (Box(-np.inf, np.inf, (1,)), Box(0.0, np.inf, (1,))):
         space[:] = [given]
         with pytest.raises(ConfigError, match="must be finite; Acting-v0 has Box"):

@@ -8,7 +8,8 @@ networks' firing rates to its actions:
 - ``"threshold"`` (``Discrete(2)``): action 1 (plus ``start``) when the first output neuron's
   rate is above 0.5;
 - ``"box"`` (a ``Box`` with finite bounds): each of the first ``d`` output neurons' rates, in
-  [0, 1], scaled onto the action's ``[low, high]``, in the space's dtype (rounded for integers).
+  [0, 1], scaled onto the action's ``[low, high]``: float64, or rounded to the space's dtype
+  for an integer box.
 
 ``outputs`` chooses the output neurons (default: neurons 0, 1, ...). ``vectorization_mode`` and
 ``autoreset_mode`` (``"next_step"``, ``"same_step"`` or ``"disabled"``) are passed to
@@ -45,6 +46,7 @@ from dnnevo.errors import ConfigError, counted
 
 try:
     import gymnasium as gym
+    from gymnasium.envs.registration import find_highest_version, get_env_id, parse_env_id
 except ImportError as e:  # pragma: no cover - depends on the installation
     raise ImportError('dnnevo.closedloop.gym needs Gymnasium: pip install "dnnevo[gym]"') from e
 
@@ -59,8 +61,6 @@ VECTORIZATION_MODES = ("vector_entry_point", "sync", "async")
 def _spec(env_id: str) -> Any:
     """The registered spec of ``env_id``, of its latest version when it names none (as
     ``gymnasium.make`` takes it); None when there is none (``gymnasium.make`` then says why)."""
-    from gymnasium.envs.registration import find_highest_version, get_env_id, parse_env_id
-
     try:
         namespace, name, version = parse_env_id(env_id)
         if version is None:
@@ -220,8 +220,10 @@ class GymEnvironment:
             return np.argmax(chosen, axis=1) + self.start
         action = (self.low + chosen * self.span).reshape((len(rates), *self.action_shape))
         if np.issubdtype(self.action_dtype, np.integer):
-            action = np.rint(action)
-        return action.astype(self.action_dtype)
+            return np.rint(action).astype(self.action_dtype)
+        # Float actions stay float64, as evolution has always given them: a float32 space's
+        # environment computes with them as given (Pendulum-v1's returns depend on it).
+        return action
 
     def close(self) -> None:
         """Closes the vector environment."""

@@ -15,6 +15,7 @@ from typing import Any
 from dnnevo import tasks
 from dnnevo.cli.outputs import reader_gone
 from dnnevo.closedloop import named
+from dnnevo.closedloop.fitness import ROLLOUT_KEYS
 from dnnevo.config import EvolutionConfig, apply_overrides
 from dnnevo.evaluation.assessment import Assessment, Rate
 from dnnevo.evaluation.stats import Verdict
@@ -91,6 +92,11 @@ def assess(args: argparse.Namespace) -> int:
     return status
 
 
+COUNTS = tuple(k for k in ROLLOUT_KEYS if k != "max_steps")
+"""The rollout's settings that count episodes or rows: a variant may not set them, since they
+do not change what a fresh episode is (``--trials`` counts the judged ones)."""
+
+
 def variant(config: EvolutionConfig, assignments: Sequence[str]) -> EvolutionConfig:
     """``config`` with ``task_params.KEY=VALUE`` ``assignments``: the run's task in conditions its
     evolution never saw. Other settings belong to the evolution, not the task, and are refused."""
@@ -99,7 +105,7 @@ def variant(config: EvolutionConfig, assignments: Sequence[str]) -> EvolutionCon
         if not key.startswith("task_params."):
             raise ConfigError(f"--set {item!r}: assess changes the task's conditions only "
                               f"(task_params.KEY=VALUE); {key or '(no key)'} is not one")
-        if key.removeprefix("task_params.") in ("episodes", "validation_episodes", "rows"):
+        if key.removeprefix("task_params.") in COUNTS:
             raise ConfigError(f"--set {item!r}: the run's {key} does not change what a fresh episode "
                               "is; --trials says how many are judged")
     return apply_overrides(config, list(assignments))
